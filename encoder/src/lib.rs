@@ -1,0 +1,6 @@
+//! The splitstream encoder.
+
+pub mod mesh;
+pub mod quadric;
+
+pub use mesh::Mesh;

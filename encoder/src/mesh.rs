@@ -1,0 +1,45 @@
+//! The encoder's input mesh: positions in f64 (so geographic coordinates
+//! survive until quantization) and counter-clockwise triangles.
+
+/// An indexed triangle mesh as read from a file, before checking.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions in the file's own units.
+    pub positions: Vec<[f64; 3]>,
+    /// Triangles as vertex indices, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    pub fn vertex_count(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Axis-aligned bounding box `(min, max)`; `None` for an empty mesh.
+    pub fn bounding_box(&self) -> Option<([f64; 3], [f64; 3])> {
+        let first = *self.positions.first()?;
+        let mut lo = first;
+        let mut hi = first;
+        for p in &self.positions {
+            for k in 0..3 {
+                lo[k] = lo[k].min(p[k]);
+                hi[k] = hi[k].max(p[k]);
+            }
+        }
+        Some((lo, hi))
+    }
+
+    /// Length of the bounding-box diagonal (0 for an empty mesh).
+    pub fn diagonal(&self) -> f64 {
+        self.bounding_box()
+            .map(|(lo, hi)| {
+                let d = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+                (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+            })
+            .unwrap_or(0.0)
+    }
+}

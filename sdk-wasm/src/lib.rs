@@ -1,0 +1,4 @@
+//! Browser SDK for splitstream streams (wasm-bindgen + TypeScript).
+//!
+//! Not built yet: this crate is an empty placeholder in the fixed workspace
+//! layout. It exports nothing, so nothing can mistake it for a working SDK.
