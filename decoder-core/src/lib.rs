@@ -1,2 +1,67 @@
+//! Reference decoder of the splitstream progressive mesh format.
+//!
+//! `#![no_std]`, no allocation, no `unsafe`: the caller hands in every byte
+//! the decoder uses, sized from the stream header ([`Layout`]), and the
+//! decoder never panics, reads out of bounds or loops without bound on any
+//! input. With `SPEC.md` beside it, this crate *defines* the format; each
+//! module names the SPEC section it implements.
+//!
+//! ```no_run
+//! use splitstream_decoder_core::{Decoder, Inflater, Layout};
+//! # let stream: &[u8] = &[];
+//! let mut inflater = Inflater::new();
+//! let needed = splitstream_decoder_core::workspace_len(stream).unwrap();
+//! let mut workspace = vec![0u8; needed];
+//! let mut decoder = Decoder::new(stream, &mut workspace, &mut inflater).unwrap();
+//! decoder.decode_available(stream).unwrap();
+//! println!("{} triangles, hash {:016x}", decoder.triangles().len(), decoder.state_hash());
+//! ```
 #![no_std]
 #![forbid(unsafe_code)]
+
+#[cfg(feature = "alloc")]
+extern crate alloc;
+
+mod base;
+mod bytes;
+mod decoder;
+mod error;
+mod hash;
+mod header;
+mod inflate;
+mod layout;
+mod level_header;
+mod level_table;
+pub mod limits;
+#[cfg(feature = "alloc")]
+pub mod owned;
+mod record;
+mod ring;
+mod round;
+mod split;
+mod state;
+mod substream;
+#[cfg(feature = "alloc")]
+pub mod writer;
+
+pub use bytes::crc32;
+pub use decoder::{Decoder, LevelDecoder, RoundInfo, layout_for};
+pub use error::{ChecksumScope, Error};
+pub use hash::Fnv1a;
+pub use header::{Header, PositionMode};
+pub use inflate::Inflater;
+pub use layout::Layout;
+pub use level_header::{ChunkEntry, LevelHeader};
+pub use level_table::{LevelInfo, LevelTable, head_len, write_level_table};
+pub use ring::Ring;
+pub use round::{RecordSource, RoundStats};
+pub use split::{SplitOutcome, SplitRecord};
+pub use state::{MeshState, StateMemory, next, prev};
+
+/// Bytes of workspace (with alignment slack) needed to decode all of
+/// `stream`, from its header and level table alone (SPEC §9).
+pub fn workspace_len(head: &[u8]) -> Result<usize, Error> {
+    let header = Header::parse(head)?;
+    let table = LevelTable::parse(head, &header)?;
+    Ok(layout_for(&header, &table, header.level_count - 1).bytes_unaligned())
+}

@@ -1,0 +1,150 @@
+//! Loading the base mesh and building its adjacency (SPEC §6.3).
+//!
+//! The base mesh arrives as plain triangles; this checks that it is a
+//! consistently oriented 2-manifold (possibly with boundary) and builds the
+//! opposite-corner table without allocating: a counting sort of the corners
+//! by vertex runs in the scratch tail of the opposite table.
+
+use crate::Error;
+use crate::limits::{LEAF, MAX_SPLIT_VALENCE, NONE};
+use crate::state::{MeshState, next, prev};
+
+impl MeshState<'_> {
+    /// Scratch `u32`s the base build needs past `3 * triangles` in the
+    /// opposite table (SPEC §9).
+    pub fn base_scratch_len(vertices: u32, triangles: u32) -> usize {
+        3 * triangles as usize + vertices as usize + 1
+    }
+
+    /// Starts the state as a base mesh whose positions, triangles and
+    /// deficits the caller has already written through [`MeshState::base_arrays`],
+    /// then validates it and builds the adjacency (SPEC §6.3).
+    pub fn finish_base(&mut self, vertices: u32, triangles: u32) -> Result<(), Error> {
+        let nv = vertices as usize;
+        let nt = triangles as usize;
+        let nc = 3 * nt;
+        if vertices > self.vertex_capacity()
+            || triangles > self.triangle_capacity()
+            || self.opposite.len() < nc + Self::base_scratch_len(vertices, triangles)
+        {
+            return Err(Error::CapacityExceeded);
+        }
+        for tri in self.corners[..nc].chunks_exact(3) {
+            if tri.iter().any(|&v| v >= vertices) {
+                return Err(Error::NonManifold("vertex index out of range"));
+            }
+            if tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2] {
+                return Err(Error::NonManifold("degenerate triangle"));
+            }
+        }
+        let (opposite, scratch) = self.opposite.split_at_mut(nc);
+        let (list, start) = scratch.split_at_mut(nc);
+        let start = &mut start[..nv + 1];
+        let corners = &self.corners[..nc];
+
+        // Counting sort of corners by vertex: afterwards the corners of v are
+        // list[start[v] .. start[v + 1]].
+        start.fill(0);
+        for &v in corners {
+            start[v as usize + 1] += 1;
+        }
+        for v in 0..nv {
+            start[v + 1] += start[v];
+        }
+        for (c, &v) in corners.iter().enumerate() {
+            // Fill from the back of each range, then shift back below.
+            start[v as usize + 1] -= 1;
+            list[start[v as usize + 1] as usize] = c as u32;
+        }
+        // start[v + 1] now holds the start of v; rotate into place.
+        for v in 0..nv {
+            start[v] = start[v + 1];
+        }
+        start[nv] = nc as u32;
+
+        let next_vertex = |c: u32| corners[next(c) as usize];
+        for v in 0..nv {
+            let s = start[v] as usize;
+            let e = start[v + 1] as usize;
+            if s == e {
+                return Err(Error::NonManifold("unreferenced vertex"));
+            }
+            let fan = &mut list[s..e];
+            fan.sort_unstable_by_key(|&c| next_vertex(c));
+            if fan
+                .windows(2)
+                .any(|w| next_vertex(w[0]) == next_vertex(w[1]))
+            {
+                return Err(Error::NonManifold(
+                    "an edge is used twice in the same direction (non-manifold or inconsistently oriented)",
+                ));
+            }
+            self.vertex_corner[v] = fan[0];
+        }
+        // The triangle facing corner c across edge b -> d holds d -> b.
+        for c in 0..nc as u32 {
+            let b = corners[next(c) as usize];
+            let d = corners[prev(c) as usize];
+            let fan = &list[start[d as usize] as usize..start[d as usize + 1] as usize];
+            opposite[c as usize] = match fan.binary_search_by_key(&b, |&x| next_vertex(x)) {
+                Ok(i) => prev(fan[i]),
+                Err(_) => NONE,
+            };
+        }
+
+        // Every vertex must have one fan: a full disk or a single open fan.
+        for v in 0..nv {
+            let count = start[v + 1] - start[v];
+            let valence = fan_valence(opposite, self.vertex_corner[v], count)
+                .ok_or(Error::NonManifold("a vertex has more than one fan"))?;
+            let deficit = self.deficit[v];
+            if deficit != LEAF && valence + deficit as usize > MAX_SPLIT_VALENCE {
+                return Err(Error::ValenceOverflow);
+            }
+        }
+        self.vertex_count = vertices;
+        self.triangle_count = triangles;
+        Ok(())
+    }
+
+    /// The arrays a base-mesh reader fills before [`MeshState::finish_base`]:
+    /// positions, the flat triangle corner list and deficits.
+    pub fn base_arrays(&mut self) -> (&mut [[u32; 3]], &mut [u32], &mut [u8]) {
+        (self.positions, self.corners, self.deficit)
+    }
+}
+
+/// Valence of the vertex at corner `start` if its `count` corners form one
+/// fan, else `None`. Interior vertices need at least 3 neighbours.
+fn fan_valence(opposite: &[u32], start: u32, count: u32) -> Option<usize> {
+    let mut seen = 1u32;
+    let mut c = start;
+    loop {
+        let o = opposite[next(c) as usize];
+        if o == NONE {
+            break;
+        }
+        c = next(o);
+        if c == start {
+            return (seen == count && count >= 3).then_some(count as usize);
+        }
+        seen += 1;
+        if seen > count {
+            return None;
+        }
+    }
+    // Open fan: count the clockwise side too.
+    let mut c = start;
+    loop {
+        let o = opposite[prev(c) as usize];
+        if o == NONE {
+            break;
+        }
+        c = prev(o);
+        seen += 1;
+        if seen > count {
+            return None;
+        }
+    }
+    (seen == count).then_some(count as usize + 2)
+}

@@ -1,0 +1,360 @@
+//! The stream decoder: levels in order, rounds within a level (SPEC §7.6).
+
+use crate::Error;
+use crate::header::Header;
+use crate::inflate::Inflater;
+use crate::layout::Layout;
+use crate::level_header::LevelHeader;
+use crate::level_table::{LevelInfo, LevelTable};
+use crate::limits::substream::{self, SLOTS};
+use crate::record::{StreamSource, read_base};
+use crate::ring::Ring;
+use crate::round::RoundStats;
+use crate::state::MeshState;
+use crate::substream::Substreams;
+
+/// What one finished round did, with the counts after it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RoundInfo {
+    pub level: u16,
+    pub round: u32,
+    pub stats: RoundStats,
+    pub vertex_count: u32,
+    pub triangle_count: u32,
+}
+
+/// Decodes a stream level by level into a caller-owned workspace.
+///
+/// Levels are fed as byte slices (each fetched by its own range request if
+/// need be), in order. When the workspace is smaller than the whole stream
+/// needs, the decoder holds as many levels as fit and [`Decoder::next_level`]
+/// returns `None` after the last of them (SPEC §9).
+pub struct Decoder<'h, 'ws> {
+    header: Header,
+    table: LevelTable<'h>,
+    state: MeshState<'ws>,
+    buffers: [&'ws mut [u8]; SLOTS],
+    inflater: &'ws mut Inflater,
+    ring: Ring,
+    next_level: u16,
+    levels_that_fit: u16,
+    poisoned: bool,
+}
+
+impl<'h, 'ws> Decoder<'h, 'ws> {
+    /// Parses the header and level table at the start of `head` (the whole
+    /// stream or just its first bytes, see [`crate::head_len`]) and lays the
+    /// decoder out in `workspace`.
+    pub fn new(
+        head: &'h [u8],
+        workspace: &'ws mut [u8],
+        inflater: &'ws mut Inflater,
+    ) -> Result<Self, Error> {
+        let header = Header::parse(head)?;
+        let table = LevelTable::parse(head, &header)?;
+        let full = layout_for(&header, &table, header.level_count - 1);
+        if full.total as u64 != header.workspace_bytes {
+            return Err(Error::InvalidHeader(
+                "declared workspace size differs from SPEC §9",
+            ));
+        }
+        // The largest prefix of levels whose layout fits the workspace.
+        let mut fit = header.level_count;
+        let layout = loop {
+            let layout = layout_for(&header, &table, fit - 1);
+            if layout.fits(workspace) {
+                break layout;
+            }
+            fit -= 1;
+            if fit == 0 {
+                return Err(Error::WorkspaceTooSmall {
+                    needed: layout_for(&header, &table, 0).total,
+                    available: workspace.len(),
+                });
+            }
+        };
+        let (memory, buffers) = layout.carve(workspace)?;
+        Ok(Decoder {
+            state: MeshState::new(memory, header.bits),
+            header,
+            table,
+            buffers,
+            inflater,
+            ring: Ring::default(),
+            next_level: 0,
+            levels_that_fit: fit,
+            poisoned: false,
+        })
+    }
+
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    pub fn level_table(&self) -> &LevelTable<'h> {
+        &self.table
+    }
+
+    /// Levels (base included) this workspace can hold.
+    pub fn levels_that_fit(&self) -> u16 {
+        self.levels_that_fit
+    }
+
+    /// The level to feed next, or `None` when every level that fits is done.
+    pub fn next_level(&self) -> Option<u16> {
+        (self.next_level < self.levels_that_fit && !self.poisoned).then_some(self.next_level)
+    }
+
+    /// Levels decoded so far (base included).
+    pub fn levels_done(&self) -> u16 {
+        self.next_level
+    }
+
+    /// The current mesh state.
+    pub fn state(&self) -> &MeshState<'ws> {
+        &self.state
+    }
+
+    pub fn positions(&self) -> &[[u32; 3]] {
+        self.state.positions()
+    }
+
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        self.state.triangles()
+    }
+
+    /// The canonical state hash of SPEC §8.
+    pub fn state_hash(&self) -> u64 {
+        self.state.state_hash()
+    }
+
+    /// The byte range of level `k` in the stream.
+    pub fn level_range(&self, k: u16) -> core::ops::Range<u64> {
+        let e = self.table.get(k);
+        e.offset..e.offset + e.length as u64
+    }
+
+    /// Starts level `level` from its bytes; decode its rounds with
+    /// [`LevelDecoder::next_round`]. The base level (0) is decoded at once.
+    pub fn begin_level<'d, 'l>(
+        &'d mut self,
+        level: u16,
+        bytes: &'l [u8],
+    ) -> Result<LevelDecoder<'d, 'l, 'ws>, Error> {
+        if self.poisoned {
+            return Err(Error::Poisoned);
+        }
+        if level != self.next_level || level >= self.levels_that_fit {
+            return Err(Error::LevelOutOfOrder {
+                expected: self.next_level,
+                got: level,
+            });
+        }
+        let info = self.table.get(level);
+        let header = match prepare_level(self, level, info, bytes) {
+            Ok(h) => h,
+            Err(e) => {
+                self.poisoned = true;
+                return Err(e);
+            }
+        };
+        let mut ld = open_level(self, level, info, header, bytes);
+        if level == 0 {
+            let result = read_base(
+                ld.state,
+                &mut ld.subs,
+                info.vertex_count,
+                info.triangle_count,
+            )
+            .and_then(|_| ld.complete());
+            if let Err(e) = result {
+                *ld.poisoned = true;
+                return Err(e);
+            }
+        }
+        Ok(ld)
+    }
+
+    /// Decodes a whole level (see [`Decoder::begin_level`]).
+    pub fn decode_level(&mut self, level: u16, bytes: &[u8]) -> Result<(), Error> {
+        let mut ld = self.begin_level(level, bytes)?;
+        while ld.next_round()?.is_some() {}
+        Ok(())
+    }
+
+    /// Decodes every level that fits from the whole `stream`; returns the
+    /// number of levels decoded (base included).
+    pub fn decode_available(&mut self, stream: &[u8]) -> Result<u16, Error> {
+        while let Some(k) = self.next_level() {
+            let range = self.level_range(k);
+            let bytes = stream
+                .get(range.start as usize..range.end as usize)
+                .ok_or(Error::Truncated)?;
+            if let Err(e) = self.decode_level(k, bytes) {
+                self.poisoned = true;
+                return Err(e);
+            }
+        }
+        Ok(self.next_level)
+    }
+
+    /// Real coordinates of a quantized position.
+    pub fn dequantize(&self, q: [u32; 3]) -> [f64; 3] {
+        self.header.dequantize(q)
+    }
+}
+
+/// Validates a level's header against its table entry (SPEC §5.1).
+fn prepare_level<'l>(
+    decoder: &Decoder<'_, '_>,
+    level: u16,
+    info: LevelInfo,
+    bytes: &'l [u8],
+) -> Result<LevelHeader<'l>, Error> {
+    if bytes.len() as u64 != info.length as u64 {
+        return Err(Error::Truncated);
+    }
+    let is_base = level == 0;
+    let header = LevelHeader::parse(bytes, is_base, decoder.header.max_chunk_len)?;
+    if header.round_count != info.round_count {
+        return Err(Error::LevelCountMismatch);
+    }
+    if !is_base {
+        let before = decoder.table.get(level - 1).vertex_count as u64;
+        let mut added = 0u64;
+        for r in 0..header.round_count {
+            let s = header.split_count(r);
+            if s == 0 {
+                return Err(Error::InvalidLevelHeader("a round without splits"));
+            }
+            added += s as u64;
+        }
+        if before + added != info.vertex_count as u64 {
+            return Err(Error::LevelCountMismatch);
+        }
+    }
+    Ok(header)
+}
+
+fn open_level<'d, 'l, 'ws>(
+    decoder: &'d mut Decoder<'_, 'ws>,
+    level: u16,
+    info: LevelInfo,
+    header: LevelHeader<'l>,
+    bytes: &'l [u8],
+) -> LevelDecoder<'d, 'l, 'ws> {
+    let is_base = level == 0;
+    let first_id = if is_base {
+        substream::BASE_POSITIONS
+    } else {
+        substream::FLAGS
+    };
+    let buffers = decoder.buffers.each_mut().map(|b| &mut **b);
+    let subs = Substreams::open(bytes, header, first_id, buffers, decoder.inflater);
+    LevelDecoder {
+        level,
+        info,
+        header,
+        round: 0,
+        mode: decoder.header.position_mode,
+        state: &mut decoder.state,
+        subs,
+        ring: &mut decoder.ring,
+        next_level: &mut decoder.next_level,
+        poisoned: &mut decoder.poisoned,
+        done: is_base,
+    }
+}
+
+/// Decodes one level round by round; a viewer may draw between rounds.
+pub struct LevelDecoder<'d, 'l, 'ws> {
+    level: u16,
+    info: LevelInfo,
+    header: LevelHeader<'l>,
+    round: u32,
+    mode: crate::header::PositionMode,
+    state: &'d mut MeshState<'ws>,
+    subs: Substreams<'l, 'd>,
+    ring: &'d mut Ring,
+    next_level: &'d mut u16,
+    poisoned: &'d mut bool,
+    done: bool,
+}
+
+impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
+    /// Decodes the next round; `None` once the level is complete and verified.
+    pub fn next_round(&mut self) -> Result<Option<RoundInfo>, Error> {
+        if *self.poisoned {
+            return Err(Error::Poisoned);
+        }
+        if self.done {
+            return Ok(None);
+        }
+        if self.round == self.header.round_count {
+            return match self.complete() {
+                Ok(()) => Ok(None),
+                Err(e) => {
+                    *self.poisoned = true;
+                    Err(e)
+                }
+            };
+        }
+        let declared = self.header.split_count(self.round);
+        let mut source = StreamSource {
+            subs: &mut self.subs,
+            mode: self.mode,
+        };
+        match self.state.run_round(declared, &mut source, self.ring) {
+            Ok(stats) => {
+                let info = RoundInfo {
+                    level: self.level,
+                    round: self.round,
+                    stats,
+                    vertex_count: self.state.vertex_count(),
+                    triangle_count: self.state.triangle_count(),
+                };
+                self.round += 1;
+                Ok(Some(info))
+            }
+            Err(e) => {
+                *self.poisoned = true;
+                Err(match e {
+                    Error::FlagCountMismatch { .. } => {
+                        Error::FlagCountMismatch { round: self.round }
+                    }
+                    other => other,
+                })
+            }
+        }
+    }
+
+    /// The mesh state as of the last round.
+    pub fn state(&self) -> &MeshState<'ws> {
+        self.state
+    }
+
+    fn complete(&mut self) -> Result<(), Error> {
+        self.subs.finish()?;
+        if self.state.vertex_count() != self.info.vertex_count
+            || self.state.triangle_count() != self.info.triangle_count
+        {
+            return Err(Error::LevelCountMismatch);
+        }
+        self.done = true;
+        *self.next_level += 1;
+        Ok(())
+    }
+}
+
+/// Layout for decoding levels `0 ..= last` of a stream (SPEC §9).
+pub fn layout_for(header: &Header, table: &LevelTable<'_>, last: u16) -> Layout {
+    let base = table.get(0);
+    let top = table.get(last);
+    Layout::new(
+        top.vertex_count,
+        top.triangle_count,
+        base.vertex_count,
+        base.triangle_count,
+        header.max_chunk_len,
+    )
+}

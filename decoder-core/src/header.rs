@@ -1,0 +1,152 @@
+//! The fixed 96-byte header (SPEC §3).
+
+use crate::bytes::{crc32, f64_at, u8_at, u16_at, u32_at, u64_at};
+use crate::limits::{
+    HEADER_LEN, MAGIC, MAX_BITS, MAX_TRIANGLES, MAX_VERTICES, MIN_BITS, VERSION_MAJOR,
+};
+use crate::{ChecksumScope, Error};
+
+/// How the two vertices of a split are placed relative to their parent (SPEC §3.2, §7.5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PositionMode {
+    /// Two deltas per split: the edge vector and the parent's offset from its midpoint.
+    Optimal,
+    /// One delta per split plus a placement code: the parent sits on P, on C or at their midpoint.
+    Constrained,
+}
+
+/// The parsed header (SPEC §3.2).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Header {
+    pub version_minor: u8,
+    pub position_mode: PositionMode,
+    /// Quantization bits per axis: coordinates lie in `0 .. 2^bits`.
+    pub bits: u8,
+    /// Entries in the level table; entry 0 is the base mesh.
+    pub level_count: u16,
+    /// Vertex count after the last level.
+    pub vertex_capacity: u32,
+    /// Triangle count after the last level.
+    pub triangle_capacity: u32,
+    /// Largest raw (decompressed) chunk length in the stream.
+    pub max_chunk_len: u32,
+    /// Real coordinate of quantized value 0 on each axis.
+    pub origin: [f64; 3],
+    /// Real length of one quantization step on each axis.
+    pub scale: [f64; 3],
+    /// Bytes of the reference workspace for the whole stream (SPEC §9).
+    pub workspace_bytes: u64,
+}
+
+impl Header {
+    /// Parses and validates the header at the start of `bytes` (SPEC §3).
+    pub fn parse(bytes: &[u8]) -> Result<Header, Error> {
+        if bytes.len() < MAGIC.len() {
+            return Err(Error::Truncated);
+        }
+        if bytes[..MAGIC.len()] != MAGIC {
+            return Err(Error::BadMagic);
+        }
+        let major = u8_at(bytes, 8)?;
+        let minor = u8_at(bytes, 9)?;
+        if major != VERSION_MAJOR {
+            return Err(Error::UnsupportedVersion { major, minor });
+        }
+        if bytes.len() < HEADER_LEN {
+            return Err(Error::Truncated);
+        }
+        if crc32(&bytes[..HEADER_LEN - 4]) != u32_at(bytes, HEADER_LEN - 4)? {
+            return Err(Error::ChecksumMismatch(ChecksumScope::Header));
+        }
+        let flags = u16_at(bytes, 10)?;
+        if flags & !1 != 0 {
+            return Err(Error::InvalidHeader("reserved flag bits set"));
+        }
+        let position_mode = if flags & 1 == 0 {
+            PositionMode::Optimal
+        } else {
+            PositionMode::Constrained
+        };
+        let bits = u8_at(bytes, 12)?;
+        if !(MIN_BITS..=MAX_BITS).contains(&bits) {
+            return Err(Error::InvalidHeader("bits per axis outside 1..=31"));
+        }
+        if u8_at(bytes, 13)? != 0 || u32_at(bytes, 28)? != 0 || u32_at(bytes, 88)? != 0 {
+            return Err(Error::InvalidHeader("reserved field not zero"));
+        }
+        let level_count = u16_at(bytes, 14)?;
+        if level_count == 0 {
+            return Err(Error::InvalidHeader("no levels"));
+        }
+        let vertex_capacity = u32_at(bytes, 16)?;
+        let triangle_capacity = u32_at(bytes, 20)?;
+        if vertex_capacity == 0 || vertex_capacity > MAX_VERTICES {
+            return Err(Error::InvalidHeader("vertex capacity"));
+        }
+        if triangle_capacity == 0 || triangle_capacity > MAX_TRIANGLES {
+            return Err(Error::InvalidHeader("triangle capacity"));
+        }
+        let max_chunk_len = u32_at(bytes, 24)?;
+        let mut origin = [0.0; 3];
+        let mut scale = [0.0; 3];
+        for k in 0..3 {
+            origin[k] = f64_at(bytes, 32 + 8 * k)?;
+            scale[k] = f64_at(bytes, 56 + 8 * k)?;
+            if !origin[k].is_finite() {
+                return Err(Error::InvalidHeader("origin not finite"));
+            }
+            if !(scale[k].is_finite() && scale[k] > 0.0) {
+                return Err(Error::InvalidHeader("scale not finite and positive"));
+            }
+        }
+        let workspace_bytes = u64_at(bytes, 80)?;
+        let header = Header {
+            version_minor: minor,
+            position_mode,
+            bits,
+            level_count,
+            vertex_capacity,
+            triangle_capacity,
+            max_chunk_len,
+            origin,
+            scale,
+            workspace_bytes,
+        };
+        Ok(header)
+    }
+
+    /// Writes the header into `out` (96 bytes), checksum included. Used by
+    /// encoders; the inverse of [`Header::parse`].
+    pub fn write(&self, out: &mut [u8; HEADER_LEN]) {
+        out.fill(0);
+        out[..8].copy_from_slice(&MAGIC);
+        out[8] = VERSION_MAJOR;
+        out[9] = self.version_minor;
+        let flags: u16 = match self.position_mode {
+            PositionMode::Optimal => 0,
+            PositionMode::Constrained => 1,
+        };
+        out[10..12].copy_from_slice(&flags.to_le_bytes());
+        out[12] = self.bits;
+        out[14..16].copy_from_slice(&self.level_count.to_le_bytes());
+        out[16..20].copy_from_slice(&self.vertex_capacity.to_le_bytes());
+        out[20..24].copy_from_slice(&self.triangle_capacity.to_le_bytes());
+        out[24..28].copy_from_slice(&self.max_chunk_len.to_le_bytes());
+        for k in 0..3 {
+            out[32 + 8 * k..40 + 8 * k].copy_from_slice(&self.origin[k].to_le_bytes());
+            out[56 + 8 * k..64 + 8 * k].copy_from_slice(&self.scale[k].to_le_bytes());
+        }
+        out[80..88].copy_from_slice(&self.workspace_bytes.to_le_bytes());
+        let crc = crc32(&out[..HEADER_LEN - 4]);
+        out[HEADER_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
+    }
+
+    /// Real coordinates of a quantized position: `origin + q * scale` (SPEC §3.2).
+    pub fn dequantize(&self, q: [u32; 3]) -> [f64; 3] {
+        [
+            self.origin[0] + q[0] as f64 * self.scale[0],
+            self.origin[1] + q[1] as f64 * self.scale[1],
+            self.origin[2] + q[2] as f64 * self.scale[2],
+        ]
+    }
+}

@@ -1,0 +1,148 @@
+//! How much memory a decoder needs, and where each array lives in it (SPEC §9).
+//!
+//! Everything a decoder touches is carved from one caller-owned byte buffer:
+//! no allocation, and one number for the caller to size.
+
+use crate::Error;
+use crate::limits::substream::SLOTS;
+use crate::state::{MeshState, StateMemory};
+
+/// Alignment of every region, and of the buffer start the layout assumes.
+pub const ALIGN: usize = 8;
+
+/// Byte ranges of the workspace regions for given capacities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Layout {
+    pub vertex_capacity: u32,
+    pub triangle_capacity: u32,
+    pub max_chunk_len: u32,
+    positions: (usize, usize),
+    corners: (usize, usize),
+    opposite: (usize, usize),
+    vertex_corner: (usize, usize),
+    deficit: (usize, usize),
+    candidates: (usize, usize),
+    buffers: (usize, usize),
+    chunk_buffer_len: usize,
+    /// Total bytes, from an 8-aligned start.
+    pub total: usize,
+}
+
+fn round_up(n: usize) -> usize {
+    n.div_ceil(ALIGN) * ALIGN
+}
+
+impl Layout {
+    /// Layout for a decoder that holds up to `vertex_capacity` vertices and
+    /// `triangle_capacity` triangles of a stream whose base mesh has
+    /// `base_vertices` and `base_triangles`, with chunks up to `max_chunk_len`.
+    pub fn new(
+        vertex_capacity: u32,
+        triangle_capacity: u32,
+        base_vertices: u32,
+        base_triangles: u32,
+        max_chunk_len: u32,
+    ) -> Layout {
+        let v = vertex_capacity as usize;
+        let t = triangle_capacity as usize;
+        let opposite_len = (3 * t).max(
+            3 * base_triangles as usize
+                + MeshState::base_scratch_len(base_vertices, base_triangles),
+        );
+        let chunk_buffer_len = round_up(max_chunk_len as usize);
+        let sizes = [
+            12 * v,
+            12 * t,
+            4 * opposite_len,
+            4 * v,
+            v,
+            8 * v.div_ceil(64),
+            SLOTS * chunk_buffer_len,
+        ];
+        let mut ranges = [(0usize, 0usize); 7];
+        let mut at = 0;
+        for (range, size) in ranges.iter_mut().zip(sizes) {
+            *range = (at, at + size);
+            at = round_up(at + size);
+        }
+        Layout {
+            vertex_capacity,
+            triangle_capacity,
+            max_chunk_len,
+            positions: ranges[0],
+            corners: ranges[1],
+            opposite: ranges[2],
+            vertex_corner: ranges[3],
+            deficit: ranges[4],
+            candidates: ranges[5],
+            buffers: ranges[6],
+            chunk_buffer_len,
+            total: at,
+        }
+    }
+
+    /// Bytes a caller must provide when it cannot guarantee an 8-aligned buffer.
+    pub fn bytes_unaligned(&self) -> usize {
+        self.total + ALIGN - 1
+    }
+
+    /// Whether `buffer` holds this layout once aligned.
+    pub fn fits(&self, buffer: &[u8]) -> bool {
+        let skip = buffer.as_ptr().align_offset(ALIGN).min(ALIGN);
+        buffer.len().saturating_sub(skip) >= self.total
+    }
+
+    /// Carves `buffer` into the state arrays and the per-substream chunk buffers.
+    pub fn carve<'ws>(
+        &self,
+        buffer: &'ws mut [u8],
+    ) -> Result<(StateMemory<'ws>, [&'ws mut [u8]; SLOTS]), Error> {
+        let skip = buffer.as_ptr().align_offset(ALIGN).min(ALIGN);
+        let available = buffer.len().saturating_sub(skip);
+        if available < self.total {
+            return Err(Error::WorkspaceTooSmall {
+                needed: self.total + skip,
+                available: buffer.len(),
+            });
+        }
+        let (_, rest) = buffer.split_at_mut(skip);
+        let (region, _) = rest.split_at_mut(self.total);
+        let (positions, rest) = take(region, self.positions, 0);
+        let (corners, rest) = take(rest, self.corners, self.positions.1);
+        let (opposite, rest) = take(rest, self.opposite, self.corners.1);
+        let (vertex_corner, rest) = take(rest, self.vertex_corner, self.opposite.1);
+        let (deficit, rest) = take(rest, self.deficit, self.vertex_corner.1);
+        let (candidates, rest) = take(rest, self.candidates, self.deficit.1);
+        let (buffers, _) = take(rest, self.buffers, self.candidates.1);
+        let mut buffers = buffers;
+        let mut slots: [&mut [u8]; SLOTS] = Default::default();
+        for slot in slots.iter_mut() {
+            let (head, tail) = buffers.split_at_mut(self.chunk_buffer_len);
+            *slot = head;
+            buffers = tail;
+        }
+        let memory = StateMemory {
+            positions: cast(positions)?,
+            corners: cast(corners)?,
+            opposite: cast(opposite)?,
+            vertex_corner: cast(vertex_corner)?,
+            deficit,
+            candidates: cast(candidates)?,
+        };
+        Ok((memory, slots))
+    }
+}
+
+/// Splits region `range` (absolute offsets) off `rest`, which starts at `at`.
+fn take(rest: &mut [u8], range: (usize, usize), at: usize) -> (&mut [u8], &mut [u8]) {
+    let (_, rest) = rest.split_at_mut(range.0 - at);
+    rest.split_at_mut(range.1 - range.0)
+}
+
+fn cast<T: bytemuck::Pod>(bytes: &mut [u8]) -> Result<&mut [T], Error> {
+    let len = bytes.len();
+    bytemuck::try_cast_slice_mut(bytes).map_err(|_| Error::WorkspaceTooSmall {
+        needed: len + core::mem::size_of::<T>(),
+        available: len,
+    })
+}

@@ -1,0 +1,122 @@
+//! A level's own header: rounds, split counts and the chunk directory (SPEC §5.1, §5.2).
+
+use crate::bytes::{crc32, u8_at, u16_at, u32_at};
+use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
+use crate::{ChecksumScope, Error};
+
+/// One chunk-directory entry (SPEC §5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ChunkEntry {
+    pub substream: u8,
+    pub codec: u8,
+    pub raw_len: u32,
+    pub stored_len: u32,
+    pub crc: u32,
+}
+
+/// The parsed level header, borrowing the level's bytes.
+#[derive(Clone, Copy, Debug)]
+pub struct LevelHeader<'l> {
+    pub round_count: u32,
+    split_counts: &'l [u8],
+    directory: &'l [u8],
+    pub chunk_count: u32,
+    /// Offset of the first chunk payload within the level bytes.
+    pub payload_start: usize,
+}
+
+impl<'l> LevelHeader<'l> {
+    /// Parses and validates the level header of `level` (SPEC §5.1).
+    /// `is_base` selects which substream ids are allowed.
+    pub fn parse(level: &'l [u8], is_base: bool, max_chunk_len: u32) -> Result<Self, Error> {
+        let round_count = u32_at(level, 0)?;
+        let chunk_count = u32_at(level, 4)?;
+        let splits_len = (round_count as usize)
+            .checked_mul(4)
+            .ok_or(Error::Truncated)?;
+        let dir_len = (chunk_count as usize)
+            .checked_mul(CHUNK_ENTRY_LEN)
+            .ok_or(Error::Truncated)?;
+        let dir_start = 8usize.checked_add(splits_len).ok_or(Error::Truncated)?;
+        let crc_at = dir_start.checked_add(dir_len).ok_or(Error::Truncated)?;
+        let payload_start = crc_at.checked_add(4).ok_or(Error::Truncated)?;
+        if level.len() < payload_start {
+            return Err(Error::Truncated);
+        }
+        if crc32(&level[..crc_at]) != u32_at(level, crc_at)? {
+            return Err(Error::ChecksumMismatch(ChecksumScope::LevelHeader));
+        }
+        let header = LevelHeader {
+            round_count,
+            split_counts: &level[8..dir_start],
+            directory: &level[dir_start..crc_at],
+            chunk_count,
+            payload_start,
+        };
+        header.validate(level.len(), is_base, max_chunk_len)?;
+        Ok(header)
+    }
+
+    fn validate(&self, level_len: usize, is_base: bool, max_chunk_len: u32) -> Result<(), Error> {
+        let allowed = if is_base {
+            substream::BASE_POSITIONS..=substream::BASE_DEFICITS
+        } else {
+            substream::FLAGS..=substream::PLACEMENT
+        };
+        let mut previous_id = 0u8;
+        let mut payload = self.payload_start as u64;
+        for k in 0..self.chunk_count {
+            let e = self.chunk(k)?;
+            if !allowed.contains(&e.substream) {
+                return Err(Error::InvalidLevelHeader(
+                    "substream id not allowed in this level",
+                ));
+            }
+            if e.substream < previous_id {
+                return Err(Error::InvalidLevelHeader("chunks not ordered by substream"));
+            }
+            previous_id = e.substream;
+            if e.raw_len == 0 || e.raw_len > max_chunk_len {
+                return Err(Error::InvalidLevelHeader(
+                    "chunk raw length 0 or above the header maximum",
+                ));
+            }
+            match e.codec {
+                codec::STORED if e.stored_len != e.raw_len => {
+                    return Err(Error::InvalidLevelHeader("stored chunk lengths differ"));
+                }
+                codec::STORED | codec::DEFLATE => {}
+                _ => return Err(Error::InvalidLevelHeader("unknown codec")),
+            }
+            payload += e.stored_len as u64;
+        }
+        if payload != level_len as u64 {
+            return Err(if payload > level_len as u64 {
+                Error::Truncated
+            } else {
+                Error::InvalidLevelHeader("bytes after the last chunk")
+            });
+        }
+        Ok(())
+    }
+
+    /// Declared split count of round `r` (SPEC §5.1).
+    pub fn split_count(&self, r: u32) -> u32 {
+        u32_at(self.split_counts, r as usize * 4).unwrap_or(0)
+    }
+
+    /// Directory entry `k` (SPEC §5.2).
+    pub fn chunk(&self, k: u32) -> Result<ChunkEntry, Error> {
+        let at = k as usize * CHUNK_ENTRY_LEN;
+        if u16_at(self.directory, at + 2)? != 0 {
+            return Err(Error::InvalidLevelHeader("reserved field not zero"));
+        }
+        Ok(ChunkEntry {
+            substream: u8_at(self.directory, at)?,
+            codec: u8_at(self.directory, at + 1)?,
+            raw_len: u32_at(self.directory, at + 4)?,
+            stored_len: u32_at(self.directory, at + 8)?,
+            crc: u32_at(self.directory, at + 12)?,
+        })
+    }
+}

@@ -1,0 +1,157 @@
+//! The level table: where each level's bytes lie and what it yields (SPEC §4).
+
+use crate::bytes::{crc32, f32_at, u32_at, u64_at};
+use crate::limits::{HEADER_LEN, LEVEL_ENTRY_LEN};
+use crate::{ChecksumScope, Error, Header};
+
+/// One level-table entry (SPEC §4.1). Level 0 is the base mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelInfo {
+    /// Byte offset of the level from the start of the stream.
+    pub offset: u64,
+    /// Byte length of the level: fetch `offset .. offset + length`.
+    pub length: u32,
+    /// Vertex count after this level is applied.
+    pub vertex_count: u32,
+    /// Triangle count after this level is applied.
+    pub triangle_count: u32,
+    /// Refinement rounds in this level (0 for the base mesh).
+    pub round_count: u32,
+    /// Encoder's estimate of the distance from this level's surface to the
+    /// original, in model units (informative; decoders do not interpret it).
+    pub geometric_error: f32,
+}
+
+/// The validated level table, borrowed from the stream.
+#[derive(Clone, Copy, Debug)]
+pub struct LevelTable<'h> {
+    bytes: &'h [u8],
+    count: u16,
+}
+
+/// Bytes from the stream start to the end of the level table, checksum included.
+pub fn head_len(level_count: u16) -> usize {
+    HEADER_LEN + LEVEL_ENTRY_LEN * level_count as usize + 4
+}
+
+impl<'h> LevelTable<'h> {
+    /// Parses and validates the table following the header (SPEC §4.2).
+    pub fn parse(stream_head: &'h [u8], header: &Header) -> Result<LevelTable<'h>, Error> {
+        let end = head_len(header.level_count);
+        let bytes = stream_head.get(HEADER_LEN..end).ok_or(Error::Truncated)?;
+        let body = &bytes[..bytes.len() - 4];
+        if crc32(body) != u32_at(bytes, body.len())? {
+            return Err(Error::ChecksumMismatch(ChecksumScope::LevelTable));
+        }
+        let table = LevelTable {
+            bytes: body,
+            count: header.level_count,
+        };
+        table.validate(header, end as u64)?;
+        Ok(table)
+    }
+
+    fn validate(&self, header: &Header, first_offset: u64) -> Result<(), Error> {
+        let mut expected_offset = first_offset;
+        let mut previous: Option<LevelInfo> = None;
+        for k in 0..self.count {
+            let e = self.get(k);
+            if u32_at(self.bytes, k as usize * LEVEL_ENTRY_LEN + 28)? != 0 {
+                return Err(Error::InvalidLevelTable("reserved field not zero"));
+            }
+            if e.offset != expected_offset {
+                return Err(Error::InvalidLevelTable("levels are not contiguous"));
+            }
+            expected_offset = e.offset + e.length as u64;
+            if !(e.geometric_error.is_finite() && e.geometric_error >= 0.0) {
+                return Err(Error::InvalidLevelTable(
+                    "geometric error not finite and >= 0",
+                ));
+            }
+            if e.vertex_count > header.vertex_capacity
+                || e.triangle_count > header.triangle_capacity
+            {
+                return Err(Error::CapacityExceeded);
+            }
+            match previous {
+                None => {
+                    if e.round_count != 0 || e.vertex_count == 0 || e.triangle_count == 0 {
+                        return Err(Error::InvalidLevelTable("base level counts"));
+                    }
+                }
+                Some(p) => {
+                    // Every round splits at least one vertex; each split adds
+                    // one vertex and one or two triangles (SPEC §7).
+                    let added = e.vertex_count.checked_sub(p.vertex_count);
+                    let ok = matches!(added, Some(a) if a >= e.round_count && e.round_count > 0)
+                        && e.triangle_count > p.triangle_count
+                        && (e.triangle_count - p.triangle_count) as u64
+                            >= (e.vertex_count - p.vertex_count) as u64
+                        && (e.triangle_count - p.triangle_count) as u64
+                            <= 2 * (e.vertex_count - p.vertex_count) as u64;
+                    if !ok {
+                        return Err(Error::InvalidLevelTable(
+                            "level counts do not grow consistently",
+                        ));
+                    }
+                }
+            }
+            previous = Some(e);
+        }
+        let last = previous.ok_or(Error::InvalidLevelTable("empty"))?;
+        if last.vertex_count != header.vertex_capacity
+            || last.triangle_count != header.triangle_capacity
+        {
+            return Err(Error::InvalidLevelTable(
+                "last level differs from the declared capacity",
+            ));
+        }
+        Ok(())
+    }
+
+    pub fn len(&self) -> u16 {
+        self.count
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Entry `k`; panics if `k >= len()` (the table was validated on parse).
+    pub fn get(&self, k: u16) -> LevelInfo {
+        let at = k as usize * LEVEL_ENTRY_LEN;
+        // The table length was checked in `parse`, so these reads succeed.
+        let read = |o: usize| u32_at(self.bytes, at + o).unwrap_or(0);
+        LevelInfo {
+            offset: u64_at(self.bytes, at).unwrap_or(0),
+            length: read(8),
+            vertex_count: read(12),
+            triangle_count: read(16),
+            round_count: read(20),
+            geometric_error: f32_at(self.bytes, at + 24).unwrap_or(0.0),
+        }
+    }
+
+    /// End of the stream: offset just past the last level.
+    pub fn stream_len(&self) -> u64 {
+        let last = self.get(self.count - 1);
+        last.offset + last.length as u64
+    }
+}
+
+/// Serialises a level table (entries then CRC-32) for encoders.
+pub fn write_level_table(entries: &[LevelInfo], out: &mut [u8]) {
+    for (k, e) in entries.iter().enumerate() {
+        let o = &mut out[k * LEVEL_ENTRY_LEN..(k + 1) * LEVEL_ENTRY_LEN];
+        o.fill(0);
+        o[0..8].copy_from_slice(&e.offset.to_le_bytes());
+        o[8..12].copy_from_slice(&e.length.to_le_bytes());
+        o[12..16].copy_from_slice(&e.vertex_count.to_le_bytes());
+        o[16..20].copy_from_slice(&e.triangle_count.to_le_bytes());
+        o[20..24].copy_from_slice(&e.round_count.to_le_bytes());
+        o[24..28].copy_from_slice(&e.geometric_error.to_le_bytes());
+    }
+    let body = entries.len() * LEVEL_ENTRY_LEN;
+    let crc = crc32(&out[..body]);
+    out[body..body + 4].copy_from_slice(&crc.to_le_bytes());
+}

@@ -1,0 +1,72 @@
+//! Allocating conveniences (`alloc` feature): a decoder that owns its
+//! workspace, and whole-stream decoding to plain vectors.
+
+use alloc::boxed::Box;
+use alloc::vec;
+use alloc::vec::Vec;
+
+use crate::{Decoder, Error, Inflater, workspace_len};
+
+/// A decoded mesh, detached from any workspace.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct DecodedMesh {
+    pub positions: Vec<[u32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    pub deficits: Vec<u8>,
+    /// State hash after the base mesh and after every round, in order.
+    pub round_hashes: Vec<u64>,
+    pub levels: u16,
+}
+
+/// Memory for one decoder: an 8-aligned workspace and a boxed inflater.
+pub struct OwnedWorkspace {
+    words: Vec<u64>,
+    inflater: Box<Inflater>,
+}
+
+impl OwnedWorkspace {
+    /// Sized for the whole stream whose head is `head`.
+    pub fn for_stream(head: &[u8]) -> Result<OwnedWorkspace, Error> {
+        let len = workspace_len(head)?;
+        Ok(OwnedWorkspace {
+            words: vec![0u64; len.div_ceil(8)],
+            inflater: Box::new(Inflater::new()),
+        })
+    }
+
+    /// A decoder over this memory.
+    pub fn decoder<'h, 'ws>(&'ws mut self, head: &'h [u8]) -> Result<Decoder<'h, 'ws>, Error> {
+        let bytes: &mut [u8] = bytemuck::cast_slice_mut(&mut self.words);
+        Decoder::new(head, bytes, &mut self.inflater)
+    }
+}
+
+/// Decodes a whole stream; with `hash_rounds`, records the state hash after
+/// the base and after every round (the conformance protocol).
+pub fn decode_all(stream: &[u8], hash_rounds: bool) -> Result<DecodedMesh, Error> {
+    let mut ws = OwnedWorkspace::for_stream(stream)?;
+    let mut decoder = ws.decoder(stream)?;
+    let mut round_hashes = Vec::new();
+    while let Some(k) = decoder.next_level() {
+        let range = decoder.level_range(k);
+        let bytes = stream
+            .get(range.start as usize..range.end as usize)
+            .ok_or(Error::Truncated)?;
+        let mut level = decoder.begin_level(k, bytes)?;
+        if k == 0 && hash_rounds {
+            round_hashes.push(level.state().state_hash());
+        }
+        while level.next_round()?.is_some() {
+            if hash_rounds {
+                round_hashes.push(level.state().state_hash());
+            }
+        }
+    }
+    Ok(DecodedMesh {
+        positions: decoder.positions().to_vec(),
+        triangles: decoder.triangles().to_vec(),
+        deficits: decoder.state().deficits().to_vec(),
+        round_hashes,
+        levels: decoder.levels_done(),
+    })
+}

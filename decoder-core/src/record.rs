@@ -1,0 +1,129 @@
+//! Reading split records and the base mesh from substreams (SPEC §6.3, §7.4, §7.5).
+
+use crate::Error;
+use crate::header::PositionMode;
+use crate::limits::substream::{self, SLOTS};
+use crate::ring::Ring;
+use crate::round::RecordSource;
+use crate::split::SplitRecord;
+use crate::state::MeshState;
+use crate::substream::Substreams;
+
+/// Substream slot of a refinement substream id (ids 1..=8 use slots 0..=7).
+const fn slot(id: u8) -> usize {
+    (id - substream::FLAGS) as usize
+}
+
+/// Substream slot of a base substream id (ids 9..=11 use slots 0..=2).
+const fn base_slot(id: u8) -> usize {
+    (id - substream::BASE_POSITIONS) as usize
+}
+
+const _: () = assert!(slot(substream::PLACEMENT) < SLOTS);
+
+/// Feeds a round from a level's substreams.
+pub struct StreamSource<'s, 'l, 'b> {
+    pub subs: &'s mut Substreams<'l, 'b>,
+    pub mode: PositionMode,
+}
+
+impl RecordSource for StreamSource<'_, '_, '_> {
+    #[inline]
+    fn flag(&mut self, _v: u32) -> Result<bool, Error> {
+        self.subs.bit(slot(substream::FLAGS))
+    }
+
+    fn record(
+        &mut self,
+        state: &MeshState<'_>,
+        r: u32,
+        _ring: &Ring,
+    ) -> Result<SplitRecord, Error> {
+        let s = &mut *self.subs;
+        let wing_offset = s.byte(slot(substream::WING_OFFSET))?;
+        let wing_distance = s.byte(slot(substream::WING_DISTANCE))?;
+        let config = s.bit(slot(substream::CONFIG))?;
+        let deficit_p = s.byte(slot(substream::DEFICIT_P))?;
+        let deficit_c = s.byte(slot(substream::DEFICIT_C))?;
+        let mut edge = [0i64; 3];
+        for e in &mut edge {
+            *e = s.signed(slot(substream::EDGE))? as i64;
+        }
+        let parent = state.positions()[r as usize];
+        let mut p = [0i64; 3];
+        match self.mode {
+            PositionMode::Optimal => {
+                for k in 0..3 {
+                    let m = s.signed(slot(substream::PLACEMENT))? as i64;
+                    p[k] = parent[k] as i64 - m - (edge[k] >> 1);
+                }
+            }
+            PositionMode::Constrained => {
+                let code = s.byte(slot(substream::PLACEMENT))?;
+                for k in 0..3 {
+                    p[k] = parent[k] as i64
+                        - match code {
+                            0 => 0,
+                            1 => edge[k],
+                            2 => edge[k] >> 1,
+                            _ => return Err(Error::InvalidPlacement),
+                        };
+                }
+            }
+        }
+        let bits = state.bits();
+        let position_p = to_grid(p, bits)?;
+        let position_c = to_grid([p[0] + edge[0], p[1] + edge[1], p[2] + edge[2]], bits)?;
+        Ok(SplitRecord {
+            wing_offset,
+            wing_distance,
+            config,
+            deficit_p,
+            deficit_c,
+            position_p,
+            position_c,
+        })
+    }
+}
+
+fn to_grid(p: [i64; 3], bits: u8) -> Result<[u32; 3], Error> {
+    let limit = 1i64 << bits;
+    let mut out = [0u32; 3];
+    for k in 0..3 {
+        if !(0..limit).contains(&p[k]) {
+            return Err(Error::PositionOutOfRange);
+        }
+        out[k] = p[k] as u32;
+    }
+    Ok(out)
+}
+
+/// Reads the base mesh of `vertices` and `triangles` into `state` and builds
+/// its adjacency (SPEC §6.3).
+pub fn read_base(
+    state: &mut MeshState<'_>,
+    subs: &mut Substreams<'_, '_>,
+    vertices: u32,
+    triangles: u32,
+) -> Result<(), Error> {
+    if vertices > state.vertex_capacity() || triangles > state.triangle_capacity() {
+        return Err(Error::CapacityExceeded);
+    }
+    let bits = state.bits();
+    let (positions, corners, deficits) = state.base_arrays();
+    let mut previous = [0i64; 3];
+    for p in &mut positions[..vertices as usize] {
+        for axis in &mut previous {
+            *axis += subs.signed(base_slot(substream::BASE_POSITIONS))? as i64;
+        }
+        *p = to_grid(previous, bits)?;
+    }
+    for c in &mut corners[..3 * triangles as usize] {
+        *c = subs.varint(base_slot(substream::BASE_TRIANGLES))?;
+    }
+    for d in &mut deficits[..vertices as usize] {
+        *d = subs.byte(base_slot(substream::BASE_DEFICITS))?;
+    }
+    subs.finish()?;
+    state.finish_base(vertices, triangles)
+}

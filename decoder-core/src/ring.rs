@@ -1,0 +1,123 @@
+//! The canonical 1-ring of a vertex (SPEC §6.1, §7.1).
+//!
+//! The ring lists the neighbours of `R` counter-clockwise. A boundary vertex
+//! gets the ghost vertex ([`NONE`]) in the gap of its open fan, so that every
+//! ring is a cycle and the ring length is the valence. The ring starts at the
+//! smallest neighbour index, the ghost counting as smaller than every vertex:
+//! that start depends only on the mesh, never on the order in which the
+//! independent splits of a round were applied.
+
+use crate::Error;
+use crate::limits::{MAX_SPLIT_VALENCE, NONE};
+use crate::state::{MeshState, next, prev};
+
+/// The ring of a vertex and the corner of that vertex in each wedge.
+#[derive(Clone)]
+pub struct Ring {
+    len: usize,
+    /// `vertices[i]` is neighbour `r_i`; [`NONE`] for the ghost.
+    vertices: [u32; MAX_SPLIT_VALENCE],
+    /// `corners[i]` is the corner of `R` in wedge `W_i = (R, r_i, r_{i+1})`,
+    /// [`NONE`] when the wedge is virtual (it touches the ghost).
+    corners: [u32; MAX_SPLIT_VALENCE],
+}
+
+impl Default for Ring {
+    fn default() -> Self {
+        Ring {
+            len: 0,
+            vertices: [NONE; MAX_SPLIT_VALENCE],
+            corners: [NONE; MAX_SPLIT_VALENCE],
+        }
+    }
+}
+
+impl Ring {
+    /// Valence: ring length, the ghost counted (SPEC §6.1).
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// Neighbours in canonical order ([`NONE`] is the ghost).
+    pub fn vertices(&self) -> &[u32] {
+        &self.vertices[..self.len]
+    }
+
+    /// Corner of the centre vertex in each wedge ([`NONE`] when virtual).
+    pub fn corners(&self) -> &[u32] {
+        &self.corners[..self.len]
+    }
+
+    /// Whether the centre is a boundary vertex.
+    pub fn is_boundary(&self) -> bool {
+        self.len > 0 && self.vertices[0] == NONE
+    }
+}
+
+impl MeshState<'_> {
+    /// Fills `ring` with the canonical ring of `r` (SPEC §7.1). Fails with
+    /// [`Error::ValenceOverflow`] when the ring is longer than 255.
+    pub fn ring(&self, r: u32, ring: &mut Ring) -> Result<(), Error> {
+        let start = self.vertex_corner[r as usize];
+        let mut c = start;
+        let mut n = 0usize;
+        loop {
+            if n == MAX_SPLIT_VALENCE {
+                return Err(Error::ValenceOverflow);
+            }
+            ring.corners[n] = c;
+            ring.vertices[n] = self.vertex_at(next(c));
+            n += 1;
+            let o = self.opposite[next(c) as usize];
+            if o == NONE {
+                return self.boundary_ring(start, ring);
+            }
+            c = next(o);
+            if c == start {
+                break;
+            }
+        }
+        let first = (0..n).min_by_key(|&i| ring.vertices[i]).unwrap_or(0);
+        ring.vertices[..n].rotate_left(first);
+        ring.corners[..n].rotate_left(first);
+        ring.len = n;
+        Ok(())
+    }
+
+    fn boundary_ring(&self, start: u32, ring: &mut Ring) -> Result<(), Error> {
+        // Walk clockwise to the first wedge after the gap.
+        let mut first = start;
+        for _ in 0..MAX_SPLIT_VALENCE {
+            let o = self.opposite[prev(first) as usize];
+            if o == NONE {
+                break;
+            }
+            first = prev(o);
+        }
+        ring.vertices[0] = NONE;
+        ring.corners[0] = NONE;
+        let mut c = first;
+        let mut m = 1usize;
+        loop {
+            // m real wedges need m + 2 ring entries.
+            if m + 1 >= MAX_SPLIT_VALENCE {
+                return Err(Error::ValenceOverflow);
+            }
+            ring.corners[m] = c;
+            ring.vertices[m] = self.vertex_at(next(c));
+            let o = self.opposite[next(c) as usize];
+            if o == NONE {
+                ring.vertices[m + 1] = self.vertex_at(prev(c));
+                ring.corners[m + 1] = NONE;
+                ring.len = m + 2;
+                return Ok(());
+            }
+            c = next(o);
+            m += 1;
+        }
+    }
+}

@@ -1,0 +1,140 @@
+//! The decoder state of SPEC §6: positions, triangles, adjacency, deficits.
+//!
+//! Triangles are stored as a corner table: corner `c` is slot `c % 3` of
+//! triangle `c / 3`. `opposite[c]` is the corner facing `c` across the edge
+//! opposite `c` ([`NONE`] on a boundary), `vertex_corner[v]` any corner of `v`.
+//! Only the positions, triangles and deficits are normative; the adjacency is
+//! this decoder's way of walking rings quickly.
+
+use crate::limits::{LEAF, NONE};
+
+/// Next corner of the same triangle (counter-clockwise).
+#[inline]
+pub fn next(c: u32) -> u32 {
+    if c % 3 == 2 { c - 2 } else { c + 1 }
+}
+
+/// Previous corner of the same triangle.
+#[inline]
+pub fn prev(c: u32) -> u32 {
+    if c.is_multiple_of(3) { c + 2 } else { c - 1 }
+}
+
+/// The mutable mesh a decoder refines, over caller-owned memory.
+pub struct MeshState<'ws> {
+    pub(crate) positions: &'ws mut [[u32; 3]],
+    pub(crate) corners: &'ws mut [u32],
+    pub(crate) opposite: &'ws mut [u32],
+    pub(crate) vertex_corner: &'ws mut [u32],
+    pub(crate) deficit: &'ws mut [u8],
+    pub(crate) candidates: &'ws mut [u64],
+    pub(crate) vertex_count: u32,
+    pub(crate) triangle_count: u32,
+    pub(crate) bits: u8,
+}
+
+/// The caller-owned arrays a [`MeshState`] lives in (see [`crate::Layout`]).
+pub struct StateMemory<'ws> {
+    pub positions: &'ws mut [[u32; 3]],
+    /// 3 per triangle.
+    pub corners: &'ws mut [u32],
+    /// At least 3 per triangle; [`crate::Layout`] sizes it for base-mesh scratch too.
+    pub opposite: &'ws mut [u32],
+    pub vertex_corner: &'ws mut [u32],
+    pub deficit: &'ws mut [u8],
+    /// One bit per vertex.
+    pub candidates: &'ws mut [u64],
+}
+
+impl<'ws> MeshState<'ws> {
+    /// An empty state over `memory`, for coordinates of `bits` bits.
+    pub fn new(memory: StateMemory<'ws>, bits: u8) -> MeshState<'ws> {
+        let StateMemory {
+            positions,
+            corners,
+            opposite,
+            vertex_corner,
+            deficit,
+            candidates,
+        } = memory;
+        MeshState {
+            positions,
+            corners,
+            opposite,
+            vertex_corner,
+            deficit,
+            candidates,
+            vertex_count: 0,
+            triangle_count: 0,
+            bits,
+        }
+    }
+
+    pub fn vertex_count(&self) -> u32 {
+        self.vertex_count
+    }
+
+    pub fn triangle_count(&self) -> u32 {
+        self.triangle_count
+    }
+
+    /// Largest vertex count the memory holds.
+    pub fn vertex_capacity(&self) -> u32 {
+        let by_bits = (self.candidates.len() as u64) * 64;
+        let n = self
+            .positions
+            .len()
+            .min(self.vertex_corner.len())
+            .min(self.deficit.len()) as u64;
+        n.min(by_bits).min(u32::MAX as u64 - 1) as u32
+    }
+
+    /// Largest triangle count the memory holds.
+    pub fn triangle_capacity(&self) -> u32 {
+        let n = (self.corners.len().min(self.opposite.len()) / 3) as u64;
+        n.min(crate::limits::MAX_TRIANGLES as u64) as u32
+    }
+
+    /// Quantized positions of the current vertices, in decoded order.
+    pub fn positions(&self) -> &[[u32; 3]] {
+        &self.positions[..self.vertex_count as usize]
+    }
+
+    /// Current triangles (counter-clockwise), ready for an index buffer.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        bytemuck::cast_slice(&self.corners[..3 * self.triangle_count as usize])
+    }
+
+    /// Current triangles as a flat index list.
+    pub fn indices(&self) -> &[u32] {
+        &self.corners[..3 * self.triangle_count as usize]
+    }
+
+    /// Valence deficit of every vertex: split valence minus current valence,
+    /// or [`LEAF`] for a vertex that never splits again (SPEC §6.2).
+    pub fn deficits(&self) -> &[u8] {
+        &self.deficit[..self.vertex_count as usize]
+    }
+
+    pub fn bits(&self) -> u8 {
+        self.bits
+    }
+
+    /// Whether `v` is a leaf.
+    pub fn is_leaf(&self, v: u32) -> bool {
+        self.deficit[v as usize] == LEAF
+    }
+
+    #[inline]
+    pub(crate) fn vertex_at(&self, corner: u32) -> u32 {
+        self.corners[corner as usize]
+    }
+
+    #[inline]
+    pub(crate) fn link(&mut self, a: u32, b: u32) {
+        self.opposite[a as usize] = b;
+        if b != NONE {
+            self.opposite[b as usize] = a;
+        }
+    }
+}

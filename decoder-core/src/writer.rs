@@ -1,0 +1,206 @@
+//! Writing streams (SPEC §3–§5), the inverse of the parsers: used by the
+//! encoder and by tests that build streams by hand. Needs the `alloc` feature.
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use crate::bytes::crc32;
+use crate::header::{Header, PositionMode};
+use crate::layout::Layout;
+use crate::level_table::{LevelInfo, head_len, write_level_table};
+use crate::limits::{CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, codec, substream};
+
+/// A growing substream: bytes, bits (least significant first) or varints.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct SubstreamWriter {
+    bytes: Vec<u8>,
+    bit_count: u8,
+}
+
+impl SubstreamWriter {
+    pub fn byte(&mut self, b: u8) {
+        debug_assert_eq!(
+            self.bit_count, 0,
+            "bytes and bits do not mix in one substream"
+        );
+        self.bytes.push(b);
+    }
+
+    pub fn bit(&mut self, bit: bool) {
+        if self.bit_count == 0 {
+            self.bytes.push(0);
+        }
+        if bit {
+            *self.bytes.last_mut().expect("pushed above") |= 1 << self.bit_count;
+        }
+        self.bit_count = (self.bit_count + 1) % 8;
+    }
+
+    /// Minimal LEB128 (SPEC §5.4).
+    pub fn varint(&mut self, mut v: u32) {
+        loop {
+            let low = (v & 0x7F) as u8;
+            v >>= 7;
+            if v == 0 {
+                self.bytes.push(low);
+                return;
+            }
+            self.bytes.push(low | 0x80);
+        }
+    }
+
+    /// Zigzag then LEB128 (SPEC §5.4).
+    pub fn signed(&mut self, v: i32) {
+        self.varint(((v << 1) ^ (v >> 31)) as u32);
+    }
+
+    pub fn as_bytes(&self) -> &[u8] {
+        &self.bytes
+    }
+
+    pub fn len(&self) -> usize {
+        self.bytes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.bytes.is_empty()
+    }
+}
+
+/// How chunks are coded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChunkCodec {
+    Stored,
+    /// Raw deflate at this miniz_oxide level (1..=10).
+    Deflate(u8),
+}
+
+/// One level's content before framing.
+#[derive(Clone, Debug, Default)]
+pub struct LevelPayload {
+    /// Declared split count of each round (empty for the base level).
+    pub round_splits: Vec<u32>,
+    /// Substreams in id order: ids 1..=8 for a refinement level, 9..=11 for
+    /// the base (index 0 is the first id).
+    pub substreams: Vec<SubstreamWriter>,
+    pub vertex_count: u32,
+    pub triangle_count: u32,
+    pub geometric_error: f32,
+}
+
+/// Stream-wide parameters.
+#[derive(Clone, Copy, Debug)]
+pub struct StreamParams {
+    pub position_mode: PositionMode,
+    pub bits: u8,
+    pub origin: [f64; 3],
+    pub scale: [f64; 3],
+    pub codec: ChunkCodec,
+    /// Largest raw chunk the writer cuts (SPEC §5.2).
+    pub chunk_limit: u32,
+}
+
+/// Frames a base level and refinement levels into a complete stream.
+pub fn write_stream(params: &StreamParams, levels: &[LevelPayload]) -> Vec<u8> {
+    let mut framed: Vec<Vec<u8>> = Vec::with_capacity(levels.len());
+    let mut max_chunk = 0u32;
+    for (k, level) in levels.iter().enumerate() {
+        let first_id = if k == 0 {
+            substream::BASE_POSITIONS
+        } else {
+            substream::FLAGS
+        };
+        let (bytes, largest) = frame_level(level, first_id, params);
+        max_chunk = max_chunk.max(largest);
+        framed.push(bytes);
+    }
+    let level_count = levels.len() as u16;
+    let mut offset = head_len(level_count) as u64;
+    let mut entries = Vec::with_capacity(levels.len());
+    for (level, bytes) in levels.iter().zip(&framed) {
+        entries.push(LevelInfo {
+            offset,
+            length: bytes.len() as u32,
+            vertex_count: level.vertex_count,
+            triangle_count: level.triangle_count,
+            round_count: level.round_splits.len() as u32,
+            geometric_error: level.geometric_error,
+        });
+        offset += bytes.len() as u64;
+    }
+    let max_chunk = max_chunk.max(1);
+    let (base, top) = (&levels[0], &levels[levels.len() - 1]);
+    let layout = Layout::new(
+        top.vertex_count,
+        top.triangle_count,
+        base.vertex_count,
+        base.triangle_count,
+        max_chunk,
+    );
+    let header = Header {
+        version_minor: VERSION_MINOR,
+        position_mode: params.position_mode,
+        bits: params.bits,
+        level_count,
+        vertex_capacity: top.vertex_count,
+        triangle_capacity: top.triangle_count,
+        max_chunk_len: max_chunk,
+        origin: params.origin,
+        scale: params.scale,
+        workspace_bytes: layout.total as u64,
+    };
+    let mut out = vec![0u8; head_len(level_count)];
+    let mut head = [0u8; HEADER_LEN];
+    header.write(&mut head);
+    out[..HEADER_LEN].copy_from_slice(&head);
+    write_level_table(&entries, &mut out[HEADER_LEN..]);
+    for bytes in framed {
+        out.extend_from_slice(&bytes);
+    }
+    out
+}
+
+/// Frames one level (SPEC §5.1); returns its bytes and its largest raw chunk.
+pub fn frame_level(level: &LevelPayload, first_id: u8, params: &StreamParams) -> (Vec<u8>, u32) {
+    let limit = params.chunk_limit.max(1) as usize;
+    let mut directory = Vec::new();
+    let mut payload = Vec::new();
+    let mut largest = 0u32;
+    for (i, sub) in level.substreams.iter().enumerate() {
+        for raw in sub.as_bytes().chunks(limit) {
+            let (codec_id, stored) = match params.codec {
+                ChunkCodec::Stored => (codec::STORED, raw.to_vec()),
+                ChunkCodec::Deflate(l) => {
+                    let packed = miniz_oxide::deflate::compress_to_vec(raw, l);
+                    if packed.len() < raw.len() {
+                        (codec::DEFLATE, packed)
+                    } else {
+                        (codec::STORED, raw.to_vec())
+                    }
+                }
+            };
+            let mut entry = [0u8; CHUNK_ENTRY_LEN];
+            entry[0] = first_id + i as u8;
+            entry[1] = codec_id;
+            entry[4..8].copy_from_slice(&(raw.len() as u32).to_le_bytes());
+            entry[8..12].copy_from_slice(&(stored.len() as u32).to_le_bytes());
+            entry[12..16].copy_from_slice(&crc32(&stored).to_le_bytes());
+            directory.push(entry);
+            largest = largest.max(raw.len() as u32);
+            payload.extend_from_slice(&stored);
+        }
+    }
+    let mut out = Vec::new();
+    out.extend_from_slice(&(level.round_splits.len() as u32).to_le_bytes());
+    out.extend_from_slice(&(directory.len() as u32).to_le_bytes());
+    for s in &level.round_splits {
+        out.extend_from_slice(&s.to_le_bytes());
+    }
+    for e in &directory {
+        out.extend_from_slice(e);
+    }
+    let crc = crc32(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    out.extend_from_slice(&payload);
+    (out, largest)
+}

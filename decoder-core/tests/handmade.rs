@@ -1,0 +1,293 @@
+//! Hand-made streams (SPEC §6, §7): a tetrahedron with one split, a
+//! triangle with a boundary split, and the errors SPEC §10 requires.
+
+use splitstream_decoder_core::limits::LEAF;
+use splitstream_decoder_core::owned::decode_all;
+use splitstream_decoder_core::writer::{
+    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+};
+use splitstream_decoder_core::{Error, PositionMode};
+
+fn params(codec: ChunkCodec) -> StreamParams {
+    StreamParams {
+        position_mode: PositionMode::Optimal,
+        bits: 8,
+        origin: [0.0; 3],
+        scale: [1.0; 3],
+        codec,
+        chunk_limit: 4,
+    }
+}
+
+fn base(positions: &[[i32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
+    let mut subs = vec![SubstreamWriter::default(); 3];
+    let mut prev = [0i32; 3];
+    for p in positions {
+        for k in 0..3 {
+            subs[0].signed(p[k] - prev[k]);
+        }
+        prev = *p;
+    }
+    for t in triangles {
+        for &v in t {
+            subs[1].varint(v);
+        }
+    }
+    for &d in deficits {
+        subs[2].byte(d);
+    }
+    LevelPayload {
+        round_splits: vec![],
+        substreams: subs,
+        vertex_count: positions.len() as u32,
+        triangle_count: triangles.len() as u32,
+        geometric_error: 1.0,
+    }
+}
+
+/// One optimal-mode split record: o, d, q, deficits, edge vector, midpoint offset.
+struct Rec {
+    o: u8,
+    d: u8,
+    q: bool,
+    dp: u8,
+    dc: u8,
+    e: [i32; 3],
+    m: [i32; 3],
+}
+
+fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> LevelPayload {
+    let mut s = vec![SubstreamWriter::default(); 8];
+    for &f in flags {
+        s[0].bit(f);
+    }
+    for r in recs {
+        s[1].byte(r.o);
+        s[2].byte(r.d);
+        s[3].bit(r.q);
+        s[4].byte(r.dp);
+        s[5].byte(r.dc);
+        for k in 0..3 {
+            s[6].signed(r.e[k]);
+            s[7].signed(r.m[k]);
+        }
+    }
+    LevelPayload {
+        round_splits: rounds,
+        substreams: s,
+        vertex_count: v,
+        triangle_count: t,
+        geometric_error: 0.0,
+    }
+}
+
+fn tetrahedron() -> LevelPayload {
+    base(
+        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
+        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        &[0, LEAF, LEAF, LEAF],
+    )
+}
+
+/// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge (0,1,3).
+fn tetra_split() -> Rec {
+    // P = (0,0,0), C = (2,2,2): e = 2, m = R - P - (e >> 1) = -1.
+    Rec {
+        o: 0,
+        d: 1,
+        q: false,
+        dp: LEAF,
+        dc: LEAF,
+        e: [2; 3],
+        m: [-1; 3],
+    }
+}
+
+/// Every directed edge has exactly one reverse: a closed or bordered 2-manifold.
+fn assert_oriented_manifold(triangles: &[[u32; 3]]) {
+    let mut directed: Vec<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .collect();
+    directed.sort_unstable();
+    assert!(
+        directed.windows(2).all(|w| w[0] != w[1]),
+        "a directed edge twice"
+    );
+}
+
+#[test]
+fn tetrahedron_one_split() {
+    for codec in [ChunkCodec::Stored, ChunkCodec::Deflate(9)] {
+        let stream = write_stream(
+            &params(codec),
+            &[
+                tetrahedron(),
+                level(&[true], vec![1], &[tetra_split()], 5, 6),
+            ],
+        );
+        let mesh = decode_all(&stream, true).unwrap();
+        assert_eq!(
+            mesh.triangles,
+            vec![
+                [4, 2, 1],
+                [0, 1, 3],
+                [4, 3, 2],
+                [1, 2, 3],
+                [0, 4, 1],
+                [4, 0, 3]
+            ]
+        );
+        assert_eq!(mesh.positions[0], [0, 0, 0]);
+        assert_eq!(mesh.positions[4], [2, 2, 2]);
+        assert_eq!(mesh.deficits, vec![LEAF; 5]);
+        assert_eq!(mesh.round_hashes.len(), 2);
+        assert_oriented_manifold(&mesh.triangles);
+        let edges = mesh.triangles.len() * 3 / 2;
+        assert_eq!(5 + 6 - edges as i64, 2, "Euler characteristic of a sphere");
+    }
+}
+
+#[test]
+fn boundary_split_with_a_ghost_wing() {
+    // One triangle; vertex 0's ring is (ghost, 1, 2). Wings: ghost and 1.
+    let b = base(
+        &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
+        &[[0, 1, 2]],
+        &[0, LEAF, LEAF],
+    );
+    let rec = Rec {
+        o: 0,
+        d: 1,
+        q: false,
+        dp: LEAF,
+        dc: LEAF,
+        e: [0, 4, 0],
+        m: [0, -2, 0],
+    };
+    let stream = write_stream(
+        &params(ChunkCodec::Stored),
+        &[b, level(&[true], vec![1], &[rec], 4, 2)],
+    );
+    let mesh = decode_all(&stream, false).unwrap();
+    assert_eq!(mesh.triangles, vec![[3, 1, 2], [3, 0, 1]]);
+    assert_eq!(mesh.positions[3], [0, 4, 0]);
+    assert_oriented_manifold(&mesh.triangles);
+}
+
+fn decode_err(levels: &[LevelPayload]) -> Error {
+    let stream = write_stream(&params(ChunkCodec::Deflate(6)), levels);
+    decode_all(&stream, false).unwrap_err()
+}
+
+#[test]
+fn ring_offset_out_of_range() {
+    let mut rec = tetra_split();
+    rec.o = 2; // o + d = 3 = ring length
+    let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
+    assert_eq!(err, Error::RingOffsetOutOfRange);
+}
+
+#[test]
+fn flag_count_mismatch() {
+    let err = decode_err(&[
+        tetrahedron(),
+        level(&[false], vec![1], &[tetra_split()], 5, 6),
+    ]);
+    assert_eq!(err.class(), "count-mismatch");
+}
+
+#[test]
+fn dependent_splits() {
+    // Vertices 0 and 1 are both candidates (valence 3) and both flagged.
+    let b = base(
+        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
+        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        &[0, 0, LEAF, LEAF],
+    );
+    let err = decode_err(&[
+        b,
+        level(
+            &[true, true],
+            vec![2],
+            &[tetra_split(), tetra_split()],
+            6,
+            8,
+        ),
+    ]);
+    assert_eq!(err, Error::DependentSplits);
+}
+
+#[test]
+fn valence_overflow_on_a_wing() {
+    // Vertex 1 is a pending candidate that is not split but is a wing.
+    let b = base(
+        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
+        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        &[0, 0, LEAF, LEAF],
+    );
+    let err = decode_err(&[b, level(&[true, false], vec![1], &[tetra_split()], 5, 6)]);
+    assert_eq!(err, Error::ValenceOverflow);
+}
+
+#[test]
+fn corrupt_bytes_are_caught_by_checksums() {
+    let stream = write_stream(
+        &params(ChunkCodec::Deflate(6)),
+        &[
+            tetrahedron(),
+            level(&[true], vec![1], &[tetra_split()], 5, 6),
+        ],
+    );
+    for at in 0..stream.len() {
+        let mut bad = stream.clone();
+        bad[at] ^= 0x10;
+        let err = decode_all(&bad, false).unwrap_err();
+        assert!(
+            matches!(
+                err.class(),
+                "checksum-mismatch"
+                    | "bad-magic"
+                    | "unsupported-version"
+                    | "malformed"
+                    | "truncated"
+            ),
+            "byte {at}: {err:?}"
+        );
+    }
+    for len in 0..stream.len() {
+        assert!(decode_all(&stream[..len], false).is_err());
+    }
+}
+
+#[test]
+fn non_manifold_base_is_rejected() {
+    // Two tetrahedra sharing vertex 0 only: a bowtie vertex.
+    let b = base(
+        &[
+            [0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [9, 0, 0],
+            [0, 9, 0],
+            [0, 0, 9],
+        ],
+        &[
+            [0, 2, 1],
+            [0, 1, 3],
+            [0, 3, 2],
+            [1, 2, 3],
+            [0, 5, 4],
+            [0, 4, 6],
+            [0, 6, 5],
+            [4, 5, 6],
+        ],
+        &[LEAF; 7],
+    );
+    let stream = write_stream(&params(ChunkCodec::Stored), &[b]);
+    assert_eq!(
+        decode_all(&stream, false).unwrap_err().class(),
+        "non-manifold"
+    );
+}
