@@ -1,6 +1,13 @@
 //! The splitstream encoder.
 
+pub mod baseline;
+pub mod input;
+pub mod corner_table;
+pub mod emit;
 pub mod mesh;
+pub mod metrics;
 pub mod quadric;
+pub mod quantize;
+pub mod simplify;
 
 pub use mesh::Mesh;

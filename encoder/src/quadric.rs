@@ -132,6 +132,149 @@ pub fn norm(a: [f64; 3]) -> f64 {
     dot(a, a).sqrt()
 }
 
+/// Default weight of the boundary penalty planes in [`vertex_quadrics`].
+///
+/// A face quadric is weighted by its area (about `|e|²/2` for a triangle with
+/// edges of length `|e|`), a boundary plane by `weight * |e|²`, so with 1000
+/// sliding a border vertex off its border costs as much as tilting about two
+/// thousand neighbouring faces by the same distance: far more than any
+/// interior collapse of a terrain, so tile borders and map edges stay put,
+/// yet small enough that the summed quadrics stay well conditioned in f64
+/// (the face terms are still ~1e-3 of the boundary terms, well above the
+/// ~1e-16 rounding) and collapses *along* a straight border remain free.
+pub const DEFAULT_BOUNDARY_WEIGHT: f64 = 1000.0;
+
+/// Per-vertex quadrics of a mesh: the sum of the area-weighted plane quadrics
+/// of the vertex's triangles, plus, for every boundary edge (an undirected
+/// edge used by exactly one triangle), a penalty plane through the edge and
+/// perpendicular to its triangle, weighted by `boundary_weight * |edge|²` and
+/// added to both endpoints.
+///
+/// Both the parallel simplifier and the sequential baseline start from this
+/// function so that their errors are directly comparable. Triangles with an
+/// out-of-range index are skipped (the input checker reports them); the sum
+/// is taken in triangle order, so the result is deterministic.
+pub fn vertex_quadrics(
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    boundary_weight: f64,
+) -> Vec<Quadric> {
+    use rayon::prelude::*;
+
+    let n = positions.len();
+    let valid = |t: &[u32; 3]| t.iter().all(|&v| (v as usize) < n);
+    let face: Vec<Quadric> = triangles
+        .par_iter()
+        .map(|t| {
+            if valid(t) {
+                let [a, b, c] = t.map(|v| positions[v as usize]);
+                Quadric::from_triangle(a, b, c)
+            } else {
+                Quadric::ZERO
+            }
+        })
+        .collect();
+    let mut quadrics = vec![Quadric::ZERO; n];
+    for (t, q) in triangles.iter().zip(&face) {
+        if valid(t) {
+            for &v in t {
+                quadrics[v as usize] += *q;
+            }
+        }
+    }
+    if boundary_weight == 0.0 {
+        return quadrics;
+    }
+
+    // Undirected edge key and the corner (3 * triangle + edge slot) using it;
+    // after sorting, a key that appears once is a boundary edge.
+    let mut edges: Vec<(u64, u32)> = triangles
+        .iter()
+        .enumerate()
+        .filter(|(_, t)| valid(t))
+        .flat_map(|(i, t)| {
+            (0..3).map(move |k| {
+                let (u, v) = (t[k], t[(k + 1) % 3]);
+                let key = (u64::from(u.min(v)) << 32) | u64::from(u.max(v));
+                (key, (3 * i + k) as u32)
+            })
+        })
+        .collect();
+    edges.par_sort_unstable();
+    let mut i = 0;
+    while i < edges.len() {
+        let mut j = i + 1;
+        while j < edges.len() && edges[j].0 == edges[i].0 {
+            j += 1;
+        }
+        if j - i == 1 {
+            let corner = edges[i].1 as usize;
+            let t = triangles[corner / 3];
+            let k = corner % 3;
+            let (u, v, w) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+            let [pu, pv, pw] = [u, v, w].map(|x| positions[x as usize]);
+            let q = boundary_quadric(pu, pv, pw, boundary_weight);
+            quadrics[u as usize] += q;
+            quadrics[v as usize] += q;
+        }
+        i = j;
+    }
+    quadrics
+}
+
+/// Penalty quadric of boundary edge `(p, q)` of triangle `(p, q, r)`: the
+/// plane containing the edge and the triangle's normal.
+fn boundary_quadric(p: [f64; 3], q: [f64; 3], r: [f64; 3], weight: f64) -> Quadric {
+    let e = sub(q, p);
+    let n = cross(e, sub(r, p));
+    let m = cross(e, n);
+    let len = norm(m);
+    if len == 0.0 || !len.is_finite() {
+        return Quadric::ZERO;
+    }
+    let unit = [m[0] / len, m[1] / len, m[2] / len];
+    Quadric::from_plane(unit, -dot(unit, p), weight * dot(e, e))
+}
+
+/// Where an edge `(a, b)` with summed quadric `q` collapses to, and the
+/// error there.
+///
+/// Unconstrained: the quadric's minimizer when it exists and lies within
+/// twice the edge length of the midpoint (further away means the system is
+/// ill-conditioned, e.g. a nearly flat region, and the "optimum" is a spike);
+/// otherwise, and always when `constrained`, the best of `a`, `b` and the
+/// midpoint, preferring them in that order on ties so that flat regions keep
+/// existing vertex positions. Shared by both simplifiers so they place
+/// vertices identically.
+pub fn collapse_target(
+    q: &Quadric,
+    a: [f64; 3],
+    b: [f64; 3],
+    constrained: bool,
+) -> ([f64; 3], f64) {
+    let mid = [
+        0.5 * (a[0] + b[0]),
+        0.5 * (a[1] + b[1]),
+        0.5 * (a[2] + b[2]),
+    ];
+    let mut best = (a, q.error(a));
+    for p in [b, mid] {
+        let e = q.error(p);
+        if e < best.1 {
+            best = (p, e);
+        }
+    }
+    if !constrained && let Some(m) = q.minimizer() {
+        let reach = 2.0 * norm(sub(b, a));
+        let e = q.error(m);
+        // The minimizer can only lose to a candidate through rounding.
+        if norm(sub(m, mid)) <= reach && e < best.1 {
+            best = (m, e);
+        }
+    }
+    best
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -153,5 +296,104 @@ mod tests {
             assert!((got - want).abs() < 1e-9);
         }
         assert!(q.error(p) < 1e-12);
+    }
+
+    /// A unit square in z = 0 split into two CCW triangles.
+    fn square() -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let p = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        (p, vec![[0, 1, 2], [0, 2, 3]])
+    }
+
+    #[test]
+    fn vertex_quadrics_without_boundary_are_face_sums() {
+        let (p, t) = square();
+        let q = vertex_quadrics(&p, &t, 0.0);
+        // Vertex 0 sees both triangles: plane z = 0 with total area 1.
+        assert!((q[0].error([0.3, 0.7, 2.0]) - 4.0).abs() < 1e-12);
+        assert!((q[1].error([0.3, 0.7, 2.0]) - 2.0).abs() < 1e-12);
+        // Sliding within the plane is free.
+        assert!(q[0].error([5.0, -3.0, 0.0]) < 1e-12);
+    }
+
+    #[test]
+    fn boundary_planes_pin_border_vertices() {
+        let (p, t) = square();
+        let q = vertex_quadrics(&p, &t, 10.0);
+        // Vertex 1 lies on border edges y = 0 (0-1) and x = 1 (1-2), each of
+        // length 1: moving it off both by 0.5 costs 10 * (0.25 + 0.25).
+        assert!((q[1].error([1.5, -0.5, 0.0]) - 5.0).abs() < 1e-9);
+        // Along its border edge y = 0 only the x = 1 plane costs.
+        assert!((q[1].error([0.5, 0.0, 0.0]) - 2.5).abs() < 1e-9);
+        // The shared diagonal 0-2 is interior: no penalty for crossing it.
+        let free = vertex_quadrics(&p, &t, 0.0);
+        assert!((q[0].error([0.0, 0.0, 0.0]) - free[0].error([0.0, 0.0, 0.0])).abs() < 1e-12);
+        // Vertex 0 is a corner on borders x = 0 and y = 0, both length 1.
+        assert!((q[0].error([-1.0, -1.0, 0.0]) - 20.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn boundary_planes_are_perpendicular_to_their_triangle() {
+        let (p, t) = square();
+        let q = vertex_quadrics(&p, &t, 1.0);
+        let face = vertex_quadrics(&p, &t, 0.0);
+        // Lifting vertex 1 out of the plane is charged by the faces only.
+        let lift = [1.0, 0.0, 3.0];
+        assert!((q[1].error(lift) - face[1].error(lift)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn out_of_range_triangles_are_skipped() {
+        let (p, mut t) = square();
+        t.push([0, 1, 9]);
+        let q = vertex_quadrics(&p, &t, 1.0);
+        assert_eq!(q.len(), 4);
+    }
+
+    #[test]
+    fn collapse_target_uses_a_nearby_minimizer() {
+        let q = Quadric::from_plane([1.0, 0.0, 0.0], -1.0, 1.0)
+            + Quadric::from_plane([0.0, 1.0, 0.0], -1.0, 1.0)
+            + Quadric::from_plane([0.0, 0.0, 1.0], -1.0, 1.0);
+        let (p, e) = collapse_target(&q, [0.0, 1.0, 1.0], [2.0, 1.0, 1.0], false);
+        assert!(norm(sub(p, [1.0, 1.0, 1.0])) < 1e-9);
+        assert!(e < 1e-12);
+        // Constrained: the midpoint is the best of {a, b, mid}.
+        let (p, e) = collapse_target(&q, [0.0, 1.0, 1.0], [2.0, 1.0, 1.0], true);
+        assert_eq!(p, [1.0, 1.0, 1.0]);
+        assert!(e < 1e-12);
+        let (p, e) = collapse_target(&q, [0.0, 1.0, 1.0], [1.5, 1.0, 1.0], true);
+        assert_eq!(p, [0.75, 1.0, 1.0]);
+        assert!((e - 0.0625).abs() < 1e-12);
+    }
+
+    #[test]
+    fn collapse_target_rejects_a_far_minimizer() {
+        // Minimizer at (10, 10, 10), far from the short edge near the origin.
+        let q = Quadric::from_plane([1.0, 0.0, 0.0], -10.0, 1.0)
+            + Quadric::from_plane([0.0, 1.0, 0.0], -10.0, 1.0)
+            + Quadric::from_plane([0.0, 0.0, 1.0], -10.0, 1.0);
+        let a = [0.0, 0.0, 0.0];
+        let b = [1.0, 1.0, 1.0];
+        let (p, e) = collapse_target(&q, a, b, false);
+        assert_eq!(p, b);
+        assert!((e - 3.0 * 81.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn collapse_target_prefers_endpoints_on_ties() {
+        // Flat: the minimizer is singular and every candidate costs 0.
+        let q = Quadric::from_plane([0.0, 0.0, 1.0], 0.0, 1.0);
+        let a = [0.0, 0.0, 0.0];
+        let b = [1.0, 0.0, 0.0];
+        assert_eq!(collapse_target(&q, a, b, false), (a, 0.0));
+        assert_eq!(collapse_target(&q, a, b, true), (a, 0.0));
+        // b wins when a costs more.
+        let q = Quadric::from_plane([1.0, 0.0, 0.0], -1.0, 1.0);
+        assert_eq!(collapse_target(&q, a, b, false), (b, 0.0));
     }
 }

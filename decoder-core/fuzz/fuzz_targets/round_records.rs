@@ -1,0 +1,17 @@
+//! Drives `MeshState::run_round` with a `RecordSource` that takes flags and
+//! split records from the fuzz bytes (valid by construction, with rare
+//! injected faults), writes the chosen records into a stream, decodes it and
+//! compares the decoder with the replay after every round: same state
+//! hashes, same final mesh, or the very same error.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use splitstream_decoder_core_fuzz::gen::{self, Choices};
+
+fuzz_target!(|data: &[u8]| {
+    let g = gen::generate(&mut Choices::new(data), true);
+    let decoded = gen::decode_full(&g.stream);
+    if let Err(msg) = gen::check_against(&g, &decoded) {
+        panic!("decoder and replay disagree: {msg}");
+    }
+});

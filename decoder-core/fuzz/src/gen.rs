@@ -1,0 +1,764 @@
+//! Valid-stream generator shared by the fuzz targets, the seed-stream example
+//! and the property tests (`#[path]`-included there; it uses only the public
+//! API of `splitstream-decoder-core` with the `alloc` feature, plus `std`).
+//!
+//! A stream is built the way the encoder builds one: a [`MeshState`] replays
+//! every round through [`MeshState::run_round`] with a [`RecordSource`] that
+//! *chooses* flags and split records (from a byte string of choices) and
+//! writes them into the substreams as it goes. The result is valid by
+//! construction, and the state hash after the base and after every round is
+//! known, so a decoder run can be compared round by round.
+//!
+//! With `allow_invalid`, a few choice values inject one fault per record
+//! (a raw wing offset/distance, a raw deficit, a flagged neighbour); the
+//! replay then stops at the error and the stream ends with that round, so the
+//! decoder must report the very same error.
+
+#![allow(dead_code)]
+
+use splitstream_decoder_core::limits::{LEAF, NONE};
+use splitstream_decoder_core::writer::{
+    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+};
+use splitstream_decoder_core::{
+    Decoder, Error, Inflater, Layout, MeshState, PositionMode, RecordSource, Ring, SplitRecord,
+    workspace_len,
+};
+
+/// A byte string read as a sequence of choices; zeros once exhausted.
+pub struct Choices<'a> {
+    data: &'a [u8],
+    pos: usize,
+}
+
+impl<'a> Choices<'a> {
+    pub fn new(data: &'a [u8]) -> Self {
+        Choices { data, pos: 0 }
+    }
+
+    pub fn byte(&mut self) -> u8 {
+        let b = self.data.get(self.pos).copied().unwrap_or(0);
+        self.pos += 1;
+        b
+    }
+
+    pub fn u16(&mut self) -> u16 {
+        u16::from_le_bytes([self.byte(), self.byte()])
+    }
+
+    /// A value in `0 .. n` (0 when `n <= 1`).
+    pub fn below(&mut self, n: usize) -> usize {
+        if n <= 1 { 0 } else { self.u16() as usize % n }
+    }
+
+    pub fn exhausted(&self) -> bool {
+        self.pos >= self.data.len()
+    }
+}
+
+/// A base mesh: positions in a small grid and counter-clockwise triangles.
+#[derive(Clone, Debug)]
+pub struct BaseMesh {
+    pub name: &'static str,
+    pub positions: Vec<[u32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+pub fn tetrahedron() -> BaseMesh {
+    BaseMesh {
+        name: "tetrahedron",
+        positions: vec![[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
+        triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+    }
+}
+
+pub fn triangle() -> BaseMesh {
+    BaseMesh {
+        name: "triangle",
+        positions: vec![[0, 0, 0], [10, 0, 0], [0, 10, 0]],
+        triangles: vec![[0, 1, 2]],
+    }
+}
+
+pub fn octahedron() -> BaseMesh {
+    // 0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z.
+    let positions = vec![
+        [20, 10, 10],
+        [0, 10, 10],
+        [10, 20, 10],
+        [10, 0, 10],
+        [10, 10, 20],
+        [10, 10, 0],
+    ];
+    let mut triangles = Vec::new();
+    for sx in [1i32, -1] {
+        for sy in [1i32, -1] {
+            for sz in [1i32, -1] {
+                let x = if sx > 0 { 0 } else { 1 };
+                let y = if sy > 0 { 2 } else { 3 };
+                let z = if sz > 0 { 4 } else { 5 };
+                triangles.push(if sx * sy * sz > 0 { [x, y, z] } else { [x, z, y] });
+            }
+        }
+    }
+    BaseMesh {
+        name: "octahedron",
+        positions,
+        triangles,
+    }
+}
+
+/// A `w` x `h` vertex grid in the z = 0 plane: a disk with boundary.
+pub fn grid(w: u32, h: u32) -> BaseMesh {
+    let mut positions = Vec::new();
+    for j in 0..h {
+        for i in 0..w {
+            positions.push([10 * i, 10 * j, 0]);
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..h - 1 {
+        for i in 0..w - 1 {
+            let v00 = j * w + i;
+            let v10 = v00 + 1;
+            let v01 = v00 + w;
+            let v11 = v01 + 1;
+            triangles.push([v00, v10, v11]);
+            triangles.push([v00, v11, v01]);
+        }
+    }
+    BaseMesh {
+        name: if w == 2 && h == 2 { "quad" } else { "grid" },
+        positions,
+        triangles,
+    }
+}
+
+pub fn bases() -> Vec<BaseMesh> {
+    vec![
+        tetrahedron(),
+        octahedron(),
+        grid(4, 4),
+        triangle(),
+        grid(2, 2),
+        grid(5, 3),
+    ]
+}
+
+/// The base level (substreams 9..=11) of `base` with `deficits`.
+pub fn base_level(base: &BaseMesh, deficits: &[u8]) -> LevelPayload {
+    let mut subs = vec![SubstreamWriter::default(); 3];
+    let mut prev = [0i64; 3];
+    for p in &base.positions {
+        for k in 0..3 {
+            subs[0].signed((p[k] as i64 - prev[k]) as i32);
+            prev[k] = p[k] as i64;
+        }
+    }
+    for t in &base.triangles {
+        for &v in t {
+            subs[1].varint(v);
+        }
+    }
+    for &d in deficits {
+        subs[2].byte(d);
+    }
+    LevelPayload {
+        round_splits: vec![],
+        substreams: subs,
+        vertex_count: base.positions.len() as u32,
+        triangle_count: base.triangles.len() as u32,
+        geometric_error: 1.0,
+    }
+}
+
+/// A generated stream with what a decoder must see.
+#[derive(Clone, Debug)]
+pub struct Generated {
+    pub base: &'static str,
+    pub params: StreamParams,
+    /// Levels before framing (base first), for structured mutation.
+    pub levels: Vec<LevelPayload>,
+    pub stream: Vec<u8>,
+    /// State hash after the base and after every round that succeeded.
+    pub hashes: Vec<u64>,
+    /// The error the replay hit (only with `allow_invalid`).
+    pub error: Option<Error>,
+    pub base_vertices: u32,
+    pub splits: u32,
+    pub triangles: Vec<[u32; 3]>,
+    pub positions: Vec<[u32; 3]>,
+}
+
+/// Largest number of splits a generated stream holds.
+pub const MAX_SPLITS: u32 = 120;
+
+struct GenSource<'g, 'c> {
+    choices: &'g mut Choices<'c>,
+    flags: Vec<bool>,
+    next_flag: usize,
+    subs: &'g mut [SubstreamWriter],
+    mode: PositionMode,
+    bits: u8,
+    allow_invalid: bool,
+}
+
+fn wing_ok(state: &MeshState<'_>, x: u32) -> bool {
+    x == NONE || state.deficits()[x as usize] != 0
+}
+
+/// Wing pairs `(o, d)` that a valid record may name for this ring.
+fn wing_pairs(state: &MeshState<'_>, ring: &Ring) -> Vec<(usize, usize)> {
+    let k = ring.len();
+    let v = ring.vertices();
+    let mut pairs = Vec::new();
+    for o in 0..k {
+        if !wing_ok(state, v[o]) {
+            continue;
+        }
+        for d in 1..k - o {
+            if wing_ok(state, v[o + d]) && !(v[o] == NONE && v[o + d] == NONE) {
+                pairs.push((o, d));
+            }
+        }
+    }
+    pairs
+}
+
+fn pick_deficit(b: u8, valence: usize) -> u8 {
+    let d = match b % 4 {
+        0 => 0,
+        1 => 1,
+        2 => 2 + b / 64,
+        _ => LEAF,
+    };
+    if d != LEAF && valence + d as usize > 255 {
+        LEAF
+    } else {
+        d
+    }
+}
+
+fn small(b: u8) -> i64 {
+    ((b as i8) >> 2) as i64
+}
+
+impl RecordSource for GenSource<'_, '_> {
+    fn flag(&mut self, _v: u32) -> Result<bool, Error> {
+        let f = self.flags.get(self.next_flag).copied().unwrap_or(false);
+        self.next_flag += 1;
+        Ok(f)
+    }
+
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
+        let c = &mut *self.choices;
+        let k = ring.len();
+        let pairs = wing_pairs(state, ring);
+        let (o, d) = if self.allow_invalid && c.byte() == 0xFF {
+            (c.byte() as usize, c.byte() as usize)
+        } else if pairs.is_empty() {
+            (0, 0)
+        } else {
+            pairs[c.below(pairs.len())]
+        };
+        let config = c.byte() & 1 == 1;
+        let d_clamped = d.min(k);
+        let (len_p, len_c) = if config {
+            (k - d_clamped, d_clamped)
+        } else {
+            (d_clamped, k - d_clamped)
+        };
+        let (mut deficit_p, mut deficit_c) = (
+            pick_deficit(c.byte(), len_p + 2),
+            pick_deficit(c.byte(), len_c + 2),
+        );
+        if self.allow_invalid && c.byte() == 0xFE {
+            deficit_p = c.byte();
+            deficit_c = c.byte();
+        }
+        let limit = 1i64 << self.bits;
+        let clamp = |v: i64| v.clamp(0, limit - 1);
+        let parent = state.positions()[r as usize];
+        let parent = [parent[0] as i64, parent[1] as i64, parent[2] as i64];
+        let mut p = [0i64; 3];
+        let mut q = [0i64; 3];
+        let mut edge = [0i64; 3];
+        match self.mode {
+            PositionMode::Optimal => {
+                for k in 0..3 {
+                    p[k] = clamp(parent[k] + small(c.byte()));
+                    q[k] = clamp(p[k] + small(c.byte()));
+                    edge[k] = q[k] - p[k];
+                }
+                for e in edge {
+                    self.subs[6].signed(e as i32);
+                }
+                for k in 0..3 {
+                    let m = parent[k] - p[k] - (edge[k] >> 1);
+                    self.subs[7].signed(m as i32);
+                }
+            }
+            PositionMode::Constrained => {
+                let code = c.byte() % 3;
+                for e in &mut edge {
+                    *e = small(c.byte());
+                }
+                let place = |edge: &[i64; 3]| {
+                    let mut p = [0i64; 3];
+                    let mut q = [0i64; 3];
+                    for k in 0..3 {
+                        p[k] = parent[k]
+                            - match code {
+                                0 => 0,
+                                1 => edge[k],
+                                _ => edge[k] >> 1,
+                            };
+                        q[k] = p[k] + edge[k];
+                    }
+                    (p, q)
+                };
+                let (mut pp, mut qq) = place(&edge);
+                if pp.iter().chain(qq.iter()).any(|&v| !(0..limit).contains(&v)) {
+                    edge = [0; 3];
+                    (pp, qq) = place(&edge);
+                }
+                p = pp;
+                q = qq;
+                for e in edge {
+                    self.subs[6].signed(e as i32);
+                }
+                self.subs[7].byte(code);
+            }
+        }
+        self.subs[1].byte(o as u8);
+        self.subs[2].byte(d as u8);
+        self.subs[3].bit(config);
+        self.subs[4].byte(deficit_p);
+        self.subs[5].byte(deficit_c);
+        Ok(SplitRecord {
+            wing_offset: o as u8,
+            wing_distance: d as u8,
+            config,
+            deficit_p,
+            deficit_c,
+            position_p: [p[0] as u32, p[1] as u32, p[2] as u32],
+            position_c: [q[0] as u32, q[1] as u32, q[2] as u32],
+        })
+    }
+}
+
+/// Builds a stream from `choices` (any bytes; all zeros gives a deep stream).
+pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
+    let bases = bases();
+    let base = bases[choices.below(bases.len())].clone();
+    let position_mode = if choices.byte() & 1 == 0 {
+        PositionMode::Optimal
+    } else {
+        PositionMode::Constrained
+    };
+    let bits = [8u8, 10, 16, 24][choices.below(4)];
+    let codec = match choices.byte() % 4 {
+        0 | 1 => ChunkCodec::Stored,
+        2 => ChunkCodec::Deflate(1),
+        _ => ChunkCodec::Deflate(6),
+    };
+    let chunk_limit = [64u32, 1, 3, 7, 16, 255][choices.below(6)];
+    let params = StreamParams {
+        position_mode,
+        bits,
+        origin: [0.0; 3],
+        scale: [1.0; 3],
+        codec,
+        chunk_limit,
+    };
+    let refinement_levels = 4 - choices.below(4);
+    let bv = base.positions.len() as u32;
+    let bt = base.triangles.len() as u32;
+    let deficits: Vec<u8> = (0..bv)
+        .map(|_| match choices.byte() % 5 {
+            0 | 1 => 0,
+            2 => 1,
+            3 => 2,
+            _ => LEAF,
+        })
+        .collect();
+
+    let vcap = bv + MAX_SPLITS;
+    let tcap = bt + 2 * MAX_SPLITS;
+    let layout = Layout::new(vcap, tcap, bv, bt, 1);
+    let mut memory = vec![0u8; layout.bytes_unaligned()];
+    let (mem, _) = layout.carve(&mut memory).expect("layout fits");
+    let mut state = MeshState::new(mem, bits);
+    {
+        let (positions, corners, defs) = state.base_arrays();
+        positions[..bv as usize].copy_from_slice(&base.positions);
+        for (i, t) in base.triangles.iter().enumerate() {
+            corners[3 * i..3 * i + 3].copy_from_slice(t);
+        }
+        defs[..bv as usize].copy_from_slice(&deficits);
+    }
+    state.finish_base(bv, bt).expect("seed base meshes are manifold");
+    let mut hashes = vec![state.state_hash()];
+    let mut levels = vec![base_level(&base, &deficits)];
+    let mut ring = Ring::default();
+    let mut error = None;
+
+    'levels: for _ in 0..refinement_levels {
+        let mut subs = vec![SubstreamWriter::default(); 8];
+        let mut round_splits = Vec::new();
+        let level_start_v = state.vertex_count();
+        let rounds = 3 - choices.below(3);
+        for _ in 0..rounds {
+            let n = state.vertex_count();
+            let room = (vcap - n) as usize;
+            let mut flags = Vec::new();
+            let mut flagged: Vec<u32> = Vec::new();
+            let mut first_eligible = None;
+            for v in 0..n {
+                if state.deficits()[v as usize] != 0 {
+                    continue;
+                }
+                let eligible = flagged.len() < room
+                    && state.ring(v, &mut ring).is_ok()
+                    && ring.vertices().iter().all(|x| !flagged.contains(x))
+                    && !wing_pairs(&state, &ring).is_empty();
+                let b = choices.byte();
+                let f = if eligible {
+                    if first_eligible.is_none() {
+                        first_eligible = Some(flags.len());
+                    }
+                    b < 200
+                } else {
+                    allow_invalid && b == 0xFD && flagged.len() < room
+                };
+                if f {
+                    flagged.push(v);
+                }
+                flags.push(f);
+            }
+            if flagged.is_empty() {
+                match first_eligible {
+                    Some(i) => {
+                        flags[i] = true;
+                        flagged.push(i as u32); // count only
+                    }
+                    None => break,
+                }
+            }
+            for &f in &flags {
+                subs[0].bit(f);
+            }
+            let declared = flagged.len() as u32;
+            round_splits.push(declared);
+            let mut source = GenSource {
+                choices: &mut *choices,
+                flags,
+                next_flag: 0,
+                subs: &mut subs,
+                mode: position_mode,
+                bits,
+                allow_invalid,
+            };
+            match state.run_round(declared, &mut source, &mut ring) {
+                Ok(_) => hashes.push(state.state_hash()),
+                Err(e) => {
+                    let done = state.vertex_count() - n;
+                    let remaining = declared - done;
+                    levels.push(LevelPayload {
+                        round_splits,
+                        substreams: subs,
+                        vertex_count: n + declared,
+                        triangle_count: state.triangle_count() + remaining,
+                        geometric_error: 0.0,
+                    });
+                    error = Some(e);
+                    break 'levels;
+                }
+            }
+        }
+        if round_splits.is_empty() {
+            break;
+        }
+        debug_assert!(state.vertex_count() > level_start_v);
+        levels.push(LevelPayload {
+            round_splits,
+            substreams: subs,
+            vertex_count: state.vertex_count(),
+            triangle_count: state.triangle_count(),
+            geometric_error: 0.0,
+        });
+    }
+    let stream = write_stream(&params, &levels);
+    Generated {
+        base: base.name,
+        params,
+        levels,
+        stream,
+        hashes,
+        error,
+        base_vertices: bv,
+        splits: state.vertex_count() - bv,
+        triangles: state.triangles().to_vec(),
+        positions: state.positions().to_vec(),
+    }
+}
+
+/// What a round-by-round decode of a stream saw.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Decoded {
+    /// State hash after the base and after every round.
+    pub hashes: Vec<u64>,
+    /// Hash after each complete level.
+    pub level_hashes: Vec<u64>,
+    pub error: Option<Error>,
+    pub levels: u16,
+    pub levels_that_fit: u16,
+    pub triangles: Vec<[u32; 3]>,
+    pub positions: Vec<[u32; 3]>,
+    pub deficits: Vec<u8>,
+}
+
+/// Decodes `stream` round by round with the no-alloc API into `workspace`.
+pub fn decode_rounds(stream: &[u8], workspace: &mut [u8], inflater: &mut Inflater) -> Decoded {
+    let mut out = Decoded {
+        hashes: Vec::new(),
+        level_hashes: Vec::new(),
+        error: None,
+        levels: 0,
+        levels_that_fit: 0,
+        triangles: Vec::new(),
+        positions: Vec::new(),
+        deficits: Vec::new(),
+    };
+    let mut decoder = match Decoder::new(stream, workspace, inflater) {
+        Ok(d) => d,
+        Err(e) => {
+            out.error = Some(e);
+            return out;
+        }
+    };
+    out.levels_that_fit = decoder.levels_that_fit();
+    let result = (|| -> Result<(), Error> {
+        while let Some(k) = decoder.next_level() {
+            let range = decoder.level_range(k);
+            let bytes = stream
+                .get(range.start as usize..range.end as usize)
+                .ok_or(Error::Truncated)?;
+            let mut level = decoder.begin_level(k, bytes)?;
+            if k == 0 {
+                out.hashes.push(level.state().state_hash());
+            }
+            while level.next_round()?.is_some() {
+                out.hashes.push(level.state().state_hash());
+            }
+            out.level_hashes.push(decoder.state_hash());
+        }
+        Ok(())
+    })();
+    out.error = result.err();
+    out.levels = decoder.levels_done();
+    out.triangles = decoder.triangles().to_vec();
+    out.positions = decoder.positions().to_vec();
+    out.deficits = decoder.state().deficits().to_vec();
+    out
+}
+
+/// Decodes with a workspace of exactly the needed size.
+pub fn decode_full(stream: &[u8]) -> Decoded {
+    let len = workspace_len(stream).unwrap_or(0).min(64 << 20);
+    let mut ws = vec![0u8; len];
+    let mut inflater = Box::new(Inflater::new());
+    decode_rounds(stream, &mut ws, &mut inflater)
+}
+
+/// Checks a decode against the replay that generated the stream.
+pub fn check_against(g: &Generated, d: &Decoded) -> Result<(), String> {
+    if d.hashes != g.hashes {
+        return Err(format!(
+            "hashes differ: decoder {} rounds, generator {} (error {:?} vs {:?})",
+            d.hashes.len(),
+            g.hashes.len(),
+            d.error,
+            g.error
+        ));
+    }
+    match (g.error, d.error) {
+        (None, None) => {
+            if d.triangles != g.triangles || d.positions != g.positions {
+                return Err("final mesh differs".into());
+            }
+            Ok(())
+        }
+        (Some(a), Some(b)) if a == b => Ok(()),
+        (a, b) => Err(format!("generator error {a:?}, decoder error {b:?}")),
+    }
+}
+
+/// Structured mutation of a generated stream's content *before* framing,
+/// so that every checksum stays valid: substream bytes, bits, split counts,
+/// level counts and stream parameters. `ops` is read as a list of
+/// operations until exhausted (at most 32).
+pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec<LevelPayload>) {
+    let mut params = g.params;
+    let mut subs: Vec<Vec<Vec<u8>>> = g
+        .levels
+        .iter()
+        .map(|l| l.substreams.iter().map(|s| s.as_bytes().to_vec()).collect())
+        .collect();
+    let mut meta: Vec<(Vec<u32>, u32, u32)> = g
+        .levels
+        .iter()
+        .map(|l| (l.round_splits.clone(), l.vertex_count, l.triangle_count))
+        .collect();
+    let mut n_ops = 0;
+    while !ops.exhausted() && n_ops < 32 {
+        n_ops += 1;
+        let op = ops.byte() % 12;
+        let l = ops.below(subs.len());
+        let s = ops.below(subs[l].len());
+        let bytes = &mut subs[l][s];
+        match op {
+            0 => {
+                // Flip one bit (flags, config bits, varint continuation bits).
+                let at = ops.below(bytes.len());
+                let bit = ops.byte() % 8;
+                if let Some(b) = bytes.get_mut(at) {
+                    *b ^= 1 << bit;
+                }
+            }
+            1 => {
+                let at = ops.below(bytes.len());
+                let v = ops.byte();
+                if let Some(b) = bytes.get_mut(at) {
+                    *b = v;
+                }
+            }
+            2 => {
+                let at = ops.below(bytes.len() + 1);
+                let v = ops.byte();
+                bytes.insert(at.min(bytes.len()), v);
+            }
+            3 => {
+                let at = ops.below(bytes.len());
+                if at < bytes.len() {
+                    bytes.remove(at);
+                }
+            }
+            4 => {
+                let at = ops.below(bytes.len() + 1);
+                bytes.truncate(at);
+            }
+            5 => {
+                // Add a small delta to a byte (offsets, distances, deficits).
+                let at = ops.below(bytes.len());
+                let delta = ops.byte() as i8 % 4;
+                if let Some(b) = bytes.get_mut(at) {
+                    *b = b.wrapping_add(delta as u8);
+                }
+            }
+            6 => {
+                let (splits, _, _) = &mut meta[l];
+                let r = ops.below(splits.len());
+                let delta = (ops.byte() as i8 % 3) as i32;
+                if let Some(x) = splits.get_mut(r) {
+                    *x = (*x as i32 + delta).max(0) as u32;
+                }
+            }
+            7 => {
+                let (_, v, t) = &mut meta[l];
+                let dv = (ops.byte() as i8 % 3) as i64;
+                let dt = (ops.byte() as i8 % 3) as i64;
+                *v = (*v as i64 + dv).clamp(0, u32::MAX as i64) as u32;
+                *t = (*t as i64 + dt).clamp(0, u32::MAX as i64) as u32;
+            }
+            8 => {
+                let (splits, _, _) = &mut meta[l];
+                if ops.byte() & 1 == 0 {
+                    splits.pop();
+                } else {
+                    splits.push(1);
+                }
+            }
+            9 => match ops.byte() % 4 {
+                0 => {
+                    params.position_mode = match params.position_mode {
+                        PositionMode::Optimal => PositionMode::Constrained,
+                        PositionMode::Constrained => PositionMode::Optimal,
+                    }
+                }
+                1 => params.bits = 1 + ops.byte() % 31,
+                2 => params.chunk_limit = 1 + ops.byte() as u32,
+                _ => {
+                    params.codec = match ops.byte() % 3 {
+                        0 => ChunkCodec::Stored,
+                        1 => ChunkCodec::Deflate(1),
+                        _ => ChunkCodec::Deflate(9),
+                    }
+                }
+            },
+            10 => {
+                // Append a run of one byte (a long varint, a run of flags).
+                let v = ops.byte();
+                let n = ops.byte() % 16;
+                bytes.extend(core::iter::repeat_n(v, n as usize));
+            }
+            _ => {
+                // Drop the last level (never the base).
+                if subs.len() > 1 && ops.byte() & 1 == 0 {
+                    subs.pop();
+                    meta.pop();
+                }
+            }
+        }
+    }
+    let levels = subs
+        .into_iter()
+        .zip(meta)
+        .map(|(s, (round_splits, vertex_count, triangle_count))| LevelPayload {
+            round_splits,
+            substreams: s
+                .into_iter()
+                .map(|b| {
+                    let mut w = SubstreamWriter::default();
+                    for x in b {
+                        w.byte(x);
+                    }
+                    w
+                })
+                .collect(),
+            vertex_count,
+            triangle_count,
+            geometric_error: 0.0,
+        })
+        .collect();
+    (params, levels)
+}
+
+/// Deterministic pseudo-random bytes (xorshift64*), for seed streams.
+pub fn pseudo_random_bytes(seed: u64, len: usize) -> Vec<u8> {
+    let mut x = seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1;
+    (0..len)
+        .map(|_| {
+            x ^= x >> 12;
+            x ^= x << 25;
+            x ^= x >> 27;
+            (x.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 56) as u8
+        })
+        .collect()
+}
+
+/// The fixed seed streams of `decode_mutated`: every base mesh with all-zero
+/// choices (deep, valid) and a few pseudo-random choice strings.
+pub fn seed_generated() -> Vec<Generated> {
+    let mut out = Vec::new();
+    for b in 0..bases().len() as u8 {
+        // below(n) reads a little-endian u16: base index b.
+        let choices = [b, 0];
+        out.push(generate(&mut Choices::new(&choices), false));
+    }
+    for seed in 1..=10u64 {
+        let bytes = pseudo_random_bytes(seed, 4096);
+        out.push(generate(&mut Choices::new(&bytes), false));
+    }
+    out
+}

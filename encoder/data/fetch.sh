@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Fetch the real-world test meshes used by encoder/tests/input_real_data.rs.
+#
+# Everything comes from package registries (npm, Debian, PyPI) because those
+# are the only sources reachable from the build machines and they are
+# versioned and checksummed by their clients. Idempotent: files already in
+# encoder/data/real/ are skipped. See README.md for what each file is.
+set -euo pipefail
+
+here="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+real="$here/real"
+mkdir -p "$real"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+
+# (a) Stanford bunny from the npm package `bunny` ({positions, cells}).
+if [[ ! -s "$real/bunny.ply" ]]; then
+    echo "fetching npm package bunny" >&2
+    (cd "$tmp" && npm pack bunny --silent >/dev/null && tar -xzf bunny-*.tgz)
+    node -e '
+const b = require(process.argv[1]);
+const out = [];
+out.push("ply", "format ascii 1.0", "comment Stanford bunny from the npm package `bunny`",
+  "element vertex " + b.positions.length, "property float x", "property float y", "property float z",
+  "element face " + b.cells.length, "property list uchar int vertex_indices", "end_header");
+for (const p of b.positions) out.push(p.join(" "));
+for (const c of b.cells) out.push(c.length + " " + c.join(" "));
+require("fs").writeFileSync(process.argv[2], out.join("\n") + "\n");
+' "$tmp/package" "$real/bunny.ply.part"
+    mv "$real/bunny.ply.part" "$real/bunny.ply"
+fi
+
+# (b) CGAL's sample meshes from the Debian package libcgal-demo.
+cgal_files=(armadillo.off bunny00.off refined_elephant.off)
+need_cgal=0
+for f in "${cgal_files[@]}"; do [[ -s "$real/$f" ]] || need_cgal=1; done
+if (( need_cgal )); then
+    echo "fetching Debian package libcgal-demo" >&2
+    if ! (cd "$tmp" && apt-get download libcgal-demo >/dev/null 2>&1); then
+        echo "apt-get download failed; running apt-get update and retrying" >&2
+        apt-get update >/dev/null
+        (cd "$tmp" && apt-get download libcgal-demo >/dev/null)
+    fi
+    dpkg-deb -x "$tmp"/libcgal-demo_*.deb "$tmp/deb"
+    tarball="$tmp/deb/usr/share/doc/libcgal-dev/data.tar.gz"
+    for f in "${cgal_files[@]}"; do
+        [[ -s "$real/$f" ]] && continue
+        member="$(tar -tzf "$tarball" | grep -E "(^|/)data/meshes/$f\$" | head -n 1)"
+        if [[ -z "$member" ]]; then
+            echo "error: $f not found in $tarball" >&2
+            exit 1
+        fi
+        tar -xzf "$tarball" -C "$tmp" "$member"
+        mv "$tmp/$member" "$real/$f"
+    done
+fi
+
+# (c) matplotlib's sample DEM from its PyPI wheel.
+if [[ ! -s "$real/jacksboro_fault_dem.npz" ]]; then
+    echo "fetching matplotlib wheel from PyPI" >&2
+    pip download matplotlib --no-deps --only-binary=:all: -d "$tmp/pip" --quiet
+    unzip -q -o -j "$tmp"/pip/matplotlib-*.whl \
+        'matplotlib/mpl-data/sample_data/jacksboro_fault_dem.npz' -d "$tmp/mpl"
+    mv "$tmp/mpl/jacksboro_fault_dem.npz" "$real/jacksboro_fault_dem.npz"
+fi
+
+echo "files in $real:"
+for f in bunny.ply armadillo.off bunny00.off refined_elephant.off jacksboro_fault_dem.npz; do
+    printf '  %-26s %10s bytes\n' "$f" "$(wc -c < "$real/$f")"
+done

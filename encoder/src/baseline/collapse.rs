@@ -1,0 +1,221 @@
+//! One edge collapse: the checks that keep the mesh a valid oriented
+//! manifold, then the in-place edit of the corner table.
+
+use super::corner_table::{NONE, next, prev};
+use super::state::Simplifier;
+use crate::quadric::{Quadric, cross, dot, sub};
+
+/// Most neighbours a vertex may end up with (boundary vertices count one
+/// extra), so valences fit the stream's byte-sized fields.
+pub const MAX_VALENCE: usize = 254;
+
+/// Why a popped collapse was not performed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Refusal {
+    /// The endpoints are no longer adjacent: a stale queue entry.
+    NotAnEdge,
+    /// Legal now-or-never rules failed (link, valence, flips, ...); the edge
+    /// may become legal after a neighbouring collapse.
+    Illegal,
+}
+
+/// The triangles a legal collapse removes, by the corner at `a` in each.
+pub struct Plan {
+    /// Corner at `a` of triangle `a, b, x` (CCW), if the edge has that side.
+    left: u32,
+    /// Corner at `a` of triangle `a, y, b` (CCW), if the edge has that side.
+    right: u32,
+}
+
+impl Simplifier<'_> {
+    /// Checks collapsing `b` into `a` placed at `p`. Leaves the fans of `a`
+    /// and `b` in `self.fans[0]` and `self.fans[1]` for [`Self::apply`].
+    pub fn plan(&mut self, a: u32, b: u32, p: [f64; 3]) -> Result<Plan, Refusal> {
+        let mut fa = std::mem::take(&mut self.fans[0]);
+        let mut fb = std::mem::take(&mut self.fans[1]);
+        self.table.fan(a, &mut fa);
+        self.table.fan(b, &mut fb);
+        let result = self.check(a, b, p, &fa.corners, &fb.corners);
+        self.fans[0] = fa;
+        self.fans[1] = fb;
+        result
+    }
+
+    fn check(
+        &mut self,
+        a: u32,
+        b: u32,
+        p: [f64; 3],
+        fa: &[u32],
+        fb: &[u32],
+    ) -> Result<Plan, Refusal> {
+        let token = self.next_token();
+        let token_b = self.next_token();
+        let t = &self.table;
+        let left = fa
+            .iter()
+            .copied()
+            .find(|&c| t.v(next(c)) == b)
+            .unwrap_or(NONE);
+        let right = fa
+            .iter()
+            .copied()
+            .find(|&c| t.v(prev(c)) == b)
+            .unwrap_or(NONE);
+        if left == NONE && right == NONE {
+            return Err(Refusal::NotAnEdge);
+        }
+        let interior = left != NONE && right != NONE;
+        let (ba, bb) = (self.on_boundary[a as usize], self.on_boundary[b as usize]);
+        // Collapsing a chord between two border vertices would pinch the
+        // surface into a non-manifold vertex.
+        if interior && ba && bb {
+            return Err(Refusal::Illegal);
+        }
+
+        // Link condition: the shared neighbours are exactly the opposite
+        // vertices of the removed triangles.
+        let mut count_a = 0;
+        for &c in fa {
+            for w in [t.v(next(c)), t.v(prev(c))] {
+                if self.mark[w as usize] != token {
+                    self.mark[w as usize] = token;
+                    count_a += 1;
+                }
+            }
+        }
+        let (mut count_b, mut common) = (0, 0);
+        for &c in fb {
+            for w in [t.v(next(c)), t.v(prev(c))] {
+                let m = self.mark[w as usize];
+                if m != token_b {
+                    self.mark[w as usize] = token_b;
+                    count_b += 1;
+                    if m == token && w != a && w != b {
+                        common += 1;
+                    }
+                }
+            }
+        }
+        let removed = if interior { 2 } else { 1 };
+        if common != removed {
+            return Err(Refusal::Illegal);
+        }
+        let boundary = ba || bb;
+        // |N(a) ∪ N(b)| without a and b themselves.
+        let valence = count_a - 1 + count_b - 1 - common + usize::from(boundary);
+        if valence > MAX_VALENCE {
+            return Err(Refusal::Illegal);
+        }
+        let faces = fa.len() + fb.len() - 2 * removed;
+        if faces < if boundary { 1 } else { 3 } {
+            return Err(Refusal::Illegal);
+        }
+        // Each opposite vertex loses one triangle; it must keep a fan (two
+        // triangles on a border, four inside, else it would leave a
+        // doubled face, as when a tetrahedron folds flat).
+        for c in [left, right] {
+            if c == NONE {
+                continue;
+            }
+            let x = if c == left {
+                t.v(prev(c))
+            } else {
+                t.v(next(c))
+            };
+            let mut fx = std::mem::take(&mut self.fans[2]);
+            self.table.fan(x, &mut fx);
+            let need = if self.on_boundary[x as usize] { 2 } else { 4 };
+            let ok = fx.corners.len() >= need;
+            self.fans[2] = fx;
+            if !ok {
+                return Err(Refusal::Illegal);
+            }
+        }
+        if !self.keeps_orientation(a, b, p, fa) || !self.keeps_orientation(b, a, p, fb) {
+            return Err(Refusal::Illegal);
+        }
+        Ok(Plan { left, right })
+    }
+
+    /// Whether every triangle around `v` that survives (does not contain
+    /// `other`) keeps a non-degenerate normal within 90° of its old one when
+    /// `v` moves to `p`.
+    fn keeps_orientation(&self, v: u32, other: u32, p: [f64; 3], fan: &[u32]) -> bool {
+        let t = &self.table;
+        fan.iter().all(|&c| {
+            let (n1, n2) = (t.v(next(c)), t.v(prev(c)));
+            if n1 == other || n2 == other {
+                return true;
+            }
+            let q1 = self.positions[n1 as usize];
+            let q2 = self.positions[n2 as usize];
+            let old = cross(
+                sub(q1, self.positions[v as usize]),
+                sub(q2, self.positions[v as usize]),
+            );
+            let (e1, e2) = (sub(q1, p), sub(q2, p));
+            let new = cross(e1, e2);
+            let scale = dot(e1, e1) + dot(e2, e2);
+            dot(old, new) > 0.0 && dot(new, new) > 1e-24 * scale * scale
+        })
+    }
+
+    /// Performs a planned collapse of `b` into `a`, moving `a` to `p` with
+    /// summed quadric `q`. Returns the number of triangles removed.
+    pub fn apply(&mut self, a: u32, b: u32, p: [f64; 3], q: Quadric, plan: &Plan) -> usize {
+        let fa = std::mem::take(&mut self.fans[0]);
+        let fb = std::mem::take(&mut self.fans[1]);
+        let t = &mut self.table;
+        let doomed = |c: u32| c != NONE && (c / 3 == plan.left / 3 || c / 3 == plan.right / 3);
+
+        // Re-anchor the opposite vertices on triangles that survive: the
+        // neighbours across their two folded edges.
+        for (c, left) in [(plan.left, true), (plan.right, false)] {
+            if c == NONE {
+                continue;
+            }
+            let x = t.v(if left { prev(c) } else { next(c) });
+            let anchor = [c, next(c), prev(c)]
+                .into_iter()
+                .map(|k| t.o(k))
+                .find(|&o| o != NONE && !doomed(o))
+                .map(|o| t.corner_at(o, x))
+                .unwrap_or(NONE);
+            t.corner_of[x as usize] = anchor;
+        }
+        for &c in &fb.corners {
+            if !doomed(c) {
+                t.vertex[c as usize] = a;
+            }
+        }
+        let mut removed = 0;
+        // Remove by the corner facing the collapsing edge.
+        if plan.left != NONE {
+            t.remove_triangle(prev(plan.left));
+            removed += 1;
+        }
+        if plan.right != NONE {
+            t.remove_triangle(next(plan.right));
+            removed += 1;
+        }
+        t.corner_of[a as usize] = fa
+            .corners
+            .iter()
+            .chain(&fb.corners)
+            .copied()
+            .find(|&c| !doomed(c))
+            .unwrap_or(NONE);
+        t.corner_of[b as usize] = NONE;
+
+        let (ai, bi) = (a as usize, b as usize);
+        self.positions[ai] = p;
+        self.quadrics[ai] = q;
+        self.on_boundary[ai] |= self.on_boundary[bi];
+        self.alive[bi] = false;
+        self.alive_count -= 1;
+        self.fans[0] = fa;
+        self.fans[1] = fb;
+        removed
+    }
+}

@@ -1,0 +1,183 @@
+//! Flat corner table (Rossignac's "Corner Table"): the connectivity the
+//! sequential baseline edits in place. Three flat `u32` arrays and no
+//! per-vertex lists, so a 2M-triangle terrain costs about 50 MB and every
+//! traversal is a few indexed loads.
+
+/// Marks a missing opposite corner (a boundary edge), a dead triangle's
+/// corners, or a vertex without a corner.
+pub const NONE: u32 = u32::MAX;
+
+/// Corner `c` of triangle `c / 3` sits at vertex `vertex[c]`; `opposite[c]`
+/// is the corner across the edge facing `c` (the edge from `next(c)` to
+/// `prev(c)`), or [`NONE`] on a boundary. Triangles are removed by setting
+/// their corners' vertices to [`NONE`].
+pub struct CornerTable {
+    pub vertex: Vec<u32>,
+    pub opposite: Vec<u32>,
+    /// One live corner per vertex, [`NONE`] for removed or unused vertices.
+    pub corner_of: Vec<u32>,
+}
+
+pub fn next(c: u32) -> u32 {
+    if c % 3 == 2 { c - 2 } else { c + 1 }
+}
+
+pub fn prev(c: u32) -> u32 {
+    if c % 3 == 0 { c + 2 } else { c - 1 }
+}
+
+/// The corners around one vertex, in fan order, and whether the fan is open.
+#[derive(Default)]
+pub struct Fan {
+    pub corners: Vec<u32>,
+    pub boundary: bool,
+}
+
+impl CornerTable {
+    /// Builds the table of a consistently oriented manifold. Edges that do
+    /// not pair up as exactly two opposite half-edges are left unmatched
+    /// (treated as boundary) rather than trusted.
+    pub fn new(vertex_count: usize, triangles: &[[u32; 3]]) -> CornerTable {
+        let vertex: Vec<u32> = triangles.iter().flatten().copied().collect();
+        let mut opposite = vec![NONE; vertex.len()];
+        // Key each corner by the undirected edge it faces; the corner's own
+        // direction (from `next` to `prev`) tells the two sides apart.
+        let mut keys: Vec<(u64, u32)> = (0..vertex.len() as u32)
+            .map(|c| {
+                let (u, v) = (vertex[next(c) as usize], vertex[prev(c) as usize]);
+                ((u64::from(u.min(v)) << 32) | u64::from(u.max(v)), c)
+            })
+            .collect();
+        keys.sort_unstable();
+        for run in keys.chunk_by(|x, y| x.0 == y.0) {
+            if let [(_, c0), (_, c1)] = *run {
+                let from = |c: u32| vertex[next(c) as usize];
+                if from(c0) != from(c1) {
+                    opposite[c0 as usize] = c1;
+                    opposite[c1 as usize] = c0;
+                }
+            }
+        }
+        let mut corner_of = vec![NONE; vertex_count];
+        for (c, &v) in vertex.iter().enumerate() {
+            corner_of[v as usize] = c as u32;
+        }
+        CornerTable {
+            vertex,
+            opposite,
+            corner_of,
+        }
+    }
+
+    pub fn v(&self, c: u32) -> u32 {
+        self.vertex[c as usize]
+    }
+
+    pub fn o(&self, c: u32) -> u32 {
+        self.opposite[c as usize]
+    }
+
+    /// Collects the corners around vertex `v` into `fan`: first turning one
+    /// way from `corner_of[v]`, and if that hits a boundary, the other way
+    /// from the start too, so open fans come out complete.
+    pub fn fan(&self, v: u32, fan: &mut Fan) {
+        fan.corners.clear();
+        fan.boundary = false;
+        let start = self.corner_of[v as usize];
+        if start == NONE {
+            return;
+        }
+        let mut c = start;
+        loop {
+            fan.corners.push(c);
+            // Across the edge (v, vertex[next c]), which faces prev(c).
+            let o = self.o(prev(c));
+            if o == NONE {
+                fan.boundary = true;
+                break;
+            }
+            c = prev(o);
+            if c == start {
+                return;
+            }
+            if fan.corners.len() > self.vertex.len() {
+                // Only reachable on corrupted connectivity; stop rather than spin.
+                return;
+            }
+        }
+        let mut c = start;
+        loop {
+            // Across the edge (vertex[prev c], v), which faces next(c).
+            let o = self.o(next(c));
+            if o == NONE || fan.corners.len() > self.vertex.len() {
+                return;
+            }
+            c = next(o);
+            fan.corners.push(c);
+        }
+    }
+
+    /// Unlinks triangle `t`: its two remaining outer neighbours become each
+    /// other's opposites (the edge between them is being folded shut) and the
+    /// corners are marked dead. `keep` is the corner of `t` whose facing edge
+    /// is the collapsing one; the other two face the folded edges.
+    pub fn remove_triangle(&mut self, keep: u32) {
+        let (c1, c2) = (next(keep), prev(keep));
+        let (o1, o2) = (self.o(c1), self.o(c2));
+        if o1 != NONE {
+            self.opposite[o1 as usize] = o2;
+        }
+        if o2 != NONE {
+            self.opposite[o2 as usize] = o1;
+        }
+        let across = self.o(keep);
+        if across != NONE {
+            self.opposite[across as usize] = NONE;
+        }
+        for c in [keep, c1, c2] {
+            self.vertex[c as usize] = NONE;
+            self.opposite[c as usize] = NONE;
+        }
+    }
+
+    /// A live corner at vertex `x` in the triangle of corner `c` (which must
+    /// contain `x`).
+    pub fn corner_at(&self, c: u32, x: u32) -> u32 {
+        let base = c - c % 3;
+        (base..base + 3).find(|&k| self.v(k) == x).unwrap_or(NONE)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fans_of_a_square() {
+        // 3---2
+        // | / |
+        // 0---1
+        let t = CornerTable::new(4, &[[0, 1, 2], [0, 2, 3]]);
+        let mut fan = Fan::default();
+        t.fan(0, &mut fan);
+        assert!(fan.boundary);
+        assert_eq!(fan.corners.len(), 2);
+        t.fan(1, &mut fan);
+        assert_eq!(fan.corners, vec![1]);
+        assert_eq!(t.o(1), 5, "0-1-2 and 0-2-3 share edge 0-2");
+    }
+
+    #[test]
+    fn fan_of_an_interior_vertex_is_closed() {
+        // Vertex 0 in the middle of a hexagon fan, triangles CCW.
+        let tris: Vec<[u32; 3]> = (0..6).map(|i| [0, 1 + i, 1 + (i + 1) % 6]).collect();
+        let t = CornerTable::new(7, &tris);
+        let mut fan = Fan::default();
+        t.fan(0, &mut fan);
+        assert!(!fan.boundary);
+        assert_eq!(fan.corners.len(), 6);
+        t.fan(3, &mut fan);
+        assert!(fan.boundary);
+        assert_eq!(fan.corners.len(), 2);
+    }
+}

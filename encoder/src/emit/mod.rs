@@ -1,0 +1,147 @@
+//! Emission by replay (issue: "correct by construction"): the refinement is
+//! walked forward with decoder-core's own round procedure, and every flag and
+//! split record is written exactly as that procedure asks for it.
+
+mod levels;
+mod replay;
+
+use splitstream_decoder_core::PositionMode;
+use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, write_stream};
+
+use crate::mesh::Mesh;
+use crate::quantize::{QuantizedMesh, quantize};
+use crate::simplify::{SimplifyOptions, simplify};
+pub use levels::plan_levels;
+pub use replay::{ReplayError, replay};
+
+/// Everything `splitstream encode` can set.
+#[derive(Clone, Debug)]
+pub struct EncodeOptions {
+    /// Quantization bits per axis (1..=31).
+    pub bits: u8,
+    /// Levels of detail including the base mesh (the paper uses 5).
+    pub levels: usize,
+    /// Base mesh size; by default `vertices / 2^(levels - 1)`.
+    pub base_vertices: Option<usize>,
+    pub position_mode: PositionMode,
+    /// Maximum quadric error of any collapse (stops simplification early).
+    pub max_error: Option<f64>,
+    pub codec: ChunkCodec,
+    /// Largest raw chunk (bytes); bounds the decoder's buffers (SPEC §9).
+    pub chunk_limit: u32,
+    pub lock_boundary: bool,
+    pub admit_quantile: f64,
+}
+
+impl Default for EncodeOptions {
+    fn default() -> Self {
+        EncodeOptions {
+            bits: 14,
+            levels: 5,
+            base_vertices: None,
+            position_mode: PositionMode::Optimal,
+            max_error: None,
+            codec: ChunkCodec::Deflate(9),
+            chunk_limit: 16 * 1024,
+            lock_boundary: false,
+            admit_quantile: SimplifyOptions::default().admit_quantile,
+        }
+    }
+}
+
+/// A written stream and what went into it.
+pub struct Encoded {
+    pub stream: Vec<u8>,
+    /// Input vertex id of each decoded vertex (decoded order).
+    pub permutation: Vec<u32>,
+    /// Rounds per level and vertex counts, for reports.
+    pub level_vertex_counts: Vec<u32>,
+    pub rounds: usize,
+    pub simplify_seconds: f64,
+    pub emit_seconds: f64,
+}
+
+/// Why encoding failed.
+#[derive(Debug)]
+pub enum EncodeError {
+    BadOption(String),
+    Replay(ReplayError),
+}
+
+impl std::fmt::Display for EncodeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            EncodeError::BadOption(s) => write!(f, "{s}"),
+            EncodeError::Replay(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for EncodeError {}
+
+/// Encodes a checked mesh (see `input::check_mesh`) into a stream.
+pub fn encode(
+    mesh: &Mesh,
+    options: &EncodeOptions,
+    progress: impl FnMut(usize),
+) -> Result<Encoded, EncodeError> {
+    if !(1..=31).contains(&options.bits) {
+        return Err(EncodeError::BadOption(format!(
+            "--bits {} is outside 1..=31",
+            options.bits
+        )));
+    }
+    if options.levels == 0 {
+        return Err(EncodeError::BadOption("--levels must be at least 1".into()));
+    }
+    let quantized = quantize(mesh, options.bits);
+    encode_quantized(&quantized, options, progress)
+}
+
+/// Encodes an already quantized mesh.
+pub fn encode_quantized(
+    mesh: &QuantizedMesh,
+    options: &EncodeOptions,
+    progress: impl FnMut(usize),
+) -> Result<Encoded, EncodeError> {
+    let n = mesh.positions.len();
+    let shift = (options.levels - 1).min(40) as u32;
+    let target = options
+        .base_vertices
+        .unwrap_or(n >> shift)
+        .clamp(4.min(n), n);
+    let simplify_options = SimplifyOptions {
+        target_vertices: target,
+        max_error: options.max_error,
+        constrained: options.position_mode == PositionMode::Constrained,
+        lock_boundary: options.lock_boundary,
+        admit_quantile: options.admit_quantile,
+        ..SimplifyOptions::default()
+    };
+    let started = std::time::Instant::now();
+    let simplification = simplify(mesh, &simplify_options, progress);
+    let simplify_seconds = started.elapsed().as_secs_f64();
+    let started = std::time::Instant::now();
+    let plan = plan_levels(&simplification, options.levels, mesh.scale[0]);
+    let replayed = replay(mesh, &simplification, &plan, options.position_mode)
+        .map_err(EncodeError::Replay)?;
+    let params = StreamParams {
+        position_mode: options.position_mode,
+        bits: mesh.bits,
+        origin: mesh.origin,
+        scale: mesh.scale,
+        codec: options.codec,
+        chunk_limit: options.chunk_limit,
+    };
+    let level_vertex_counts = replayed.levels.iter().map(|l: &LevelPayload| l.vertex_count).collect();
+    let rounds = replayed.levels.iter().map(|l| l.round_splits.len()).sum();
+    let stream = write_stream(&params, &replayed.levels);
+    Ok(Encoded {
+        stream,
+        permutation: replayed.permutation,
+        level_vertex_counts,
+        rounds,
+        simplify_seconds,
+        emit_seconds: started.elapsed().as_secs_f64(),
+    })
+}

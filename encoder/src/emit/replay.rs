@@ -1,0 +1,339 @@
+//! Replays the refinement with decoder-core's round procedure, writing each
+//! flag and split record as the decoder will read it (SPEC §7).
+
+use splitstream_decoder_core::limits::{LEAF, NONE, substream};
+use splitstream_decoder_core::writer::{LevelPayload, SubstreamWriter};
+use splitstream_decoder_core::{
+    Error, MeshState, PositionMode, RecordSource, Ring, SplitOutcome, SplitRecord, StateMemory,
+};
+
+use super::levels::LevelPlan;
+use crate::corner_table::Fan;
+use crate::quantize::QuantizedMesh;
+use crate::simplify::{Collapse, Simplification};
+
+/// The replay found the simplification and the decoder disagreeing: an
+/// encoder bug, never a property of the input.
+#[derive(Debug)]
+pub struct ReplayError(pub String);
+
+impl std::fmt::Display for ReplayError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "internal encoder error during replay: {}", self.0)
+    }
+}
+
+impl std::error::Error for ReplayError {}
+
+/// Output of the replay: framed-ready levels and the vertex permutation.
+pub struct Replayed {
+    pub levels: Vec<LevelPayload>,
+    /// Input vertex id of each decoded vertex.
+    pub permutation: Vec<u32>,
+    /// State hash after the last round.
+    pub final_hash: u64,
+}
+
+/// Owned memory for a [`MeshState`].
+struct Memory {
+    positions: Vec<[u32; 3]>,
+    corners: Vec<u32>,
+    opposite: Vec<u32>,
+    vertex_corner: Vec<u32>,
+    deficit: Vec<u8>,
+    candidates: Vec<u64>,
+}
+
+impl Memory {
+    fn new(v: usize, t: usize, base_v: usize, base_t: usize) -> Memory {
+        Memory {
+            positions: vec![[0; 3]; v],
+            corners: vec![0; 3 * t],
+            opposite: vec![0; (3 * t).max(6 * base_t + base_v + 1)],
+            vertex_corner: vec![0; v],
+            deficit: vec![0; v],
+            candidates: vec![0; v.div_ceil(64)],
+        }
+    }
+
+    fn state(&mut self, bits: u8) -> MeshState<'_> {
+        MeshState::new(
+            StateMemory {
+                positions: &mut self.positions,
+                corners: &mut self.corners,
+                opposite: &mut self.opposite,
+                vertex_corner: &mut self.vertex_corner,
+                deficit: &mut self.deficit,
+                candidates: &mut self.candidates,
+            },
+            bits,
+        )
+    }
+}
+
+/// Feeds one round from the collapses of one simplification step.
+struct StepSource<'a> {
+    collapses: &'a [Collapse],
+    /// For each input id, the index of its collapse in this step (or NONE).
+    current: &'a mut [u32],
+    enc2dec: &'a mut [u32],
+    dec2enc: &'a mut Vec<u32>,
+    subs: &'a mut [SubstreamWriter],
+    mode: PositionMode,
+    pending: Option<usize>,
+    problem: Option<String>,
+}
+
+fn slot(id: u8) -> usize {
+    (id - substream::FLAGS) as usize
+}
+
+impl StepSource<'_> {
+    fn fail(&mut self, what: String) -> Error {
+        self.problem.get_or_insert(what);
+        Error::RingOffsetOutOfRange
+    }
+}
+
+impl RecordSource for StepSource<'_> {
+    fn flag(&mut self, v: u32) -> Result<bool, Error> {
+        let id = self.dec2enc[v as usize];
+        let flagged = self.current[id as usize] != NONE;
+        self.subs[slot(substream::FLAGS)].bit(flagged);
+        Ok(flagged)
+    }
+
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
+        let id = self.dec2enc[r as usize];
+        let index = self.current[id as usize] as usize;
+        let col = self.collapses[index];
+        self.pending = Some(index);
+        let dec = |enc: u32, map: &[u32]| if enc == NONE { NONE } else { map[enc as usize] };
+        let (a, b) = (dec(col.wing_a, self.enc2dec), dec(col.wing_b, self.enc2dec));
+        let find = |x: u32| ring.vertices().iter().position(|&y| y == x);
+        let (Some(ia), Some(ib)) = (find(a), find(b)) else {
+            return Err(self.fail(format!("wings of the collapse of {id} not in the ring")));
+        };
+        // P's arc runs counter-clockwise from wing A to wing B.
+        let (o, d, config) = if ia < ib { (ia, ib - ia, false) } else { (ib, ia - ib, true) };
+        let k = ring.len();
+        let len_p = if config { k - d } else { d };
+        let deficit = |split_valence: u8, valence: usize| -> Option<u8> {
+            if split_valence == LEAF {
+                Some(LEAF)
+            } else {
+                (split_valence as usize).checked_sub(valence).map(|x| x as u8)
+            }
+        };
+        let (Some(dp), Some(dc)) = (
+            deficit(col.split_valence_p, len_p + 2),
+            deficit(col.split_valence_c, k - len_p + 2),
+        ) else {
+            return Err(self.fail(format!("valence of {id} grew past its split valence")));
+        };
+        let parent = state.positions()[r as usize];
+        if parent != col.position_r {
+            return Err(self.fail(format!("position of {id} differs from its collapse")));
+        }
+        let (p, c) = (col.position_p, col.position_c);
+        let e: [i64; 3] = std::array::from_fn(|i| c[i] as i64 - p[i] as i64);
+        let s = &mut *self.subs;
+        s[slot(substream::WING_OFFSET)].byte(o as u8);
+        s[slot(substream::WING_DISTANCE)].byte(d as u8);
+        s[slot(substream::CONFIG)].bit(config);
+        s[slot(substream::DEFICIT_P)].byte(dp);
+        s[slot(substream::DEFICIT_C)].byte(dc);
+        for &ek in &e {
+            s[slot(substream::EDGE)].signed(ek as i32);
+        }
+        match self.mode {
+            PositionMode::Optimal => {
+                for i in 0..3 {
+                    let m = parent[i] as i64 - p[i] as i64 - (e[i] >> 1);
+                    s[slot(substream::PLACEMENT)].signed(m as i32);
+                }
+            }
+            PositionMode::Constrained => {
+                let mid: [u32; 3] = std::array::from_fn(|i| (p[i] as i64 + (e[i] >> 1)) as u32);
+                let code = if parent == p {
+                    0
+                } else if parent == c {
+                    1
+                } else if parent == mid {
+                    2
+                } else {
+                    return Err(self.fail(format!("constrained position of {id} off P, C and midpoint")));
+                };
+                s[slot(substream::PLACEMENT)].byte(code);
+            }
+        }
+        Ok(SplitRecord {
+            wing_offset: o as u8,
+            wing_distance: d as u8,
+            config,
+            deficit_p: dp,
+            deficit_c: dc,
+            position_p: p,
+            position_c: c,
+        })
+    }
+
+    fn applied(&mut self, _r: u32, c: u32, _outcome: &SplitOutcome) {
+        if let Some(index) = self.pending.take() {
+            let gone = self.collapses[index].c;
+            self.enc2dec[gone as usize] = c;
+            self.dec2enc.push(gone);
+        }
+    }
+}
+
+/// Replays `s` level by level as planned, returning the level payloads.
+pub fn replay(
+    mesh: &QuantizedMesh,
+    s: &Simplification,
+    plan: &LevelPlan,
+    mode: PositionMode,
+) -> Result<Replayed, ReplayError> {
+    let n = mesh.positions.len();
+    let t_total = mesh.triangles.len();
+    // Base mesh: survivors in ascending id.
+    let mut dec2enc: Vec<u32> = (0..n as u32).filter(|&v| s.alive[v as usize]).collect();
+    let mut enc2dec = vec![NONE; n];
+    for (d, &e) in dec2enc.iter().enumerate() {
+        enc2dec[e as usize] = d as u32;
+    }
+    let base_triangles: Vec<[u32; 3]> = s
+        .table
+        .vertex
+        .chunks_exact(3)
+        .filter(|t| t[0] != NONE)
+        .map(|t| [enc2dec[t[0] as usize], enc2dec[t[1] as usize], enc2dec[t[2] as usize]])
+        .collect();
+    let mut fan = Fan::default();
+    let base_deficits: Vec<u8> = dec2enc
+        .iter()
+        .map(|&e| {
+            let sv = s.split_valence[e as usize];
+            if sv == LEAF {
+                return LEAF;
+            }
+            s.table.fan(e, &mut fan);
+            let valence = fan.corners.len() + if fan.boundary { 2 } else { 0 };
+            (sv as usize).saturating_sub(valence) as u8
+        })
+        .collect();
+    let (v0, t0) = (dec2enc.len(), base_triangles.len());
+    let mut memory = Memory::new(n, t_total, v0, t0);
+    let mut state = memory.state(mesh.bits);
+    let mut base_subs = vec![SubstreamWriter::default(); 3];
+    {
+        let (positions, corners, deficits) = state.base_arrays();
+        let mut previous = [0i64; 3];
+        for (d, &e) in dec2enc.iter().enumerate() {
+            let p = s.positions[e as usize];
+            positions[d] = p;
+            for k in 0..3 {
+                base_subs[0].signed((p[k] as i64 - previous[k]) as i32);
+                previous[k] = p[k] as i64;
+            }
+        }
+        for (i, t) in base_triangles.iter().enumerate() {
+            corners[3 * i..3 * i + 3].copy_from_slice(t);
+            for &v in t {
+                base_subs[1].varint(v);
+            }
+        }
+        for (d, &x) in base_deficits.iter().enumerate() {
+            deficits[d] = x;
+            base_subs[2].byte(x);
+        }
+    }
+    state
+        .finish_base(v0 as u32, t0 as u32)
+        .map_err(|e| ReplayError(format!("base mesh rejected by the decoder: {e}")))?;
+    let mut levels = vec![LevelPayload {
+        round_splits: vec![],
+        substreams: base_subs,
+        vertex_count: v0 as u32,
+        triangle_count: t0 as u32,
+        geometric_error: plan.errors[0],
+    }];
+    let mut current = vec![NONE; n];
+    let mut ring = Ring::default();
+    for (l, steps) in plan.rounds.iter().enumerate() {
+        let mut subs = vec![SubstreamWriter::default(); 8];
+        let mut round_splits = Vec::with_capacity(steps.len());
+        for &k in steps {
+            let collapses = &s.steps[k];
+            for (i, col) in collapses.iter().enumerate() {
+                current[col.p as usize] = i as u32;
+            }
+            let mut source = StepSource {
+                collapses,
+                current: &mut current,
+                enc2dec: &mut enc2dec,
+                dec2enc: &mut dec2enc,
+                subs: &mut subs,
+                mode,
+                pending: None,
+                problem: None,
+            };
+            let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
+            if let Err(e) = result {
+                let why = source.problem.take().unwrap_or_else(|| e.to_string());
+                return Err(ReplayError(format!("step {k}: {why}")));
+            }
+            for col in collapses {
+                current[col.p as usize] = NONE;
+            }
+            round_splits.push(collapses.len() as u32);
+        }
+        levels.push(LevelPayload {
+            round_splits,
+            substreams: subs,
+            vertex_count: state.vertex_count(),
+            triangle_count: state.triangle_count(),
+            geometric_error: plan.errors[l + 1],
+        });
+    }
+    check_exact(mesh, &state, &dec2enc)?;
+    let final_hash = state.state_hash();
+    Ok(Replayed {
+        levels,
+        permutation: dec2enc,
+        final_hash,
+    })
+}
+
+/// decode(encode(M)) == M: the refined state, mapped back to input ids, has
+/// exactly the input's oriented triangles and quantized positions.
+fn check_exact(mesh: &QuantizedMesh, state: &MeshState<'_>, dec2enc: &[u32]) -> Result<(), ReplayError> {
+    if state.vertex_count() as usize != mesh.positions.len() {
+        return Err(ReplayError(format!(
+            "replay ended with {} vertices, the input has {}",
+            state.vertex_count(),
+            mesh.positions.len()
+        )));
+    }
+    for (d, &e) in dec2enc.iter().enumerate() {
+        if state.positions()[d] != mesh.positions[e as usize] {
+            return Err(ReplayError(format!("vertex {e} decodes to another position")));
+        }
+    }
+    let canonical = |t: [u32; 3]| {
+        let r = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+        [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
+    };
+    let mut decoded: Vec<[u32; 3]> = state
+        .triangles()
+        .iter()
+        .map(|t| canonical(t.map(|v| dec2enc[v as usize])))
+        .collect();
+    let mut input: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
+    decoded.sort_unstable();
+    input.sort_unstable();
+    if decoded != input {
+        return Err(ReplayError("decoded triangles differ from the input".into()));
+    }
+    Ok(())
+}

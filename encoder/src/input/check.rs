@@ -1,0 +1,546 @@
+//! Validation of a mesh before encoding: the simplifier and the vertex-split
+//! stream assume a clean, consistently oriented 2-manifold (with boundary),
+//! so anything else is rejected up front with the first offending element.
+//!
+//! Rules run in a fixed order and each reports its lowest-indexed offender,
+//! so the same file always gives the same message. Everything is O(n log d)
+//! (d = vertex degree) via bucketed half-edge tables, fast on 4M triangles.
+
+use std::fmt;
+
+use rayon::prelude::*;
+
+use crate::Mesh;
+
+use super::csr::Buckets;
+
+/// Summary of a mesh that passed [`check_mesh`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MeshStats {
+    pub vertices: usize,
+    pub triangles: usize,
+    /// Undirected edges.
+    pub edges: usize,
+    /// Edges used by exactly one triangle.
+    pub boundary_edges: usize,
+    /// Closed loops formed by the boundary edges (holes and outer rims).
+    pub boundary_loops: usize,
+    /// Edge-connected components.
+    pub components: usize,
+    /// V - E + F.
+    pub euler_characteristic: i64,
+    /// Total genus over all components: (2C - B - chi) / 2.
+    pub genus: i64,
+}
+
+impl fmt::Display for MeshStats {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} vertices, {} triangles, {} edges ({} boundary in {} loops), {} component(s), Euler characteristic {}, genus {}",
+            self.vertices,
+            self.triangles,
+            self.edges,
+            self.boundary_edges,
+            self.boundary_loops,
+            self.components,
+            self.euler_characteristic,
+            self.genus
+        )
+    }
+}
+
+/// The first rule a mesh breaks, with the element that breaks it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum MeshError {
+    /// No vertices or no triangles.
+    Empty { vertices: usize, triangles: usize },
+    /// More triangles than the 2^31 the edge tables can index.
+    TooLarge { triangles: usize },
+    NonFiniteCoordinate { vertex: usize, position: [f64; 3] },
+    IndexOutOfRange { triangle: usize, vertices: [u32; 3], vertex_count: usize },
+    /// A triangle uses the same vertex twice.
+    DegenerateTriangle { triangle: usize, vertices: [u32; 3] },
+    /// A triangle has the same vertex set as an earlier one (any order).
+    DuplicateTriangle { triangle: usize, vertices: [u32; 3], earlier: usize, earlier_vertices: [u32; 3] },
+    /// An undirected edge used by more than two triangles (all listed, ascending).
+    NonManifoldEdge { edge: [u32; 2], positions: [[f64; 3]; 2], triangles: Vec<usize> },
+    /// Two triangles traverse the same directed edge.
+    InconsistentOrientation { edge: [u32; 2], triangles: [usize; 2] },
+    /// The triangles around a vertex form more than one fan.
+    NonManifoldVertex { vertex: usize, position: [f64; 3], fans: usize },
+    /// A vertex no triangle uses.
+    UnreferencedVertex { vertex: usize, position: [f64; 3] },
+}
+
+struct P([f64; 3]);
+
+impl fmt::Display for P {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "({}, {}, {})", self.0[0], self.0[1], self.0[2])
+    }
+}
+
+impl fmt::Display for MeshError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            MeshError::Empty { vertices, triangles } => {
+                write!(f, "mesh is empty ({vertices} vertices, {triangles} triangles)")
+            }
+            MeshError::TooLarge { triangles } => {
+                write!(f, "{triangles} triangles exceed the checker's limit of 2^31")
+            }
+            MeshError::NonFiniteCoordinate { vertex, position } => {
+                write!(f, "vertex {vertex} has a non-finite coordinate {}", P(*position))
+            }
+            MeshError::IndexOutOfRange { triangle, vertices, vertex_count } => {
+                let bad = vertices.iter().find(|&&v| v as usize >= *vertex_count).copied().unwrap_or(vertices[0]);
+                write!(
+                    f,
+                    "triangle {triangle} {vertices:?} refers to vertex {bad}, but there are only {vertex_count} vertices"
+                )
+            }
+            MeshError::DegenerateTriangle { triangle, vertices } => {
+                write!(f, "triangle {triangle} {vertices:?} is degenerate (repeats a vertex)")
+            }
+            MeshError::DuplicateTriangle { triangle, vertices, earlier, earlier_vertices } => write!(
+                f,
+                "triangle {triangle} {vertices:?} duplicates triangle {earlier} {earlier_vertices:?} (same vertices)"
+            ),
+            MeshError::NonManifoldEdge { edge, positions, triangles } => write!(
+                f,
+                "edge {}-{} {}-{} is non-manifold: shared by {} triangles {:?} (at most 2 allowed)",
+                edge[0],
+                edge[1],
+                P(positions[0]),
+                P(positions[1]),
+                triangles.len(),
+                triangles
+            ),
+            MeshError::InconsistentOrientation { edge, triangles } => write!(
+                f,
+                "triangles {} and {} both traverse edge {}->{} in the same direction (inconsistent orientation)",
+                triangles[0], triangles[1], edge[0], edge[1]
+            ),
+            MeshError::NonManifoldVertex { vertex, position, fans } => write!(
+                f,
+                "vertex {vertex} {} is non-manifold: its triangles form {fans} separate fans",
+                P(*position)
+            ),
+            MeshError::UnreferencedVertex { vertex, position } => {
+                write!(f, "vertex {vertex} {} is not used by any triangle", P(*position))
+            }
+        }
+    }
+}
+
+impl std::error::Error for MeshError {}
+
+/// Half-edge record in the edge table: `far << 32 | triangle << 1 | reversed`,
+/// bucketed by the smaller endpoint, so sorting a bucket groups the
+/// triangles of each undirected edge in ascending triangle order.
+pub(crate) fn edge_table(triangles: &[[u32; 3]], vertex_count: usize) -> Buckets<u64> {
+    let mut table = Buckets::build(vertex_count, || {
+        triangles.iter().enumerate().flat_map(|(t, tri)| {
+            (0..3).map(move |k| {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let (lo, hi, rev) = if a < b { (a, b, 0) } else { (b, a, 1) };
+                (lo as usize, (hi as u64) << 32 | (t as u64) << 1 | rev)
+            })
+        })
+    });
+    table.sort_each(|s| s.sort_unstable());
+    table
+}
+
+/// Link edges `src << 32 | dst` of each vertex: triangle (v, a, b) gives v the
+/// edge a -> b. For an oriented edge-manifold mesh each vertex's link is a
+/// union of paths and cycles; one component means one fan.
+pub(crate) fn link_table(triangles: &[[u32; 3]], vertex_count: usize) -> Buckets<u64> {
+    let mut table = Buckets::build(vertex_count, || {
+        triangles.iter().flat_map(|tri| {
+            (0..3).map(move |k| {
+                let (v, a, b) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+                (v as usize, (a as u64) << 32 | b as u64)
+            })
+        })
+    });
+    table.sort_each(|s| s.sort_unstable());
+    table
+}
+
+/// Iterates the groups of equal `far` vertex in one sorted edge-table bucket:
+/// yields `(far, records)`.
+pub(crate) fn edge_groups(bucket: &[u64]) -> impl Iterator<Item = (u32, &[u64])> {
+    bucket
+        .chunk_by(|a, b| a >> 32 == b >> 32)
+        .map(|g| ((g[0] >> 32) as u32, g))
+}
+
+#[inline]
+pub(crate) fn record_triangle(rec: u64) -> usize {
+    ((rec & 0xffff_ffff) >> 1) as usize
+}
+
+#[inline]
+pub(crate) fn record_reversed(rec: u64) -> bool {
+    rec & 1 == 1
+}
+
+/// Counts the fans (connected components of the link) of one vertex whose
+/// sorted link edges are `link`; `scratch` avoids per-vertex allocation.
+/// Only meaningful once edges are manifold and consistently oriented.
+pub(crate) fn count_fans(link: &[u64], scratch: &mut (Vec<u32>, Vec<bool>)) -> usize {
+    let (dsts, visited) = scratch;
+    dsts.clear();
+    dsts.extend(link.iter().map(|&e| e as u32));
+    dsts.sort_unstable();
+    visited.clear();
+    visited.resize(link.len(), false);
+    let find = |src: u32| link.binary_search_by_key(&src, |&e| (e >> 32) as u32).ok();
+    let mut fans = 0;
+    let walk = |start: usize, visited: &mut Vec<bool>| {
+        let mut i = start;
+        while !visited[i] {
+            visited[i] = true;
+            match find(link[i] as u32) {
+                Some(next) => i = next,
+                None => break,
+            }
+        }
+    };
+    // Open fans first: they start at a link vertex nothing points to.
+    for i in 0..link.len() {
+        let src = (link[i] >> 32) as u32;
+        if !visited[i] && dsts.binary_search(&src).is_err() {
+            fans += 1;
+            walk(i, visited);
+        }
+    }
+    // What is left are closed fans (cycles).
+    for i in 0..link.len() {
+        if !visited[i] {
+            fans += 1;
+            walk(i, visited);
+        }
+    }
+    fans
+}
+
+/// Checks every rule in order and returns statistics for a clean mesh, or the
+/// first violation.
+pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
+    let (pos, tris) = (&mesh.positions, &mesh.triangles);
+    let nv = pos.len();
+    if nv == 0 || tris.is_empty() {
+        return Err(MeshError::Empty { vertices: nv, triangles: tris.len() });
+    }
+    if tris.len() >= 1 << 31 {
+        return Err(MeshError::TooLarge { triangles: tris.len() });
+    }
+    if let Some(v) = pos.par_iter().position_first(|p| !p.iter().all(|c| c.is_finite())) {
+        return Err(MeshError::NonFiniteCoordinate { vertex: v, position: pos[v] });
+    }
+    if let Some(t) = tris.par_iter().position_first(|t| t.iter().any(|&v| v as usize >= nv)) {
+        return Err(MeshError::IndexOutOfRange { triangle: t, vertices: tris[t], vertex_count: nv });
+    }
+    if let Some(t) = tris.par_iter().position_first(|&[a, b, c]| a == b || b == c || a == c) {
+        return Err(MeshError::DegenerateTriangle { triangle: t, vertices: tris[t] });
+    }
+    if let Some((t, earlier)) = first_duplicate(tris, nv) {
+        return Err(MeshError::DuplicateTriangle {
+            triangle: t,
+            vertices: tris[t],
+            earlier,
+            earlier_vertices: tris[earlier],
+        });
+    }
+
+    let edges = edge_table(tris, nv);
+    let mut edge_count = 0usize;
+    let mut boundary_edges = 0usize;
+    let mut worst_nonmanifold: Option<(usize, [u32; 2], Vec<usize>)> = None;
+    let mut worst_orientation: Option<(usize, [u32; 2], usize)> = None;
+    // Boundary successor of each vertex: a -> b as the triangle runs it.
+    let mut boundary_next = vec![u32::MAX; nv];
+    for lo in 0..nv {
+        for (hi, group) in edge_groups(edges.get(lo)) {
+            edge_count += 1;
+            match group.len() {
+                1 => {
+                    boundary_edges += 1;
+                    let (a, b) = if record_reversed(group[0]) { (hi, lo as u32) } else { (lo as u32, hi) };
+                    boundary_next[a as usize] = b;
+                }
+                2 => {
+                    if record_reversed(group[0]) == record_reversed(group[1]) {
+                        let second = record_triangle(group[1]);
+                        if worst_orientation.as_ref().is_none_or(|w| second < w.0) {
+                            let first = record_triangle(group[0]);
+                            let [a, b] = [lo as u32, hi];
+                            let edge = if record_reversed(group[0]) { [b, a] } else { [a, b] };
+                            worst_orientation = Some((second, edge, first));
+                        }
+                    }
+                }
+                _ => {
+                    let third = record_triangle(group[2]);
+                    if worst_nonmanifold.as_ref().is_none_or(|w| third < w.0) {
+                        let list = group.iter().map(|&r| record_triangle(r)).collect();
+                        worst_nonmanifold = Some((third, [lo as u32, hi], list));
+                    }
+                }
+            }
+        }
+    }
+    drop(edges);
+    if let Some((_, edge, triangles)) = worst_nonmanifold {
+        let positions = edge.map(|v| pos[v as usize]);
+        return Err(MeshError::NonManifoldEdge { edge, positions, triangles });
+    }
+    if let Some((second, edge, first)) = worst_orientation {
+        return Err(MeshError::InconsistentOrientation { edge, triangles: [first, second] });
+    }
+
+    let links = link_table(tris, nv);
+    let bad_vertex = (0..nv)
+        .into_par_iter()
+        .map_init(
+            || (Vec::new(), Vec::new()),
+            |scratch, v| {
+                let link = links.get(v);
+                if link.is_empty() {
+                    return None;
+                }
+                let fans = count_fans(link, scratch);
+                (fans > 1).then_some((v, fans))
+            },
+        )
+        .find_first(|r| r.is_some())
+        .flatten();
+    if let Some((v, fans)) = bad_vertex {
+        return Err(MeshError::NonManifoldVertex { vertex: v, position: pos[v], fans });
+    }
+    if let Some(v) = (0..nv).into_par_iter().position_first(|v| links.get(v).is_empty()) {
+        return Err(MeshError::UnreferencedVertex { vertex: v, position: pos[v] });
+    }
+    drop(links);
+
+    let boundary_loops = count_loops(&boundary_next);
+    let components = count_components(tris, nv);
+    let euler = nv as i64 - edge_count as i64 + tris.len() as i64;
+    Ok(MeshStats {
+        vertices: nv,
+        triangles: tris.len(),
+        edges: edge_count,
+        boundary_edges,
+        boundary_loops,
+        components,
+        euler_characteristic: euler,
+        genus: (2 * components as i64 - boundary_loops as i64 - euler) / 2,
+    })
+}
+
+/// Returns `(t, earlier)` for the lowest-indexed triangle `t` whose vertex set
+/// equals that of an earlier triangle.
+fn first_duplicate(tris: &[[u32; 3]], nv: usize) -> Option<(usize, usize)> {
+    let table = sorted_vertex_sets(tris, nv);
+    let mut best: Option<(usize, usize)> = None;
+    for v in 0..nv {
+        for g in table.get(v).chunk_by(|a, b| a.0 == b.0) {
+            if g.len() > 1 && best.is_none_or(|b| (g[1].1 as usize) < b.0) {
+                best = Some((g[1].1 as usize, g[0].1 as usize));
+            }
+        }
+    }
+    best
+}
+
+/// Triangles bucketed by their smallest vertex, keyed by the other two
+/// (`mid << 32 | max`) and their index; sorting groups equal vertex sets.
+pub(crate) fn sorted_vertex_sets(tris: &[[u32; 3]], nv: usize) -> Buckets<(u64, u32)> {
+    let mut table = Buckets::build(nv, || {
+        tris.iter().enumerate().map(|(t, tri)| {
+            let mut s = *tri;
+            s.sort_unstable();
+            (s[0] as usize, ((s[1] as u64) << 32 | s[2] as u64, t as u32))
+        })
+    });
+    table.sort_each(|s| s.sort_unstable());
+    table
+}
+
+/// Boundary edges chain into loops; with manifold vertices each vertex
+/// starts at most one boundary edge, so `next` is a partial permutation.
+fn count_loops(next: &[u32]) -> usize {
+    let mut loops = 0;
+    let mut seen = vec![false; next.len()];
+    for start in 0..next.len() {
+        if next[start] == u32::MAX || seen[start] {
+            continue;
+        }
+        loops += 1;
+        let mut v = start;
+        while !seen[v] && next[v] != u32::MAX {
+            seen[v] = true;
+            v = next[v] as usize;
+        }
+    }
+    loops
+}
+
+/// Connected components over shared vertices (union-find with path halving).
+pub(crate) fn count_components(tris: &[[u32; 3]], nv: usize) -> usize {
+    let mut parent: Vec<u32> = (0..nv as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            let up = parent[parent[x as usize] as usize];
+            parent[x as usize] = up;
+            x = up;
+        }
+        x
+    }
+    for t in tris {
+        let a = find(&mut parent, t[0]);
+        for &v in &t[1..] {
+            let b = find(&mut parent, v);
+            if a != b {
+                parent[b as usize] = a;
+            }
+        }
+    }
+    let mut used = vec![false; nv];
+    for t in tris {
+        for &v in t {
+            used[v as usize] = true;
+        }
+    }
+    (0..nv as u32).filter(|&v| used[v as usize] && find(&mut parent, v) == v).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mesh(positions: usize, triangles: &[[u32; 3]]) -> Mesh {
+        Mesh {
+            positions: (0..positions).map(|i| [i as f64, (i * i) as f64, 0.5]).collect(),
+            triangles: triangles.to_vec(),
+        }
+    }
+
+    const TETRA: [[u32; 3]; 4] = [[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+
+    /// A torus from an n x m grid with wrap-around (genus 1, closed).
+    fn torus(n: u32, m: u32) -> Mesh {
+        let mut tris = Vec::new();
+        for i in 0..n {
+            for j in 0..m {
+                let v = |a: u32, b: u32| (a % n) * m + (b % m);
+                tris.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+                tris.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+            }
+        }
+        mesh((n * m) as usize, &tris)
+    }
+
+    #[test]
+    fn stats_of_clean_meshes() {
+        let s = check_mesh(&mesh(4, &TETRA)).unwrap();
+        assert_eq!(
+            s,
+            MeshStats {
+                vertices: 4,
+                triangles: 4,
+                edges: 6,
+                boundary_edges: 0,
+                boundary_loops: 0,
+                components: 1,
+                euler_characteristic: 2,
+                genus: 0
+            }
+        );
+        let s = check_mesh(&torus(5, 4)).unwrap();
+        assert_eq!((s.euler_characteristic, s.genus, s.boundary_loops), (0, 1, 0));
+        // Square with a quad hole: an annulus, one component, two loops.
+        let mut tris = Vec::new();
+        let v = |r: u32, c: u32| r * 4 + c;
+        for r in 0..3 {
+            for c in 0..3 {
+                if (r, c) != (1, 1) {
+                    tris.push([v(r, c), v(r, c + 1), v(r + 1, c + 1)]);
+                    tris.push([v(r, c), v(r + 1, c + 1), v(r + 1, c)]);
+                }
+            }
+        }
+        let s = check_mesh(&mesh(16, &tris)).unwrap();
+        assert_eq!((s.boundary_loops, s.boundary_edges, s.components, s.genus), (2, 16, 1, 0));
+        // Two disjoint triangles.
+        let s = check_mesh(&mesh(6, &[[0, 1, 2], [3, 4, 5]])).unwrap();
+        assert_eq!((s.components, s.boundary_loops), (2, 2));
+        assert!(s.to_string().contains("2 component(s)"));
+    }
+
+    #[test]
+    fn each_rule_names_the_first_offender() {
+        let err = |m: &Mesh| check_mesh(m).unwrap_err();
+        assert_eq!(err(&mesh(0, &[])), MeshError::Empty { vertices: 0, triangles: 0 });
+        assert_eq!(err(&mesh(3, &[])).to_string(), "mesh is empty (3 vertices, 0 triangles)");
+
+        let mut m = mesh(4, &TETRA);
+        m.positions[2][1] = f64::NAN;
+        m.positions[3][0] = f64::INFINITY;
+        assert_eq!(err(&m).to_string(), "vertex 2 has a non-finite coordinate (2, NaN, 0.5)");
+
+        let e = err(&mesh(4, &[[0, 2, 1], [0, 1, 9], [0, 1, 7]]));
+        assert_eq!(e.to_string(), "triangle 1 [0, 1, 9] refers to vertex 9, but there are only 4 vertices");
+
+        let e = err(&mesh(4, &[[0, 2, 1], [0, 1, 1], [2, 2, 2]]));
+        assert_eq!(e.to_string(), "triangle 1 [0, 1, 1] is degenerate (repeats a vertex)");
+
+        let e = err(&mesh(4, &[[0, 2, 1], [0, 1, 3], [3, 0, 1], [1, 0, 2]]));
+        assert_eq!(e.to_string(), "triangle 2 [3, 0, 1] duplicates triangle 1 [0, 1, 3] (same vertices)");
+
+        let e = err(&mesh(5, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]));
+        assert_eq!(
+            e.to_string(),
+            "edge 0-1 (0, 0, 0.5)-(1, 1, 0.5) is non-manifold: shared by 3 triangles [0, 1, 2] (at most 2 allowed)"
+        );
+
+        let e = err(&mesh(4, &[[0, 1, 2], [0, 1, 3]]));
+        assert_eq!(
+            e,
+            MeshError::InconsistentOrientation { edge: [0, 1], triangles: [0, 1] }
+        );
+        assert!(e.to_string().contains("edge 0->1"));
+
+        // Bowtie: two triangles share only vertex 0.
+        let e = err(&mesh(5, &[[0, 1, 2], [0, 3, 4]]));
+        assert_eq!(e, MeshError::NonManifoldVertex { vertex: 0, position: [0.0, 0.0, 0.5], fans: 2 });
+        // Two closed fans at one vertex: two tetrahedra glued at a vertex.
+        let mut tris = TETRA.to_vec();
+        tris.extend(TETRA.iter().map(|t| t.map(|v| if v == 0 { 0 } else { v + 3 })));
+        assert!(matches!(err(&mesh(7, &tris)), MeshError::NonManifoldVertex { vertex: 0, fans: 2, .. }));
+
+        let e = err(&mesh(5, &[[0, 1, 2]]));
+        assert_eq!(e.to_string(), "vertex 3 (3, 9, 0.5) is not used by any triangle");
+    }
+
+    #[test]
+    fn fans_of_open_and_closed_links() {
+        let mut scratch = (Vec::new(), Vec::new());
+        let e = |a: u64, b: u64| a << 32 | b;
+        let mut open = vec![e(1, 2), e(2, 3), e(3, 4)];
+        open.sort_unstable();
+        assert_eq!(count_fans(&open, &mut scratch), 1);
+        let mut closed = vec![e(1, 2), e(2, 3), e(3, 1)];
+        closed.sort_unstable();
+        assert_eq!(count_fans(&closed, &mut scratch), 1);
+        let mut mixed = vec![e(1, 2), e(2, 3), e(3, 1), e(5, 6)];
+        mixed.sort_unstable();
+        assert_eq!(count_fans(&mixed, &mut scratch), 2);
+        let mut two_cycles = vec![e(1, 2), e(2, 1), e(5, 6), e(6, 7), e(7, 5)];
+        two_cycles.sort_unstable();
+        assert_eq!(count_fans(&two_cycles, &mut scratch), 2);
+    }
+}

@@ -1,0 +1,225 @@
+//! The encoder's input layer: reading meshes and elevation grids from files,
+//! checking that a mesh is something the encoder can stream, optionally
+//! repairing it, and generating synthetic terrain for benchmarks.
+//!
+//! One file per job: a reader per format (`ply`, `obj`, `off`, `esri`,
+//! `npy`, `geotiff`), `grid` for raster triangulation, `check` and `repair`
+//! for mesh validity, `terrain` for the synthetic DEM.
+
+mod check;
+mod csr;
+mod error;
+mod esri;
+mod geotiff;
+mod grid;
+mod npy;
+mod obj;
+mod off;
+mod ply;
+mod repair;
+mod terrain;
+
+use std::path::Path;
+
+use crate::Mesh;
+
+pub use check::{MeshError, MeshStats, check_mesh};
+pub use error::{InputError, SUPPORTED_EXTENSIONS};
+pub use grid::{Grid, grid_to_mesh};
+pub use repair::{RepairReport, repair_mesh};
+pub use terrain::fractal_terrain;
+
+/// How to interpret an input file.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReadOptions {
+    /// `.npz` only: the array holding the elevations; by default the first
+    /// two-dimensional array in the archive.
+    pub npz_array: Option<String>,
+    /// Grid formats only: sample spacing `(dx, dy)` replacing whatever the
+    /// file says (or the unit spacing used when it says nothing).
+    pub grid_spacing: Option<(f64, f64)>,
+    /// Every format: factor applied to z, e.g. to exaggerate relief or to
+    /// bring elevations in metres to the units of geographic x/y.
+    pub z_scale: f64,
+}
+
+impl Default for ReadOptions {
+    /// Hand-written because `z_scale` must default to 1, not 0.
+    fn default() -> Self {
+        ReadOptions {
+            npz_array: None,
+            grid_spacing: None,
+            z_scale: 1.0,
+        }
+    }
+}
+
+/// Reads a mesh or an elevation grid, choosing the format by extension
+/// (case-insensitive): `.ply`, `.obj`, `.off`, `.tif`/`.tiff` (GeoTIFF),
+/// `.asc` (ESRI ASCII grid), `.npy`, `.npz`. Grids become meshes through
+/// [`grid_to_mesh`]. The mesh is not checked: call [`check_mesh`].
+pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<Mesh, InputError> {
+    let file = path.display().to_string();
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let mut mesh = match extension.as_str() {
+        "ply" => ply::read(path, &file)?,
+        "obj" => obj::read(path, &file)?,
+        "off" => off::read(path, &file)?,
+        "tif" | "tiff" => grid_to_mesh(&apply_spacing(geotiff::read(path, &file)?, options)),
+        "asc" => grid_to_mesh(&apply_spacing(esri::read(path, &file)?, options)),
+        "npy" => grid_to_mesh(&apply_spacing(npy::read_npy(path, &file)?, options)),
+        "npz" => grid_to_mesh(&apply_spacing(
+            npy::read_npz(path, &file, options.npz_array.as_deref())?,
+            options,
+        )),
+        _ => return Err(InputError::UnknownExtension { file, extension }),
+    };
+    if options.z_scale != 1.0 {
+        for p in &mut mesh.positions {
+            p[2] *= options.z_scale;
+        }
+    }
+    Ok(mesh)
+}
+
+fn apply_spacing(mut grid: Grid, options: &ReadOptions) -> Grid {
+    if let Some((dx, dy)) = options.grid_spacing {
+        grid.spacing = [dx, dy];
+    }
+    grid
+}
+
+/// Appends the fan triangulation (v0, vi, vi+1) of one polygon, which keeps
+/// its winding; shared by the PLY and OFF readers. `indices` are as read
+/// (possibly negative); returns a message naming the bad index.
+pub(crate) fn push_polygon<I>(
+    triangles: &mut Vec<[u32; 3]>,
+    indices: I,
+    vertex_count: usize,
+    scratch: &mut Vec<u32>,
+) -> Result<(), String>
+where
+    I: IntoIterator<Item = i64>,
+{
+    scratch.clear();
+    for i in indices {
+        if i < 0 || i as u64 >= vertex_count as u64 {
+            return Err(format!("vertex index {i} out of range (the file has {vertex_count} vertices)"));
+        }
+        scratch.push(i as u32);
+    }
+    if scratch.len() < 3 {
+        return Err(format!("polygon with {} vertices (at least 3 needed)", scratch.len()));
+    }
+    for k in 1..scratch.len() - 1 {
+        triangles.push([scratch[0], scratch[k], scratch[k + 1]]);
+    }
+    Ok(())
+}
+
+/// Fails with [`InputError::TooLarge`] when `count` vertices cannot be
+/// addressed by `u32` triangle indices.
+pub(crate) fn check_vertex_count(file: &str, count: u64) -> Result<(), InputError> {
+    if count > u32::MAX as u64 + 1 {
+        Err(InputError::TooLarge {
+            file: file.to_owned(),
+            vertices: count,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod test_util {
+    use std::path::PathBuf;
+    use std::sync::atomic::{AtomicUsize, Ordering};
+
+    /// A file in the temp dir that is deleted on drop; the name is unique per
+    /// process and call so tests can run in parallel.
+    pub struct TempFile(pub PathBuf);
+
+    impl TempFile {
+        pub fn new(name: &str, contents: &[u8]) -> TempFile {
+            static COUNTER: AtomicUsize = AtomicUsize::new(0);
+            let n = COUNTER.fetch_add(1, Ordering::Relaxed);
+            let path = std::env::temp_dir().join(format!("splitstream-input-{}-{n}-{name}", std::process::id()));
+            std::fs::write(&path, contents).expect("write temp file");
+            TempFile(path)
+        }
+    }
+
+    impl Drop for TempFile {
+        fn drop(&mut self) {
+            let _ = std::fs::remove_file(&self.0);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_util::TempFile;
+    use super::*;
+
+    #[test]
+    fn unknown_extension_lists_supported_ones() {
+        let f = TempFile::new("mesh.stl", b"solid");
+        let err = read_mesh(&f.0, &ReadOptions::default()).unwrap_err();
+        assert!(matches!(err, InputError::UnknownExtension { .. }));
+        let msg = err.to_string();
+        assert!(msg.contains("'.stl'") && msg.contains(".npz"), "{msg}");
+        let err = read_mesh(Path::new("noext"), &ReadOptions::default()).unwrap_err();
+        assert!(err.to_string().contains("no file extension"));
+    }
+
+    #[test]
+    fn missing_file_is_io_error() {
+        let err = read_mesh(Path::new("/nonexistent/x.ply"), &ReadOptions::default()).unwrap_err();
+        assert!(matches!(err, InputError::Io { .. }), "{err}");
+        assert!(err.to_string().starts_with("/nonexistent/x.ply: "));
+    }
+
+    #[test]
+    fn empty_and_garbage_files_fail_cleanly() {
+        for ext in SUPPORTED_EXTENSIONS {
+            for (i, contents) in [&b""[..], b"\x00\x01garbage\xff\xfe\nmore garbage 1 2 3\n"].iter().enumerate() {
+                let f = TempFile::new(&format!("garbage{i}.{ext}"), contents);
+                let result = read_mesh(&f.0, &ReadOptions::default());
+                // OBJ without vertices or faces is an empty mesh, not an error.
+                if let Ok(mesh) = result {
+                    assert!(check_mesh(&mesh).is_err(), "{ext} {i}");
+                } else if let Err(e) = result {
+                    let msg = e.to_string();
+                    assert!(!msg.contains('\n'), "{msg}");
+                    assert!(msg.contains("garbage"), "{msg}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn z_scale_and_spacing_options() {
+        let f = TempFile::new("g.asc", b"ncols 2\nnrows 2\nxllcenter 0\nyllcenter 0\ncellsize 1\n1 2\n3 4\n");
+        let options = ReadOptions {
+            z_scale: 2.0,
+            grid_spacing: Some((10.0, 20.0)),
+            ..ReadOptions::default()
+        };
+        let m = read_mesh(&f.0, &options).unwrap();
+        assert_eq!(m.positions, vec![[0.0, 0.0, 6.0], [10.0, 0.0, 8.0], [0.0, 20.0, 2.0], [10.0, 20.0, 4.0]]);
+    }
+
+    #[test]
+    fn fan_triangulation() {
+        let mut tris = Vec::new();
+        let mut scratch = Vec::new();
+        push_polygon(&mut tris, [0, 1, 2, 3, 4], 5, &mut scratch).unwrap();
+        assert_eq!(tris, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
+        assert!(push_polygon(&mut tris, [0, 5, 1], 5, &mut scratch).unwrap_err().contains("index 5"));
+        assert!(push_polygon(&mut tris, [0, -1, 1], 5, &mut scratch).is_err());
+        assert!(push_polygon(&mut tris, [0, 1], 5, &mut scratch).unwrap_err().contains("2 vertices"));
+    }
+}

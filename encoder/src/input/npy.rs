@@ -1,0 +1,341 @@
+//! NumPy `.npy` / `.npz` elevation arrays, via `npyz`.
+//!
+//! Arrays are two-dimensional, any integer or float dtype, C or Fortran
+//! order. Like image-ordered DEMs (and GeoTIFF, ESRI grids), row 0 is taken
+//! as the northern edge; spacing is 1 and the south-west sample sits at the
+//! origin unless the archive says otherwise.
+//!
+//! `.npz` archives may carry scalar `dx`, `dy`, `xmin`, `ymin` (and `xmax`,
+//! `ymax`) entries, as matplotlib's `jacksboro_fault_dem.npz` does. There
+//! `(xmin, ymin)` is the position of element `[0, 0]`, and `ymax < ymin`
+//! says that rows run southward (matplotlib's own examples place row `r` at
+//! `linspace(ymin, ymax, nrows)[r]`). Without `ymax`, `ymin` is taken
+//! literally as the southern edge.
+
+use std::fs::File;
+use std::io::{BufReader, Read};
+use std::path::Path;
+
+use npyz::npz::NpzArchive;
+use npyz::{DType, NpyFile, Order, TypeChar};
+
+use super::grid::Grid;
+use super::{InputError, check_vertex_count};
+
+pub(super) fn read_npy(path: &Path, file: &str) -> Result<Grid, InputError> {
+    let f = File::open(path).map_err(|e| InputError::io(file, e))?;
+    let npy = NpyFile::new(BufReader::new(f)).map_err(|e| InputError::malformed(file, format!("invalid .npy: {e}")))?;
+    let (rows, cols, values) = read_2d(npy, file, "array")?;
+    north_first_grid(file, rows, cols, values, [0.0, 0.0], [1.0, 1.0])
+}
+
+fn north_first_grid(
+    file: &str,
+    rows: usize,
+    cols: usize,
+    values: Vec<f64>,
+    south_west: [f64; 2],
+    spacing: [f64; 2],
+) -> Result<Grid, InputError> {
+    Grid::from_north_first(rows, cols, values, south_west, spacing, None)
+        .ok_or_else(|| InputError::malformed(file, "array length does not match its shape"))
+}
+
+/// Shape and values (row-major, as f64) of a 2-D array.
+fn read_2d<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<(usize, usize, Vec<f64>), InputError> {
+    let shape = npy.shape().to_vec();
+    let [rows, cols] = shape[..] else {
+        return Err(InputError::malformed(
+            file,
+            format!("{name} must be two-dimensional, its shape is {shape:?}"),
+        ));
+    };
+    check_vertex_count(file, rows.saturating_mul(cols))?;
+    let fortran = npy.order() == Order::Fortran;
+    let mut values = read_values(npy, file, name)?;
+    let (rows, cols) = (rows as usize, cols as usize);
+    if values.len() != rows * cols {
+        return Err(InputError::malformed(
+            file,
+            format!("{name} has {} values, expected {rows} x {cols}", values.len()),
+        ));
+    }
+    if fortran {
+        let mut c_order = vec![0.0; values.len()];
+        for c in 0..cols {
+            for r in 0..rows {
+                c_order[r * cols + c] = values[c * rows + r];
+            }
+        }
+        values = c_order;
+    }
+    Ok((rows, cols, values))
+}
+
+/// Reads any numeric dtype as f64.
+fn read_values<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<Vec<f64>, InputError> {
+    let dtype = npy.dtype();
+    let DType::Plain(ts) = &dtype else {
+        return Err(InputError::unsupported(file, format!("{name} has a structured dtype")));
+    };
+    let err = |e: std::io::Error| InputError::malformed(file, format!("cannot read {name}: {e}"));
+    fn widen<T: Copy + Into<f64>>(v: Vec<T>) -> Vec<f64> {
+        v.into_iter().map(Into::into).collect()
+    }
+    Ok(match (ts.type_char(), ts.size_field()) {
+        (TypeChar::Float, 4) => widen(npy.into_vec::<f32>().map_err(err)?),
+        (TypeChar::Float, 8) => npy.into_vec::<f64>().map_err(err)?,
+        (TypeChar::Int, 1) => widen(npy.into_vec::<i8>().map_err(err)?),
+        (TypeChar::Int, 2) => widen(npy.into_vec::<i16>().map_err(err)?),
+        (TypeChar::Int, 4) => widen(npy.into_vec::<i32>().map_err(err)?),
+        (TypeChar::Int, 8) => npy.into_vec::<i64>().map_err(err)?.into_iter().map(|v| v as f64).collect(),
+        (TypeChar::Uint, 1) => widen(npy.into_vec::<u8>().map_err(err)?),
+        (TypeChar::Uint, 2) => widen(npy.into_vec::<u16>().map_err(err)?),
+        (TypeChar::Uint, 4) => widen(npy.into_vec::<u32>().map_err(err)?),
+        (TypeChar::Uint, 8) => npy.into_vec::<u64>().map_err(err)?.into_iter().map(|v| v as f64).collect(),
+        _ => return Err(InputError::unsupported(file, format!("{name} has dtype '{ts}'"))),
+    })
+}
+
+pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<Grid, InputError> {
+    let bad = |e: std::io::Error| InputError::malformed(file, format!("invalid .npz: {e}"));
+    let mut archive = NpzArchive::open(path).map_err(|e| match e.kind() {
+        std::io::ErrorKind::NotFound | std::io::ErrorKind::PermissionDenied => InputError::io(file, e),
+        _ => bad(e),
+    })?;
+    // Archive order (array_names() iterates a hash map).
+    let zip = archive.zip_archive();
+    let mut names = Vec::new();
+    for i in 0..zip.len() {
+        let entry = zip.by_index(i).map_err(|e| InputError::malformed(file, format!("invalid .npz: {e}")))?;
+        if let Some(name) = npyz::npz::array_name_from_file_name(entry.name()) {
+            names.push(name.to_owned());
+        }
+    }
+
+    let name = match wanted {
+        Some(w) => {
+            if !names.iter().any(|n| n == w) {
+                return Err(InputError::NpzArrayMissing {
+                    file: file.to_owned(),
+                    name: w.to_owned(),
+                    available: names,
+                });
+            }
+            w.to_owned()
+        }
+        None => {
+            let mut found = None;
+            for n in &names {
+                let npy = archive.by_name(n).map_err(bad)?;
+                if npy.is_some_and(|a| a.shape().len() == 2) {
+                    found = Some(n.clone());
+                    break;
+                }
+            }
+            found.ok_or_else(|| InputError::malformed(file, format!("no two-dimensional array in the archive (arrays: {})", names.join(", "))))?
+        }
+    };
+    let npy = archive
+        .by_name(&name)
+        .map_err(bad)?
+        .ok_or_else(|| InputError::malformed(file, format!("array '{name}' vanished")))?;
+    let (rows, cols, values) = read_2d(npy, file, &format!("array '{name}'"))?;
+
+    let mut scalar = |key: &str| -> Result<Option<f64>, InputError> {
+        if !names.iter().any(|n| n == key) || key == name {
+            return Ok(None);
+        }
+        let Some(npy) = archive.by_name(key).map_err(bad)? else {
+            return Ok(None);
+        };
+        if npy.shape().iter().product::<u64>() != 1 {
+            return Ok(None);
+        }
+        Ok(read_values(npy, file, key)?.first().copied())
+    };
+    let dx = scalar("dx")?;
+    let dy = scalar("dy")?;
+    let xmin = scalar("xmin")?;
+    let ymin = scalar("ymin")?;
+    let xmax = scalar("xmax")?;
+    let ymax = scalar("ymax")?;
+
+    let dx = dx.unwrap_or(1.0);
+    let dy = dy.or(dx.into()).unwrap_or(1.0);
+    if !(dx.is_finite() && dy.is_finite() && dx != 0.0 && dy != 0.0) {
+        return Err(InputError::malformed(file, format!("invalid spacing dx={dx}, dy={dy}")));
+    }
+    let (dx, dy) = (dx.abs(), dy.abs());
+    let x0 = xmin.unwrap_or(0.0);
+    // Columns run toward xmax, so a reversed x extent mirrors them.
+    let dx = if xmax.zip(xmin).is_some_and(|(hi, lo)| hi < lo) { -dx } else { dx };
+    let y0 = ymin.unwrap_or(0.0);
+    let grid = match ymax {
+        // Rows run north from ymin: row 0 is the southern edge.
+        Some(ymax) if ymax > y0 => Grid {
+            rows,
+            cols,
+            elevations: values,
+            origin: [x0, y0],
+            spacing: [dx, dy],
+            nodata: None,
+        },
+        // Rows run south from ymin (jacksboro), or no ymax: ymin is the south edge.
+        Some(_) => north_first_grid(file, rows, cols, values, [x0, y0 - rows.saturating_sub(1) as f64 * dy], [dx, dy])?,
+        None => north_first_grid(file, rows, cols, values, [x0, y0], [dx, dy])?,
+    };
+    Ok(grid)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::TempFile;
+    use super::super::{ReadOptions, check_mesh, read_mesh};
+    use super::*;
+
+    /// A minimal .npy file: version 1.0 header, padded to 64 bytes.
+    fn npy_bytes(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> {
+        let mut header = format!("{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}", if fortran { "True" } else { "False" });
+        while (10 + header.len() + 1) % 64 != 0 {
+            header.push(' ');
+        }
+        header.push('\n');
+        let mut out = b"\x93NUMPY\x01\x00".to_vec();
+        out.extend((header.len() as u16).to_le_bytes());
+        out.extend(header.as_bytes());
+        out.extend(data);
+        out
+    }
+
+    fn le<T: Copy, const N: usize>(values: &[T], f: impl Fn(T) -> [u8; N]) -> Vec<u8> {
+        values.iter().flat_map(|&v| f(v)).collect()
+    }
+
+    #[test]
+    fn reads_npy_dtypes_and_orders() {
+        // 2 rows x 3 cols, row 0 = north = [1, 2, 3].
+        let expect_south_first = vec![4.0, 5.0, 6.0, 1.0, 2.0, 3.0];
+        let cases = [
+            npy_bytes("<f4", false, "(2, 3)", &le(&[1f32, 2., 3., 4., 5., 6.], f32::to_le_bytes)),
+            npy_bytes(">f8", false, "(2, 3)", &le(&[1f64, 2., 3., 4., 5., 6.], f64::to_be_bytes)),
+            npy_bytes("<i2", false, "(2, 3)", &le(&[1i16, 2, 3, 4, 5, 6], i16::to_le_bytes)),
+            npy_bytes("<u2", true, "(2, 3)", &le(&[1u16, 4, 2, 5, 3, 6], u16::to_le_bytes)),
+            npy_bytes("<i8", false, "(2, 3)", &le(&[1i64, 2, 3, 4, 5, 6], i64::to_le_bytes)),
+            npy_bytes("|u1", false, "(2, 3)", &[1, 2, 3, 4, 5, 6]),
+        ];
+        for (i, bytes) in cases.iter().enumerate() {
+            let f = TempFile::new("a.npy", bytes);
+            let g = read_npy(&f.0, "a.npy").unwrap();
+            assert_eq!((g.rows, g.cols), (2, 3), "case {i}");
+            assert_eq!(g.elevations, expect_south_first, "case {i}");
+            let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+            assert_eq!(m.positions[0], [0.0, 0.0, 4.0]);
+            assert_eq!(m.positions[5], [2.0, 1.0, 3.0]);
+            check_mesh(&m).unwrap();
+        }
+    }
+
+    #[test]
+    fn npy_errors() {
+        let cases = [
+            (npy_bytes("<f4", false, "(6,)", &[0; 24]), "two-dimensional"),
+            (npy_bytes("<f4", false, "(2, 3)", &[0; 10]), "cannot read array"),
+            (npy_bytes("<c8", false, "(1, 1)", &[0; 8]), "unsupported"),
+            (b"\x93NUMPY\x01".to_vec(), "invalid .npy"),
+        ];
+        for (bytes, needle) in cases {
+            let f = TempFile::new("bad.npy", &bytes);
+            let msg = read_npy(&f.0, "bad.npy").unwrap_err().to_string();
+            assert!(msg.starts_with("bad.npy: ") && msg.contains(needle), "{msg}");
+        }
+    }
+
+    fn npz(entries: &[(&str, Vec<u8>)]) -> Vec<u8> {
+        // Stored (uncompressed) zip written by hand: local headers, central
+        // directory, end record. Enough for npyz's zip reader.
+        let mut out = Vec::new();
+        let mut central = Vec::new();
+        for (name, data) in entries {
+            let name = format!("{name}.npy");
+            let crc = crc32fast::hash(data);
+            let offset = out.len() as u32;
+            let mut local = Vec::new();
+            local.extend(0x04034b50u32.to_le_bytes());
+            local.extend([20, 0, 0, 0, 0, 0, 0, 0, 0, 0]);
+            local.extend(crc.to_le_bytes());
+            local.extend((data.len() as u32).to_le_bytes());
+            local.extend((data.len() as u32).to_le_bytes());
+            local.extend((name.len() as u16).to_le_bytes());
+            local.extend([0, 0]);
+            local.extend(name.as_bytes());
+            out.extend(&local);
+            out.extend(data);
+            central.extend(0x02014b50u32.to_le_bytes());
+            central.extend([20, 0, 20, 0, 0, 0, 0, 0, 0, 0, 0, 0]);
+            central.extend(crc.to_le_bytes());
+            central.extend((data.len() as u32).to_le_bytes());
+            central.extend((data.len() as u32).to_le_bytes());
+            central.extend((name.len() as u16).to_le_bytes());
+            central.extend([0; 12]);
+            central.extend(offset.to_le_bytes());
+            central.extend(name.as_bytes());
+        }
+        let cd_offset = out.len() as u32;
+        out.extend(&central);
+        out.extend(0x06054b50u32.to_le_bytes());
+        out.extend([0, 0, 0, 0]);
+        out.extend((entries.len() as u16).to_le_bytes());
+        out.extend((entries.len() as u16).to_le_bytes());
+        out.extend((central.len() as u32).to_le_bytes());
+        out.extend(cd_offset.to_le_bytes());
+        out.extend([0, 0]);
+        out
+    }
+
+    fn scalar(v: f64) -> Vec<u8> {
+        npy_bytes("<f8", false, "()", &v.to_le_bytes())
+    }
+
+    #[test]
+    fn npz_uses_metadata_like_jacksboro() {
+        let elevation = npy_bytes("<i2", false, "(2, 3)", &le(&[1i16, 2, 3, 4, 5, 6], i16::to_le_bytes));
+        let bytes = npz(&[
+            ("dx", scalar(0.5)),
+            ("elevation", elevation.clone()),
+            ("dy", scalar(0.25)),
+            ("xmin", scalar(-84.0)),
+            ("ymin", scalar(36.5)),
+            ("ymax", scalar(36.0)),
+            ("other", npy_bytes("<f8", false, "(1, 1)", &1f64.to_le_bytes())),
+        ]);
+        let f = TempFile::new("dem.npz", &bytes);
+        let g = read_npz(&f.0, "dem.npz", None).unwrap();
+        assert_eq!(g.spacing, [0.5, 0.25]);
+        assert_eq!(g.origin, [-84.0, 36.25]);
+        assert_eq!(g.elevations, vec![4.0, 5.0, 6.0, 1.0, 2.0, 3.0]);
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        assert!(m.positions.contains(&[-84.0, 36.5, 1.0]));
+        check_mesh(&m).unwrap();
+
+        // Named array, missing array, no 2-D array.
+        let g = read_npz(&f.0, "dem.npz", Some("other")).unwrap();
+        assert_eq!((g.rows, g.cols), (1, 1));
+        let msg = read_npz(&f.0, "dem.npz", Some("nope")).unwrap_err().to_string();
+        assert!(msg.contains("no array named 'nope'") && msg.contains("dx, elevation"), "{msg}");
+        let f2 = TempFile::new("flat.npz", &npz(&[("dx", scalar(1.0))]));
+        let msg = read_npz(&f2.0, "flat.npz", None).unwrap_err().to_string();
+        assert!(msg.contains("no two-dimensional array"), "{msg}");
+
+        // Without ymax, ymin is the south edge; rows still run north to south.
+        let f3 = TempFile::new("plain.npz", &npz(&[("elevation", elevation), ("ymin", scalar(10.0))]));
+        let g = read_npz(&f3.0, "plain.npz", None).unwrap();
+        assert_eq!(g.origin, [0.0, 10.0]);
+        assert_eq!(g.spacing, [1.0, 1.0]);
+
+        let mut truncated = bytes.clone();
+        truncated.truncate(bytes.len() / 2);
+        let f4 = TempFile::new("trunc.npz", &truncated);
+        assert!(read_npz(&f4.0, "trunc.npz", None).is_err());
+    }
+}

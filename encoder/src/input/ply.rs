@@ -1,0 +1,275 @@
+//! PLY reader (ascii, binary little and big endian) on top of `ply-rs-bw`.
+//!
+//! One element type serves every PLY element so that unknown elements
+//! (edges, materials) are parsed and ignored instead of rejected; only the
+//! `vertex` x/y/z (any numeric type) and the `face` `vertex_indices` or
+//! `vertex_index` list are kept. Polygons are fan-triangulated.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{BeginList, Property, PropertyAccess, PropertyAccessResult, PropertyType};
+
+use crate::Mesh;
+
+use super::{InputError, check_vertex_count, push_polygon};
+
+/// Whatever a PLY element carries that we care about.
+#[derive(Default)]
+struct Element {
+    xyz: [f64; 3],
+    indices_i32: Vec<i32>,
+    indices_u32: Vec<u32>,
+    /// Index lists stored with other integer types, widened.
+    indices_other: Vec<i64>,
+}
+
+fn is_index_list(name: &str) -> bool {
+    name == "vertex_indices" || name == "vertex_index"
+}
+
+impl Element {
+    fn set_coord(&mut self, name: &str, value: f64) -> PropertyAccessResult {
+        let k = match name {
+            "x" => 0,
+            "y" => 1,
+            "z" => 2,
+            _ => return PropertyAccessResult::Ignored,
+        };
+        self.xyz[k] = value;
+        PropertyAccessResult::Set
+    }
+
+    fn set_other_list(&mut self, name: &str, values: impl Iterator<Item = i64>) -> PropertyAccessResult {
+        if !is_index_list(name) {
+            return PropertyAccessResult::Ignored;
+        }
+        self.indices_other = values.collect();
+        PropertyAccessResult::Set
+    }
+
+    fn indices(&self) -> impl Iterator<Item = i64> + '_ {
+        self.indices_i32
+            .iter()
+            .map(|&i| i as i64)
+            .chain(self.indices_u32.iter().map(|&i| i as i64))
+            .chain(self.indices_other.iter().copied())
+    }
+}
+
+impl PropertyAccess for Element {
+    fn new() -> Self {
+        Element::default()
+    }
+    fn set_char(&mut self, name: &str, v: i8) -> PropertyAccessResult {
+        self.set_coord(name, v as f64)
+    }
+    fn set_uchar(&mut self, name: &str, v: u8) -> PropertyAccessResult {
+        self.set_coord(name, v as f64)
+    }
+    fn set_short(&mut self, name: &str, v: i16) -> PropertyAccessResult {
+        self.set_coord(name, v as f64)
+    }
+    fn set_ushort(&mut self, name: &str, v: u16) -> PropertyAccessResult {
+        self.set_coord(name, v as f64)
+    }
+    fn set_int(&mut self, name: &str, v: i32) -> PropertyAccessResult {
+        self.set_coord(name, v as f64)
+    }
+    fn set_uint(&mut self, name: &str, v: u32) -> PropertyAccessResult {
+        self.set_coord(name, v as f64)
+    }
+    fn set_float(&mut self, name: &str, v: f32) -> PropertyAccessResult {
+        self.set_coord(name, v as f64)
+    }
+    fn set_double(&mut self, name: &str, v: f64) -> PropertyAccessResult {
+        self.set_coord(name, v)
+    }
+    fn set_property(&mut self, _name: &str, _p: Property) -> PropertyAccessResult {
+        PropertyAccessResult::Ignored
+    }
+    fn begin_list_int(&mut self, name: &str, _len: usize) -> BeginList<'_, i32> {
+        if is_index_list(name) { BeginList::Fill(&mut self.indices_i32) } else { BeginList::UseSetter }
+    }
+    fn begin_list_uint(&mut self, name: &str, _len: usize) -> BeginList<'_, u32> {
+        if is_index_list(name) { BeginList::Fill(&mut self.indices_u32) } else { BeginList::UseSetter }
+    }
+    fn set_list_char(&mut self, name: &str, v: Vec<i8>) -> PropertyAccessResult {
+        self.set_other_list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_uchar(&mut self, name: &str, v: Vec<u8>) -> PropertyAccessResult {
+        self.set_other_list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_short(&mut self, name: &str, v: Vec<i16>) -> PropertyAccessResult {
+        self.set_other_list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_ushort(&mut self, name: &str, v: Vec<u16>) -> PropertyAccessResult {
+        self.set_other_list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_int(&mut self, name: &str, v: Vec<i32>) -> PropertyAccessResult {
+        self.set_other_list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_uint(&mut self, name: &str, v: Vec<u32>) -> PropertyAccessResult {
+        self.set_other_list(name, v.into_iter().map(i64::from))
+    }
+    fn set_list_float(&mut self, _name: &str, _v: Vec<f32>) -> PropertyAccessResult {
+        PropertyAccessResult::Ignored
+    }
+    fn set_list_double(&mut self, _name: &str, _v: Vec<f64>) -> PropertyAccessResult {
+        PropertyAccessResult::Ignored
+    }
+}
+
+pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
+    let f = File::open(path).map_err(|e| InputError::io(file, e))?;
+    let mut reader = BufReader::new(f);
+    let ply = Parser::<Element>::new().read_ply(&mut reader).map_err(|e| match e.line() {
+        Some(line) if e.kind() != std::io::ErrorKind::UnexpectedEof || line > 0 => {
+            InputError::malformed(file, format!("PLY line {line}: {}", strip_line_prefix(&e.to_string())))
+        }
+        _ => InputError::malformed(file, format!("invalid PLY: {e}")),
+    })?;
+
+    let vertex_def = ply
+        .header
+        .elements
+        .get("vertex")
+        .ok_or_else(|| InputError::malformed(file, "PLY has no 'vertex' element"))?;
+    for axis in ["x", "y", "z"] {
+        match vertex_def.properties.get(axis).map(|p| &p.data_type) {
+            Some(PropertyType::Scalar(_)) => {}
+            Some(PropertyType::List(..)) => {
+                return Err(InputError::malformed(file, format!("PLY vertex property '{axis}' is a list")));
+            }
+            None => return Err(InputError::malformed(file, format!("PLY vertex element has no '{axis}' property"))),
+        }
+    }
+    let face_def = ply
+        .header
+        .elements
+        .get("face")
+        .ok_or_else(|| InputError::malformed(file, "PLY has no 'face' element"))?;
+    let has_list = face_def
+        .properties
+        .iter()
+        .any(|(name, p)| is_index_list(name) && matches!(p.data_type, PropertyType::List(..)));
+    if !has_list {
+        return Err(InputError::malformed(
+            file,
+            "PLY face element has no 'vertex_indices' or 'vertex_index' list",
+        ));
+    }
+
+    let empty = Vec::new();
+    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
+    let faces = ply.payload.get("face").unwrap_or(&empty);
+    check_vertex_count(file, vertices.len() as u64)?;
+    let positions: Vec<[f64; 3]> = vertices.iter().map(|v| v.xyz).collect();
+    let mut triangles = Vec::with_capacity(faces.len());
+    let mut scratch = Vec::new();
+    for (i, face) in faces.iter().enumerate() {
+        push_polygon(&mut triangles, face.indices(), positions.len(), &mut scratch)
+            .map_err(|m| InputError::element(file, format!("face {i}"), m))?;
+    }
+    Ok(Mesh { positions, triangles })
+}
+
+/// `ply-rs-bw` prefixes messages with "Line N:"; we print our own.
+fn strip_line_prefix(message: &str) -> &str {
+    match message.strip_prefix("Line ") {
+        Some(rest) => rest.split_once(": ").map_or(message, |(_, m)| m),
+        None => message,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::test_util::TempFile;
+    use super::super::{ReadOptions, check_mesh, read_mesh};
+    use super::*;
+
+    const ASCII: &str = "ply\nformat ascii 1.0\ncomment a unit square as one quad plus a triangle\n\
+element vertex 5\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\n\
+element face 2\nproperty list uchar int vertex_indices\nend_header\n\
+0 0 0 255\n1 0 0 0\n1 1 0 0\n0 1 0 0\n2 0.5 0 0\n4 0 1 2 3\n3 1 4 2\n";
+
+    fn expected() -> Mesh {
+        Mesh {
+            positions: vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.], [2., 0.5, 0.]],
+            triangles: vec![[0, 1, 2], [0, 2, 3], [1, 4, 2]],
+        }
+    }
+
+    fn binary(big_endian: bool, index_name: &str) -> Vec<u8> {
+        let fmt = if big_endian { "binary_big_endian" } else { "binary_little_endian" };
+        let mut out = format!(
+            "ply\nformat {fmt} 1.0\nelement vertex 5\nproperty double x\nproperty double y\nproperty double z\n\
+element edge 1\nproperty int vertex1\nproperty int vertex2\n\
+element face 2\nproperty list uchar uint {index_name}\nend_header\n"
+        )
+        .into_bytes();
+        for p in expected().positions {
+            for c in p {
+                out.extend(if big_endian { c.to_be_bytes() } else { c.to_le_bytes() });
+            }
+        }
+        for i in [0i32, 1] {
+            out.extend(if big_endian { i.to_be_bytes() } else { i.to_le_bytes() });
+        }
+        for face in [&[0u32, 1, 2, 3][..], &[1, 4, 2]] {
+            out.push(face.len() as u8);
+            for &i in face {
+                out.extend(if big_endian { i.to_be_bytes() } else { i.to_le_bytes() });
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn reads_ascii_with_quads() {
+        let f = TempFile::new("sq.ply", ASCII.as_bytes());
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        assert_eq!(m, expected());
+        check_mesh(&m).unwrap();
+    }
+
+    #[test]
+    fn reads_binary_both_endians_and_index_names() {
+        for (big, name) in [(false, "vertex_indices"), (true, "vertex_index"), (true, "vertex_indices")] {
+            let f = TempFile::new("bin.ply", &binary(big, name));
+            let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+            assert_eq!(m, expected(), "big endian {big}, {name}");
+        }
+    }
+
+    #[test]
+    fn truncated_binary_fails_cleanly() {
+        let data = binary(false, "vertex_indices");
+        for cut in [data.len() - 3, data.len() - 30, 180, 10] {
+            let f = TempFile::new("trunc.ply", &data[..cut]);
+            let err = read_mesh(&f.0, &ReadOptions::default()).unwrap_err();
+            let msg = err.to_string();
+            assert!(msg.contains("trunc.ply") && !msg.contains('\n'), "{msg}");
+        }
+    }
+
+    #[test]
+    fn bad_index_and_missing_properties() {
+        let bad = ASCII.replace("3 1 4 2", "3 1 7 2");
+        let f = TempFile::new("bad.ply", bad.as_bytes());
+        let msg = read_mesh(&f.0, &ReadOptions::default()).unwrap_err().to_string();
+        assert!(msg.ends_with("bad.ply: face 1: vertex index 7 out of range (the file has 5 vertices)"), "{msg}");
+
+        let noz = ASCII.replace("property float z\n", "").replace(" 0 255\n", " 255\n").replace(" 0 0\n", " 0\n");
+        let f = TempFile::new("noz.ply", noz.as_bytes());
+        let msg = read_mesh(&f.0, &ReadOptions::default()).unwrap_err().to_string();
+        assert!(msg.contains("no 'z' property"), "{msg}");
+
+        let garbage = ASCII.replace("1 1 0 0", "1 one 0 0");
+        let f = TempFile::new("garbage.ply", garbage.as_bytes());
+        let msg = read_mesh(&f.0, &ReadOptions::default()).unwrap_err().to_string();
+        assert!(msg.contains("line") && !msg.contains('\n'), "{msg}");
+    }
+}

@@ -1,0 +1,124 @@
+//! Tests of the two-sided distance on meshes with known answers.
+
+use super::*;
+
+fn grid(n: u32, z: f64) -> Mesh {
+    let mut positions = Vec::new();
+    for j in 0..n {
+        for i in 0..n {
+            positions.push([f64::from(i), f64::from(j), z]);
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..n - 1 {
+        for i in 0..n - 1 {
+            let v = j * n + i;
+            triangles.push([v, v + 1, v + n + 1]);
+            triangles.push([v, v + n + 1, v + n]);
+        }
+    }
+    Mesh {
+        positions,
+        triangles,
+    }
+}
+
+#[test]
+fn identical_meshes_are_zero_apart() {
+    let m = grid(10, 0.0);
+    let r = surface_distance(&m, &m, 5000, 1);
+    // Zero up to the rounding of interpolated sample points.
+    assert!(r.hausdorff < 1e-12 * r.diagonal, "{r:?}");
+    assert!(r.rms <= r.hausdorff && r.mean <= r.rms);
+    assert!((r.diagonal - 162f64.sqrt()).abs() < 1e-12);
+}
+
+#[test]
+fn offset_plane_is_half_a_unit_away() {
+    let a = grid(10, 0.0);
+    let b = grid(10, 0.5);
+    let r = surface_distance(&a, &b, 5000, 1);
+    assert!((r.hausdorff - 0.5).abs() < 1e-12);
+    assert!((r.rms - 0.5).abs() < 1e-12);
+    assert!((r.mean - 0.5).abs() < 1e-12);
+    let back = surface_distance(&b, &a, 5000, 1);
+    assert!((back.rms - 0.5).abs() < 1e-12);
+}
+
+#[test]
+fn differently_triangulated_same_surface_is_zero_apart() {
+    let fine = grid(9, 0.0);
+    let coarse = Mesh {
+        positions: vec![
+            [0.0, 0.0, 0.0],
+            [8.0, 0.0, 0.0],
+            [8.0, 8.0, 0.0],
+            [0.0, 8.0, 0.0],
+        ],
+        triangles: vec![[0, 1, 3], [1, 2, 3]],
+    };
+    let r = surface_distance(&fine, &coarse, 2000, 3);
+    assert!(r.hausdorff < 1e-12);
+}
+
+#[test]
+fn hausdorff_sees_a_one_sided_bump() {
+    // b is a with one vertex lifted by 1: a -> b is small on average but
+    // b -> a reaches exactly 1 at the lifted vertex.
+    let a = grid(5, 0.0);
+    let mut b = a.clone();
+    b.positions[12][2] = 1.0;
+    let r = surface_distance(&a, &b, 1000, 5);
+    assert!((r.hausdorff - 1.0).abs() < 1e-12);
+    assert!(r.rms > 0.0 && r.rms < 0.5);
+    assert!(r.mean <= r.rms);
+}
+
+#[test]
+fn deterministic_for_a_seed() {
+    let a = grid(6, 0.0);
+    let mut b = a.clone();
+    b.positions[7][2] = 0.3;
+    let x = surface_distance(&a, &b, 3000, 42);
+    assert_eq!(x, surface_distance(&a, &b, 3000, 42));
+    assert_ne!(x.rms, surface_distance(&a, &b, 3000, 43).rms);
+}
+
+#[test]
+fn empty_meshes() {
+    let m = grid(3, 0.0);
+    let empty = Mesh::default();
+    assert_eq!(surface_distance(&empty, &empty, 10, 0).hausdorff, 0.0);
+    assert_eq!(surface_distance(&m, &empty, 10, 0).hausdorff, f64::INFINITY);
+}
+
+/// Speed of 1M samples per side between a 1M-vertex, 2M-triangle terrain
+/// and its half-size simplification:
+/// `cargo test --release -p splitstream-encoder metrics_speed -- --ignored --nocapture`.
+#[test]
+#[ignore = "benchmark; run in release"]
+fn metrics_speed_on_a_million_vertices() {
+    use crate::baseline::{BaselineOptions, simplify_sequential, tests::terrain};
+    use std::time::Instant;
+
+    let fine = terrain(1000);
+    let coarse = simplify_sequential(
+        &fine,
+        &BaselineOptions {
+            target_vertices: 500_000,
+            ..BaselineOptions::default()
+        },
+    )
+    .mesh;
+    let start = Instant::now();
+    let r = surface_distance(&fine, &coarse, 1_000_000, 7);
+    println!(
+        "{} + {} samples, {} + {} triangles: {:.2} s; {r:?}",
+        fine.vertex_count() + 1_000_000,
+        coarse.vertex_count() + 1_000_000,
+        fine.triangle_count(),
+        coarse.triangle_count(),
+        start.elapsed().as_secs_f64()
+    );
+    assert!(r.hausdorff < 1e-3 * r.diagonal);
+}

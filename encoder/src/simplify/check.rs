@@ -1,0 +1,142 @@
+//! Whether one collapse keeps the mesh a valid oriented 2-manifold that the
+//! decoder can split back (SPEC §6, §7): link condition with the boundary
+//! ghost, valence limits, wings that keep a fan, no folded triangles.
+//! Read-only, so every vertex can check its candidates in parallel.
+
+use super::state::{MAX_VALENCE, State};
+use crate::corner_table::{Fan, NONE, next, prev};
+use crate::quadric::{cross, dot, sub};
+
+/// What a valid collapse of (p, c) removes and records.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plan {
+    /// Corner at p of triangle (p, c, A), or NONE.
+    pub left: u32,
+    /// Corner at p of triangle (p, B, c) = (c, p, B), or NONE.
+    pub right: u32,
+    pub wing_a: u32,
+    pub wing_b: u32,
+    /// Valence of the merged vertex, the ghost counted.
+    pub valence_r: usize,
+}
+
+/// Reusable buffers so the parallel passes do not allocate per vertex.
+#[derive(Default)]
+pub struct CheckScratch {
+    pub fan_v: Fan,
+    pub candidates: Vec<super::select::Candidate>,
+    fan_p: Fan,
+    fan_c: Fan,
+    fan_x: Fan,
+    np: Vec<u32>,
+    nc: Vec<u32>,
+}
+
+/// Distinct neighbours of the fan's centre, sorted, with [`NONE`] (the ghost)
+/// for a boundary vertex.
+fn neighbours(s: &State, fan: &Fan, out: &mut Vec<u32>) {
+    out.clear();
+    for &c in &fan.corners {
+        out.push(s.table.v(next(c)));
+        out.push(s.table.v(prev(c)));
+    }
+    if fan.boundary {
+        out.push(NONE);
+    }
+    out.sort_unstable();
+    out.dedup();
+}
+
+/// Checks collapsing `c` into `p` (p < c survives) placed at `target`.
+pub fn check_collapse(
+    s: &State,
+    p: u32,
+    c: u32,
+    target: [f64; 3],
+    k: &mut CheckScratch,
+) -> Result<Plan, ()> {
+    let t = &s.table;
+    t.fan(p, &mut k.fan_p);
+    t.fan(c, &mut k.fan_c);
+    let left = k.fan_p.corners.iter().copied().find(|&x| t.v(next(x)) == c).unwrap_or(NONE);
+    let right = k.fan_p.corners.iter().copied().find(|&x| t.v(prev(x)) == c).unwrap_or(NONE);
+    if left == NONE && right == NONE {
+        return Err(());
+    }
+    let wing_a = if left != NONE { t.v(prev(left)) } else { NONE };
+    let wing_b = if right != NONE { t.v(next(right)) } else { NONE };
+    neighbours(s, &k.fan_p, &mut k.np);
+    neighbours(s, &k.fan_c, &mut k.nc);
+    // Link condition on the ghost-closed mesh: the common neighbours are
+    // exactly the two wings (one may be the ghost).
+    let mut common = 0;
+    let mut union = 0;
+    let (mut i, mut j) = (0, 0);
+    while i < k.np.len() || j < k.nc.len() {
+        let a = k.np.get(i).copied().unwrap_or(u32::MAX);
+        let b = k.nc.get(j).copied().unwrap_or(u32::MAX);
+        let x = a.min(b);
+        if a == b {
+            // NONE (the ghost) sorts last: both at the end means common ghost.
+            if i < k.np.len() && j < k.nc.len() {
+                common += 1;
+            }
+            i += 1;
+            j += 1;
+        } else if a < b {
+            i += 1;
+        } else {
+            j += 1;
+        }
+        if x != p && x != c {
+            union += 1;
+        }
+    }
+    if common != 2 {
+        return Err(());
+    }
+    let valence_r = union;
+    if !(3..=MAX_VALENCE).contains(&valence_r) {
+        return Err(());
+    }
+    // Each real wing loses a neighbour and must keep a valence of 3.
+    for w in [wing_a, wing_b] {
+        if w == NONE {
+            continue;
+        }
+        t.fan(w, &mut k.fan_x);
+        let valence = k.fan_x.corners.len() + if k.fan_x.boundary { 2 } else { 0 };
+        if valence < 4 {
+            return Err(());
+        }
+    }
+    if !keeps_orientation(s, p, c, target, &k.fan_p) || !keeps_orientation(s, c, p, target, &k.fan_c) {
+        return Err(());
+    }
+    Ok(Plan {
+        left,
+        right,
+        wing_a,
+        wing_b,
+        valence_r,
+    })
+}
+
+/// Whether every triangle around `v` not containing `other` keeps a
+/// non-degenerate normal within 90° of its old one when `v` moves to `target`.
+fn keeps_orientation(s: &State, v: u32, other: u32, target: [f64; 3], fan: &Fan) -> bool {
+    let t = &s.table;
+    let pv = s.geometry(v);
+    fan.corners.iter().all(|&c| {
+        let (n1, n2) = (t.v(next(c)), t.v(prev(c)));
+        if n1 == other || n2 == other {
+            return true;
+        }
+        let (q1, q2) = (s.geometry(n1), s.geometry(n2));
+        let old = cross(sub(q1, pv), sub(q2, pv));
+        let (e1, e2) = (sub(q1, target), sub(q2, target));
+        let new = cross(e1, e2);
+        let scale = dot(e1, e1) + dot(e2, e2);
+        dot(old, new) > 0.0 && dot(new, new) > 1e-24 * scale * scale
+    })
+}

@@ -1,0 +1,19 @@
+//! The paper's parallel simplification (Cellier et al. 2012, §2): every step
+//! collapses, at once, all edges that are reciprocal best choices of their
+//! two endpoints and local minima of the quadric error among the requests
+//! of their 1-ring, so the collapses of a step touch disjoint neighbourhoods
+//! and can be reversed as one round of independent vertex splits.
+//!
+//! Each step is three data-parallel passes over the vertex array (rayon here,
+//! compute kernels later): best edge per vertex (§2 step a, with the sub-grid
+//! tie-break of Fig. 2), reciprocity (step b), local minimum with index
+//! priority (step c); then the winners are applied. The paper's bitonic sort
+//! of the Index array is not needed on the CPU: the collapses of a step are
+//! kept in ascending survivor id (a stable order) and the stream's vertex
+//! order is fixed by the decoder's own rule during replay (see `emit`).
+
+mod check;
+mod select;
+mod state;
+
+pub use state::{Collapse, Simplification, SimplifyOptions, simplify};

@@ -1,0 +1,152 @@
+//! Step a of §2: each vertex's best incident edge, with the sub-grid tie-break.
+
+use super::check::{CheckScratch, check_collapse};
+use super::state::State;
+use crate::corner_table::{NONE, next, prev};
+use crate::quadric::collapse_target;
+
+/// A vertex's chosen collapse; `other == NONE` when it has none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Best {
+    pub other: u32,
+    pub error: f64,
+    /// Error rounded to f32 bits (flat regions flushed to 0) so that equal
+    /// errors tie exactly and the tie-breaks decide.
+    pub error_key: u32,
+    pub target: [u32; 3],
+}
+
+impl Best {
+    pub const NONE: Best = Best {
+        other: NONE,
+        error: f64::INFINITY,
+        error_key: u32::MAX,
+        target: [0; 3],
+    };
+
+    pub fn target_geometry(&self) -> [f64; 3] {
+        self.target.map(|x| x as f64)
+    }
+}
+
+/// Total order of collapse requests: error first, then the lower id wins
+/// (the paper's index priority).
+pub fn pair_key(b: &Best, v: u32) -> u64 {
+    ((b.error_key as u64) << 32) | v.min(b.other) as u64
+}
+
+/// Where the collapse of edge (v, u) puts the merged vertex, and its error.
+/// Computed from the lower id first, so both endpoints get identical results.
+fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
+    let (p, c) = (v.min(u), v.max(u));
+    let (pi, ci) = (p as usize, c as usize);
+    let q = s.quadrics[pi] + s.quadrics[ci];
+    let (pp, pc) = (s.positions[pi], s.positions[ci]);
+    let target = if s.lock_boundary && (s.boundary[pi] || s.boundary[ci]) {
+        match (s.boundary[pi], s.boundary[ci]) {
+            (true, true) => return None,
+            (true, false) => pp,
+            _ => pc,
+        }
+    } else if s.constrained {
+        // P, C or the integer midpoint P + ((C - P) >> 1) (SPEC §7.4).
+        let mid: [u32; 3] =
+            std::array::from_fn(|k| (pp[k] as i64 + ((pc[k] as i64 - pp[k] as i64) >> 1)) as u32);
+        let mut best = (pp, q.error(s.geometry[pi]));
+        for cand in [pc, mid] {
+            let e = q.error(cand.map(|x| x as f64));
+            if e < best.1 {
+                best = (cand, e);
+            }
+        }
+        best.0
+    } else {
+        let (t, _) = collapse_target(&q, s.geometry[pi], s.geometry[ci], false);
+        let top = ((1u64 << s.bits) - 1) as f64;
+        t.map(|x| x.round().clamp(0.0, top) as u32)
+    };
+    Some((target, q.error(target.map(|x| x as f64))))
+}
+
+/// Scale of the current mesh, for the tie-breaks.
+#[derive(Clone, Copy, Debug)]
+pub struct Scale {
+    /// Sub-grid cell size (0: no sub-grid).
+    pub cell: f64,
+    /// Errors below this count as flat (exactly 0).
+    pub flat: f64,
+}
+
+fn cell_of(p: [f64; 3], cell: f64) -> [i64; 3] {
+    p.map(|x| (x / cell).floor() as i64)
+}
+
+/// The best valid collapse of `v` (§2 step a).
+pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) -> Best {
+    if !s.alive[v as usize] {
+        return Best::NONE;
+    }
+    let mut fan = std::mem::take(&mut scratch.fan_v);
+    s.table.fan(v, &mut fan);
+    let mut candidates = std::mem::take(&mut scratch.candidates);
+    candidates.clear();
+    let home = (scale.cell > 0.0).then(|| cell_of(s.geometry(v), scale.cell));
+    for &c in &fan.corners {
+        for u in [s.table.v(next(c)), s.table.v(prev(c))] {
+            if candidates.iter().any(|x: &Candidate| x.other == u) {
+                continue;
+            }
+            let Some((target, error)) = evaluate(s, v, u) else {
+                continue;
+            };
+            let error_key = if error <= scale.flat {
+                0
+            } else {
+                (error as f32).to_bits()
+            };
+            let other_cell = home.is_some_and(|h| h != cell_of(s.geometry(u), scale.cell));
+            candidates.push(Candidate {
+                rank: (error_key, other_cell, s.positions[u as usize], u),
+                other: u,
+                best: Best {
+                    other: u,
+                    error,
+                    error_key,
+                    target,
+                },
+            });
+        }
+    }
+    candidates.sort_unstable_by_key(|x| x.rank);
+    let mut found = Best::NONE;
+    for cand in &candidates {
+        let (p, c) = (v.min(cand.other), v.max(cand.other));
+        if check_collapse(s, p, c, cand.best.target_geometry(), scratch).is_ok() {
+            found = cand.best;
+            break;
+        }
+    }
+    scratch.fan_v = fan;
+    scratch.candidates = candidates;
+    found
+}
+
+/// A candidate edge of one vertex, ranked by error, then same sub-grid cell,
+/// then minimal coordinates of the other end (Fig. 2), then id.
+#[derive(Clone, Copy, Debug)]
+pub struct Candidate {
+    rank: (u32, bool, [u32; 3], u32),
+    other: u32,
+    best: Best,
+}
+
+impl Default for Candidate {
+    fn default() -> Self {
+        Candidate {
+            rank: (u32::MAX, true, [0; 3], NONE),
+            other: NONE,
+            best: Best::NONE,
+        }
+    }
+}
+

@@ -1,0 +1,300 @@
+//! Working state and the step loop of the parallel simplifier.
+
+use rayon::prelude::*;
+
+use super::check::{CheckScratch, check_collapse};
+use super::select::{Best, Scale, best_edge, pair_key};
+use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
+use crate::quadric::{Quadric, vertex_quadrics};
+use crate::quantize::QuantizedMesh;
+
+/// Split valence stored for vertices that were never produced by a collapse.
+pub const LEAF: u8 = 0xFF;
+/// Largest valence (ghost included) a collapse may produce; below [`LEAF`].
+pub const MAX_VALENCE: usize = 254;
+
+/// Options of the parallel simplifier.
+#[derive(Clone, Debug)]
+pub struct SimplifyOptions {
+    /// Stop once this many vertices remain.
+    pub target_vertices: usize,
+    /// Never collapse an edge whose quadric error exceeds this.
+    pub max_error: Option<f64>,
+    /// Constrained placement: the merged vertex sits on P, on C or at their midpoint.
+    pub constrained: bool,
+    pub boundary_weight: f64,
+    /// Never move or remove boundary vertices (for patch borders).
+    pub lock_boundary: bool,
+    /// Fraction of the candidate errors admitted per step (the threshold S is
+    /// raised to this quantile): lower is closer to the sequential order, higher
+    /// collapses more per step.
+    pub admit_quantile: f64,
+    /// Sub-grid cell size in mean edge lengths (Fig. 2 tie-break); 0 disables it.
+    pub subgrid_cells: f64,
+}
+
+impl Default for SimplifyOptions {
+    fn default() -> Self {
+        SimplifyOptions {
+            target_vertices: 0,
+            max_error: None,
+            constrained: false,
+            boundary_weight: crate::quadric::DEFAULT_BOUNDARY_WEIGHT,
+            lock_boundary: false,
+            admit_quantile: 0.5,
+            subgrid_cells: 2.0,
+        }
+    }
+}
+
+/// One collapse of P (the lower id, which survives as R) and C, recorded so
+/// that a vertex split can reverse it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Collapse {
+    pub p: u32,
+    pub c: u32,
+    /// Third vertex of triangle (P, C, A); [`NONE`] for the boundary ghost.
+    pub wing_a: u32,
+    /// Third vertex of triangle (C, P, B); [`NONE`] for the boundary ghost.
+    pub wing_b: u32,
+    pub position_p: [u32; 3],
+    pub position_c: [u32; 3],
+    pub position_r: [u32; 3],
+    /// Split valences P and C had before the collapse ([`LEAF`] if original).
+    pub split_valence_p: u8,
+    pub split_valence_c: u8,
+    /// Quadric error of the collapse.
+    pub error: f64,
+    /// The error as a distance in grid units: sqrt(error / total weight of
+    /// the merged quadric), an RMS distance to the planes it summarises.
+    pub distance: f64,
+}
+
+/// Result: the collapses, step by step, and the simplified mesh they leave.
+pub struct Simplification {
+    pub steps: Vec<Vec<Collapse>>,
+    pub table: CornerTable,
+    pub positions: Vec<[u32; 3]>,
+    /// Split valence of each surviving vertex ([`LEAF`] for originals).
+    pub split_valence: Vec<u8>,
+    pub alive: Vec<bool>,
+    pub alive_count: usize,
+    /// Largest error of any collapse, per step.
+    pub step_errors: Vec<f64>,
+}
+
+pub(super) struct State {
+    pub table: CornerTable,
+    pub positions: Vec<[u32; 3]>,
+    pub geometry: Vec<[f64; 3]>,
+    pub quadrics: Vec<Quadric>,
+    pub boundary: Vec<bool>,
+    pub alive: Vec<bool>,
+    pub split_valence: Vec<u8>,
+    pub bits: u8,
+    pub constrained: bool,
+    pub lock_boundary: bool,
+}
+
+impl State {
+    pub fn geometry(&self, v: u32) -> [f64; 3] {
+        self.geometry[v as usize]
+    }
+}
+
+/// Simplifies `mesh` (quantized, checked manifold) with the parallel algorithm.
+pub fn simplify(
+    mesh: &QuantizedMesh,
+    options: &SimplifyOptions,
+    mut progress: impl FnMut(usize),
+) -> Simplification {
+    let n = mesh.positions.len();
+    let geometry: Vec<[f64; 3]> = mesh
+        .positions
+        .iter()
+        .map(|p| p.map(|x| x as f64))
+        .collect();
+    let table = CornerTable::new(n, &mesh.triangles);
+    let mut boundary = vec![false; n];
+    for (c, &o) in table.opposite.iter().enumerate() {
+        if o == NONE {
+            boundary[table.v(next(c as u32)) as usize] = true;
+            boundary[table.v(prev(c as u32)) as usize] = true;
+        }
+    }
+    let alive: Vec<bool> = table.corner_of.iter().map(|&c| c != NONE).collect();
+    let mut s = State {
+        quadrics: vertex_quadrics(&geometry, &mesh.triangles, options.boundary_weight),
+        positions: mesh.positions.clone(),
+        geometry,
+        table,
+        boundary,
+        alive,
+        split_valence: vec![LEAF; n],
+        bits: mesh.bits,
+        constrained: options.constrained,
+        lock_boundary: options.lock_boundary,
+    };
+    let mut alive_count = s.alive.iter().filter(|&&a| a).count();
+    let mut steps = Vec::new();
+    let mut step_errors = Vec::new();
+    let mut threshold = 0.0f64;
+    let limit = options.max_error.unwrap_or(f64::INFINITY);
+    while alive_count > options.target_vertices {
+        let edge = mean_edge_length(&s);
+        let scale = Scale {
+            cell: options.subgrid_cells * edge,
+            flat: 1e-6 * edge * edge,
+        };
+        let best: Vec<Best> = (0..n as u32)
+            .into_par_iter()
+            .map_init(CheckScratch::default, |scratch, v| best_edge(&s, v, scale, scratch))
+            .collect();
+        // Raise S to the admitted quantile of the current candidate errors.
+        let mut errors: Vec<f64> = best.iter().filter(|b| b.other != NONE).map(|b| b.error).collect();
+        if errors.is_empty() {
+            break;
+        }
+        let q = ((errors.len() - 1) as f64 * options.admit_quantile.clamp(0.0, 1.0)) as usize;
+        let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
+        threshold = threshold.max(*quantile).min(limit);
+        let mut winners = step_winners(&s, &best, threshold);
+        if winners.is_empty() {
+            // Nothing under S: raise it to the smallest candidate error (the
+            // paper's "S is increased"), unless that passes the maximum.
+            let smallest = errors.iter().copied().fold(f64::INFINITY, f64::min);
+            if smallest > limit || smallest <= threshold && threshold >= limit {
+                break;
+            }
+            threshold = threshold.max(smallest).min(limit);
+            winners = step_winners(&s, &best, threshold);
+            if winners.is_empty() {
+                break;
+            }
+        }
+        // Hit the target exactly: keep the cheapest collapses of the last step.
+        let room = alive_count - options.target_vertices;
+        if winners.len() > room {
+            winners.sort_by_key(|&v| pair_key(&best[v as usize], v));
+            winners.truncate(room);
+            winners.sort_unstable();
+        }
+        let mut collapses = Vec::with_capacity(winners.len());
+        let mut fans = [Fan::default(), Fan::default()];
+        let mut step_error = 0.0f64;
+        for &p in &winners {
+            let b = best[p as usize];
+            let collapse = apply_collapse(&mut s, p, b, &mut fans);
+            step_error = step_error.max(b.error);
+            collapses.push(collapse);
+        }
+        alive_count -= collapses.len();
+        steps.push(collapses);
+        step_errors.push(step_error);
+        progress(n - alive_count);
+    }
+    Simplification {
+        steps,
+        table: s.table,
+        positions: s.positions,
+        split_valence: s.split_valence,
+        alive: s.alive,
+        alive_count,
+        step_errors,
+    }
+}
+
+/// Steps b and c: reciprocal pairs under the threshold that are local minima
+/// among the requests of their 1-rings. Returns the survivors (lower ids).
+fn step_winners(s: &State, best: &[Best], threshold: f64) -> Vec<u32> {
+    let n = best.len();
+    let admitted = |v: usize| {
+        let b = &best[v];
+        b.other != NONE && b.error <= threshold && best[b.other as usize].other == v as u32
+    };
+    // Key of the reciprocal request each vertex takes part in (u64::MAX: none).
+    let keys: Vec<u64> = (0..n)
+        .into_par_iter()
+        .map(|v| {
+            if admitted(v) {
+                pair_key(&best[v], v as u32)
+            } else {
+                u64::MAX
+            }
+        })
+        .collect();
+    (0..n as u32)
+        .into_par_iter()
+        .filter(|&v| {
+            let b = &best[v as usize];
+            admitted(v as usize) && v < b.other && {
+                let key = keys[v as usize];
+                is_local_minimum(s, v, b.other, key, &keys)
+            }
+        })
+        .collect()
+}
+
+fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64]) -> bool {
+    let mut fan = Fan::default();
+    for v in [p, c] {
+        s.table.fan(v, &mut fan);
+        for &corner in &fan.corners {
+            for x in [s.table.v(next(corner)), s.table.v(prev(corner))] {
+                if x != p && x != c && keys[x as usize] < key {
+                    return false;
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Applies the collapse chosen by `p`, returning its record.
+fn apply_collapse(s: &mut State, p: u32, b: Best, fans: &mut [Fan; 2]) -> Collapse {
+    let c = b.other;
+    let mut scratch = CheckScratch::default();
+    let plan = check_collapse(s, p, c, b.target_geometry(), &mut scratch)
+        .expect("the winner was checked in this step and its neighbourhood is untouched");
+    let q = s.quadrics[p as usize] + s.quadrics[c as usize];
+    let weight = q.c[0] + q.c[4] + q.c[7];
+    let distance = if weight > 0.0 { (b.error / weight).sqrt() } else { 0.0 };
+    let record = Collapse {
+        p,
+        c,
+        wing_a: plan.wing_a,
+        wing_b: plan.wing_b,
+        position_p: s.positions[p as usize],
+        position_c: s.positions[c as usize],
+        position_r: b.target,
+        split_valence_p: s.split_valence[p as usize],
+        split_valence_c: s.split_valence[c as usize],
+        error: b.error,
+        distance,
+    };
+    s.table.collapse(p, c, plan.left, plan.right, fans);
+    let (pi, ci) = (p as usize, c as usize);
+    s.positions[pi] = b.target;
+    s.geometry[pi] = b.target_geometry();
+    s.quadrics[pi] = q;
+    s.boundary[pi] |= s.boundary[ci];
+    s.alive[ci] = false;
+    s.split_valence[pi] = plan.valence_r as u8;
+    record
+}
+
+/// Mean length of the live edges, for the sub-grid cell size.
+fn mean_edge_length(s: &State) -> f64 {
+    let t = &s.table;
+    let (sum, count) = (0..t.vertex.len() as u32)
+        .into_par_iter()
+        .filter(|&c| t.v(c) != NONE)
+        .map(|c| {
+            let a = s.geometry(t.v(c));
+            let b = s.geometry(t.v(next(c)));
+            let d = crate::quadric::norm(crate::quadric::sub(a, b));
+            (d, 1usize)
+        })
+        .reduce(|| (0.0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
+    if count == 0 { 1.0 } else { sum / count as f64 }
+}
