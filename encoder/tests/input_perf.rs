@@ -18,7 +18,10 @@ fn terrain_check_and_repair_at_scale() {
     let t = Instant::now();
     let stats = check_mesh(&mesh).unwrap();
     let check = t.elapsed();
-    assert_eq!((stats.components, stats.boundary_loops, stats.genus), (1, 1, 0));
+    assert_eq!(
+        (stats.components, stats.boundary_loops, stats.genus),
+        (1, 1, 0)
+    );
 
     let t = Instant::now();
     let (_, report) = repair_mesh(&mesh);

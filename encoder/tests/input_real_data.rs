@@ -8,7 +8,9 @@ use splitstream_encoder::Mesh;
 use splitstream_encoder::input::{MeshStats, ReadOptions, check_mesh, read_mesh, repair_mesh};
 
 fn load(name: &str) -> Option<Mesh> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/real").join(name);
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("data/real")
+        .join(name);
     if !path.exists() {
         eprintln!("skipped {name}: run encoder/data/fetch.sh to download it");
         return None;
@@ -65,11 +67,20 @@ fn matplotlib_jacksboro_dem() {
     let Some(s) = check("jacksboro_fault_dem.npz", 138_632, 2 * 343 * 402) else {
         return;
     };
-    assert_eq!((s.components, s.boundary_loops, s.boundary_edges), (1, 1, 2 * (343 + 402)));
+    assert_eq!(
+        (s.components, s.boundary_loops, s.boundary_edges),
+        (1, 1, 2 * (343 + 402))
+    );
     let mesh = load("jacksboro_fault_dem.npz").unwrap();
     let (lo, hi) = mesh.bounding_box().unwrap();
     let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
-    assert!(close(lo[0], -84.41375) && close(hi[0], -84.41375 + 402.0 / 1200.0), "{lo:?} {hi:?}");
-    assert!(close(hi[1], 36.73291666666667) && close(lo[1], hi[1] - 343.0 / 1200.0), "{lo:?} {hi:?}");
+    assert!(
+        close(lo[0], -84.41375) && close(hi[0], -84.41375 + 402.0 / 1200.0),
+        "{lo:?} {hi:?}"
+    );
+    assert!(
+        close(hi[1], 36.73291666666667) && close(lo[1], hi[1] - 343.0 / 1200.0),
+        "{lo:?} {hi:?}"
+    );
     assert!(lo[2] >= 200.0 && hi[2] <= 1100.0, "{lo:?} {hi:?}");
 }

@@ -3,7 +3,7 @@
 //! deficits, edge and placement varints), split counts, level counts and
 //! stream parameters of fixed deep seed streams, which are then framed with
 //! valid checksums, so every input reaches the split logic. Input: byte 0
-//! picks the seed, the rest is a list of mutations (see `gen::mutate_levels`).
+//! picks the seed, the rest is a list of mutations (see `streams::mutate_levels`).
 //! Must never panic; with no mutation the decode must match the replay.
 #![no_main]
 
@@ -11,21 +11,21 @@ use std::sync::OnceLock;
 
 use libfuzzer_sys::fuzz_target;
 use splitstream_decoder_core::writer::write_stream;
-use splitstream_decoder_core_fuzz::gen::{self, Choices, Generated};
+use splitstream_decoder_core_fuzz::streams::{self, Choices, Generated};
 
 static SEEDS: OnceLock<Vec<Generated>> = OnceLock::new();
 
 fuzz_target!(|data: &[u8]| {
-    let seeds = SEEDS.get_or_init(gen::seed_generated);
+    let seeds = SEEDS.get_or_init(streams::seed_generated);
     let Some((&pick, ops)) = data.split_first() else {
         return;
     };
     let seed = &seeds[pick as usize % seeds.len()];
-    let (params, levels) = gen::mutate_levels(seed, &mut Choices::new(ops));
+    let (params, levels) = streams::mutate_levels(seed, &mut Choices::new(ops));
     let stream = write_stream(&params, &levels);
-    let decoded = gen::decode_full(&stream);
+    let decoded = streams::decode_full(&stream);
     if ops.is_empty() {
-        gen::check_against(seed, &decoded).unwrap();
+        streams::check_against(seed, &decoded).unwrap();
     }
     if let Some(e) = decoded.error {
         // Typed errors only; the class is total.

@@ -6,12 +6,12 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use splitstream_decoder_core_fuzz::gen::{self, Choices};
+use splitstream_decoder_core_fuzz::streams::{self, Choices};
 
 fuzz_target!(|data: &[u8]| {
-    let g = gen::generate(&mut Choices::new(data), true);
-    let decoded = gen::decode_full(&g.stream);
-    if let Err(msg) = gen::check_against(&g, &decoded) {
+    let g = streams::generate(&mut Choices::new(data), true);
+    let decoded = streams::decode_full(&g.stream);
+    if let Err(msg) = streams::check_against(&g, &decoded) {
         panic!("decoder and replay disagree: {msg}");
     }
 });

@@ -1,6 +1,6 @@
 //! Shared code of the splitstream decoder fuzz targets.
 
-pub mod gen;
+pub mod streams;
 
 use splitstream_decoder_core::{Decoder, Error, Inflater, workspace_len};
 

@@ -23,7 +23,7 @@ pub fn next(c: u32) -> u32 {
 }
 
 pub fn prev(c: u32) -> u32 {
-    if c % 3 == 0 { c + 2 } else { c - 1 }
+    if c.is_multiple_of(3) { c + 2 } else { c - 1 }
 }
 
 /// The corners around one vertex, in fan order, and whether the fan is open.

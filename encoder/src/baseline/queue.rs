@@ -159,8 +159,8 @@ mod tests {
         let initial: Vec<Entry> = (0..500).map(&mut make).collect();
         let mut reference: BinaryHeap<_> = initial.iter().map(|&e| key(e)).collect();
         let mut q = Queue::from_entries(initial);
-        for i in 0..3000 {
-            if i % 3 == 0 {
+        for i in 0..3000u32 {
+            if i.is_multiple_of(3) {
                 let e = make(1000 + i);
                 q.push(e);
                 reference.push(key(e));

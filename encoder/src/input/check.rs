@@ -54,23 +54,57 @@ impl fmt::Display for MeshStats {
 #[derive(Clone, Debug, PartialEq)]
 pub enum MeshError {
     /// No vertices or no triangles.
-    Empty { vertices: usize, triangles: usize },
+    Empty {
+        vertices: usize,
+        triangles: usize,
+    },
     /// More triangles than the 2^31 the edge tables can index.
-    TooLarge { triangles: usize },
-    NonFiniteCoordinate { vertex: usize, position: [f64; 3] },
-    IndexOutOfRange { triangle: usize, vertices: [u32; 3], vertex_count: usize },
+    TooLarge {
+        triangles: usize,
+    },
+    NonFiniteCoordinate {
+        vertex: usize,
+        position: [f64; 3],
+    },
+    IndexOutOfRange {
+        triangle: usize,
+        vertices: [u32; 3],
+        vertex_count: usize,
+    },
     /// A triangle uses the same vertex twice.
-    DegenerateTriangle { triangle: usize, vertices: [u32; 3] },
+    DegenerateTriangle {
+        triangle: usize,
+        vertices: [u32; 3],
+    },
     /// A triangle has the same vertex set as an earlier one (any order).
-    DuplicateTriangle { triangle: usize, vertices: [u32; 3], earlier: usize, earlier_vertices: [u32; 3] },
+    DuplicateTriangle {
+        triangle: usize,
+        vertices: [u32; 3],
+        earlier: usize,
+        earlier_vertices: [u32; 3],
+    },
     /// An undirected edge used by more than two triangles (all listed, ascending).
-    NonManifoldEdge { edge: [u32; 2], positions: [[f64; 3]; 2], triangles: Vec<usize> },
+    NonManifoldEdge {
+        edge: [u32; 2],
+        positions: [[f64; 3]; 2],
+        triangles: Vec<usize>,
+    },
     /// Two triangles traverse the same directed edge.
-    InconsistentOrientation { edge: [u32; 2], triangles: [usize; 2] },
+    InconsistentOrientation {
+        edge: [u32; 2],
+        triangles: [usize; 2],
+    },
     /// The triangles around a vertex form more than one fan.
-    NonManifoldVertex { vertex: usize, position: [f64; 3], fans: usize },
+    NonManifoldVertex {
+        vertex: usize,
+        position: [f64; 3],
+        fans: usize,
+    },
     /// A vertex no triangle uses.
-    UnreferencedVertex { vertex: usize, position: [f64; 3] },
+    UnreferencedVertex {
+        vertex: usize,
+        position: [f64; 3],
+    },
 }
 
 struct P([f64; 3]);
@@ -84,30 +118,63 @@ impl fmt::Display for P {
 impl fmt::Display for MeshError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            MeshError::Empty { vertices, triangles } => {
-                write!(f, "mesh is empty ({vertices} vertices, {triangles} triangles)")
+            MeshError::Empty {
+                vertices,
+                triangles,
+            } => {
+                write!(
+                    f,
+                    "mesh is empty ({vertices} vertices, {triangles} triangles)"
+                )
             }
             MeshError::TooLarge { triangles } => {
-                write!(f, "{triangles} triangles exceed the checker's limit of 2^31")
+                write!(
+                    f,
+                    "{triangles} triangles exceed the checker's limit of 2^31"
+                )
             }
             MeshError::NonFiniteCoordinate { vertex, position } => {
-                write!(f, "vertex {vertex} has a non-finite coordinate {}", P(*position))
+                write!(
+                    f,
+                    "vertex {vertex} has a non-finite coordinate {}",
+                    P(*position)
+                )
             }
-            MeshError::IndexOutOfRange { triangle, vertices, vertex_count } => {
-                let bad = vertices.iter().find(|&&v| v as usize >= *vertex_count).copied().unwrap_or(vertices[0]);
+            MeshError::IndexOutOfRange {
+                triangle,
+                vertices,
+                vertex_count,
+            } => {
+                let bad = vertices
+                    .iter()
+                    .find(|&&v| v as usize >= *vertex_count)
+                    .copied()
+                    .unwrap_or(vertices[0]);
                 write!(
                     f,
                     "triangle {triangle} {vertices:?} refers to vertex {bad}, but there are only {vertex_count} vertices"
                 )
             }
             MeshError::DegenerateTriangle { triangle, vertices } => {
-                write!(f, "triangle {triangle} {vertices:?} is degenerate (repeats a vertex)")
+                write!(
+                    f,
+                    "triangle {triangle} {vertices:?} is degenerate (repeats a vertex)"
+                )
             }
-            MeshError::DuplicateTriangle { triangle, vertices, earlier, earlier_vertices } => write!(
+            MeshError::DuplicateTriangle {
+                triangle,
+                vertices,
+                earlier,
+                earlier_vertices,
+            } => write!(
                 f,
                 "triangle {triangle} {vertices:?} duplicates triangle {earlier} {earlier_vertices:?} (same vertices)"
             ),
-            MeshError::NonManifoldEdge { edge, positions, triangles } => write!(
+            MeshError::NonManifoldEdge {
+                edge,
+                positions,
+                triangles,
+            } => write!(
                 f,
                 "edge {}-{} {}-{} is non-manifold: shared by {} triangles {:?} (at most 2 allowed)",
                 edge[0],
@@ -122,13 +189,21 @@ impl fmt::Display for MeshError {
                 "triangles {} and {} both traverse edge {}->{} in the same direction (inconsistent orientation)",
                 triangles[0], triangles[1], edge[0], edge[1]
             ),
-            MeshError::NonManifoldVertex { vertex, position, fans } => write!(
+            MeshError::NonManifoldVertex {
+                vertex,
+                position,
+                fans,
+            } => write!(
                 f,
                 "vertex {vertex} {} is non-manifold: its triangles form {fans} separate fans",
                 P(*position)
             ),
             MeshError::UnreferencedVertex { vertex, position } => {
-                write!(f, "vertex {vertex} {} is not used by any triangle", P(*position))
+                write!(
+                    f,
+                    "vertex {vertex} {} is not used by any triangle",
+                    P(*position)
+                )
             }
         }
     }
@@ -233,19 +308,43 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
     let (pos, tris) = (&mesh.positions, &mesh.triangles);
     let nv = pos.len();
     if nv == 0 || tris.is_empty() {
-        return Err(MeshError::Empty { vertices: nv, triangles: tris.len() });
+        return Err(MeshError::Empty {
+            vertices: nv,
+            triangles: tris.len(),
+        });
     }
     if tris.len() >= 1 << 31 {
-        return Err(MeshError::TooLarge { triangles: tris.len() });
+        return Err(MeshError::TooLarge {
+            triangles: tris.len(),
+        });
     }
-    if let Some(v) = pos.par_iter().position_first(|p| !p.iter().all(|c| c.is_finite())) {
-        return Err(MeshError::NonFiniteCoordinate { vertex: v, position: pos[v] });
+    if let Some(v) = pos
+        .par_iter()
+        .position_first(|p| !p.iter().all(|c| c.is_finite()))
+    {
+        return Err(MeshError::NonFiniteCoordinate {
+            vertex: v,
+            position: pos[v],
+        });
     }
-    if let Some(t) = tris.par_iter().position_first(|t| t.iter().any(|&v| v as usize >= nv)) {
-        return Err(MeshError::IndexOutOfRange { triangle: t, vertices: tris[t], vertex_count: nv });
+    if let Some(t) = tris
+        .par_iter()
+        .position_first(|t| t.iter().any(|&v| v as usize >= nv))
+    {
+        return Err(MeshError::IndexOutOfRange {
+            triangle: t,
+            vertices: tris[t],
+            vertex_count: nv,
+        });
     }
-    if let Some(t) = tris.par_iter().position_first(|&[a, b, c]| a == b || b == c || a == c) {
-        return Err(MeshError::DegenerateTriangle { triangle: t, vertices: tris[t] });
+    if let Some(t) = tris
+        .par_iter()
+        .position_first(|&[a, b, c]| a == b || b == c || a == c)
+    {
+        return Err(MeshError::DegenerateTriangle {
+            triangle: t,
+            vertices: tris[t],
+        });
     }
     if let Some((t, earlier)) = first_duplicate(tris, nv) {
         return Err(MeshError::DuplicateTriangle {
@@ -269,7 +368,11 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
             match group.len() {
                 1 => {
                     boundary_edges += 1;
-                    let (a, b) = if record_reversed(group[0]) { (hi, lo as u32) } else { (lo as u32, hi) };
+                    let (a, b) = if record_reversed(group[0]) {
+                        (hi, lo as u32)
+                    } else {
+                        (lo as u32, hi)
+                    };
                     boundary_next[a as usize] = b;
                 }
                 2 => {
@@ -278,7 +381,11 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
                         if worst_orientation.as_ref().is_none_or(|w| second < w.0) {
                             let first = record_triangle(group[0]);
                             let [a, b] = [lo as u32, hi];
-                            let edge = if record_reversed(group[0]) { [b, a] } else { [a, b] };
+                            let edge = if record_reversed(group[0]) {
+                                [b, a]
+                            } else {
+                                [a, b]
+                            };
                             worst_orientation = Some((second, edge, first));
                         }
                     }
@@ -296,10 +403,17 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
     drop(edges);
     if let Some((_, edge, triangles)) = worst_nonmanifold {
         let positions = edge.map(|v| pos[v as usize]);
-        return Err(MeshError::NonManifoldEdge { edge, positions, triangles });
+        return Err(MeshError::NonManifoldEdge {
+            edge,
+            positions,
+            triangles,
+        });
     }
     if let Some((second, edge, first)) = worst_orientation {
-        return Err(MeshError::InconsistentOrientation { edge, triangles: [first, second] });
+        return Err(MeshError::InconsistentOrientation {
+            edge,
+            triangles: [first, second],
+        });
     }
 
     let links = link_table(tris, nv);
@@ -319,10 +433,20 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
         .find_first(|r| r.is_some())
         .flatten();
     if let Some((v, fans)) = bad_vertex {
-        return Err(MeshError::NonManifoldVertex { vertex: v, position: pos[v], fans });
+        return Err(MeshError::NonManifoldVertex {
+            vertex: v,
+            position: pos[v],
+            fans,
+        });
     }
-    if let Some(v) = (0..nv).into_par_iter().position_first(|v| links.get(v).is_empty()) {
-        return Err(MeshError::UnreferencedVertex { vertex: v, position: pos[v] });
+    if let Some(v) = (0..nv)
+        .into_par_iter()
+        .position_first(|v| links.get(v).is_empty())
+    {
+        return Err(MeshError::UnreferencedVertex {
+            vertex: v,
+            position: pos[v],
+        });
     }
     drop(links);
 
@@ -415,7 +539,9 @@ pub(crate) fn count_components(tris: &[[u32; 3]], nv: usize) -> usize {
             used[v as usize] = true;
         }
     }
-    (0..nv as u32).filter(|&v| used[v as usize] && find(&mut parent, v) == v).count()
+    (0..nv as u32)
+        .filter(|&v| used[v as usize] && find(&mut parent, v) == v)
+        .count()
 }
 
 #[cfg(test)]
@@ -424,7 +550,9 @@ mod tests {
 
     fn mesh(positions: usize, triangles: &[[u32; 3]]) -> Mesh {
         Mesh {
-            positions: (0..positions).map(|i| [i as f64, (i * i) as f64, 0.5]).collect(),
+            positions: (0..positions)
+                .map(|i| [i as f64, (i * i) as f64, 0.5])
+                .collect(),
             triangles: triangles.to_vec(),
         }
     }
@@ -461,7 +589,10 @@ mod tests {
             }
         );
         let s = check_mesh(&torus(5, 4)).unwrap();
-        assert_eq!((s.euler_characteristic, s.genus, s.boundary_loops), (0, 1, 0));
+        assert_eq!(
+            (s.euler_characteristic, s.genus, s.boundary_loops),
+            (0, 1, 0)
+        );
         // Square with a quad hole: an annulus, one component, two loops.
         let mut tris = Vec::new();
         let v = |r: u32, c: u32| r * 4 + c;
@@ -474,7 +605,10 @@ mod tests {
             }
         }
         let s = check_mesh(&mesh(16, &tris)).unwrap();
-        assert_eq!((s.boundary_loops, s.boundary_edges, s.components, s.genus), (2, 16, 1, 0));
+        assert_eq!(
+            (s.boundary_loops, s.boundary_edges, s.components, s.genus),
+            (2, 16, 1, 0)
+        );
         // Two disjoint triangles.
         let s = check_mesh(&mesh(6, &[[0, 1, 2], [3, 4, 5]])).unwrap();
         assert_eq!((s.components, s.boundary_loops), (2, 2));
@@ -484,22 +618,43 @@ mod tests {
     #[test]
     fn each_rule_names_the_first_offender() {
         let err = |m: &Mesh| check_mesh(m).unwrap_err();
-        assert_eq!(err(&mesh(0, &[])), MeshError::Empty { vertices: 0, triangles: 0 });
-        assert_eq!(err(&mesh(3, &[])).to_string(), "mesh is empty (3 vertices, 0 triangles)");
+        assert_eq!(
+            err(&mesh(0, &[])),
+            MeshError::Empty {
+                vertices: 0,
+                triangles: 0
+            }
+        );
+        assert_eq!(
+            err(&mesh(3, &[])).to_string(),
+            "mesh is empty (3 vertices, 0 triangles)"
+        );
 
         let mut m = mesh(4, &TETRA);
         m.positions[2][1] = f64::NAN;
         m.positions[3][0] = f64::INFINITY;
-        assert_eq!(err(&m).to_string(), "vertex 2 has a non-finite coordinate (2, NaN, 0.5)");
+        assert_eq!(
+            err(&m).to_string(),
+            "vertex 2 has a non-finite coordinate (2, NaN, 0.5)"
+        );
 
         let e = err(&mesh(4, &[[0, 2, 1], [0, 1, 9], [0, 1, 7]]));
-        assert_eq!(e.to_string(), "triangle 1 [0, 1, 9] refers to vertex 9, but there are only 4 vertices");
+        assert_eq!(
+            e.to_string(),
+            "triangle 1 [0, 1, 9] refers to vertex 9, but there are only 4 vertices"
+        );
 
         let e = err(&mesh(4, &[[0, 2, 1], [0, 1, 1], [2, 2, 2]]));
-        assert_eq!(e.to_string(), "triangle 1 [0, 1, 1] is degenerate (repeats a vertex)");
+        assert_eq!(
+            e.to_string(),
+            "triangle 1 [0, 1, 1] is degenerate (repeats a vertex)"
+        );
 
         let e = err(&mesh(4, &[[0, 2, 1], [0, 1, 3], [3, 0, 1], [1, 0, 2]]));
-        assert_eq!(e.to_string(), "triangle 2 [3, 0, 1] duplicates triangle 1 [0, 1, 3] (same vertices)");
+        assert_eq!(
+            e.to_string(),
+            "triangle 2 [3, 0, 1] duplicates triangle 1 [0, 1, 3] (same vertices)"
+        );
 
         let e = err(&mesh(5, &[[0, 1, 2], [1, 0, 3], [0, 1, 4]]));
         assert_eq!(
@@ -510,20 +665,44 @@ mod tests {
         let e = err(&mesh(4, &[[0, 1, 2], [0, 1, 3]]));
         assert_eq!(
             e,
-            MeshError::InconsistentOrientation { edge: [0, 1], triangles: [0, 1] }
+            MeshError::InconsistentOrientation {
+                edge: [0, 1],
+                triangles: [0, 1]
+            }
         );
         assert!(e.to_string().contains("edge 0->1"));
 
         // Bowtie: two triangles share only vertex 0.
         let e = err(&mesh(5, &[[0, 1, 2], [0, 3, 4]]));
-        assert_eq!(e, MeshError::NonManifoldVertex { vertex: 0, position: [0.0, 0.0, 0.5], fans: 2 });
+        assert_eq!(
+            e,
+            MeshError::NonManifoldVertex {
+                vertex: 0,
+                position: [0.0, 0.0, 0.5],
+                fans: 2
+            }
+        );
         // Two closed fans at one vertex: two tetrahedra glued at a vertex.
         let mut tris = TETRA.to_vec();
-        tris.extend(TETRA.iter().map(|t| t.map(|v| if v == 0 { 0 } else { v + 3 })));
-        assert!(matches!(err(&mesh(7, &tris)), MeshError::NonManifoldVertex { vertex: 0, fans: 2, .. }));
+        tris.extend(
+            TETRA
+                .iter()
+                .map(|t| t.map(|v| if v == 0 { 0 } else { v + 3 })),
+        );
+        assert!(matches!(
+            err(&mesh(7, &tris)),
+            MeshError::NonManifoldVertex {
+                vertex: 0,
+                fans: 2,
+                ..
+            }
+        ));
 
         let e = err(&mesh(5, &[[0, 1, 2]]));
-        assert_eq!(e.to_string(), "vertex 3 (3, 9, 0.5) is not used by any triangle");
+        assert_eq!(
+            e.to_string(),
+            "vertex 3 (3, 9, 0.5) is not used by any triangle"
+        );
     }
 
     #[test]

@@ -8,9 +8,8 @@ use std::fmt;
 use std::io;
 
 /// Every extension `read_mesh` understands, for the unknown-extension message.
-pub const SUPPORTED_EXTENSIONS: &[&str] = &[
-    "ply", "obj", "off", "tif", "tiff", "asc", "npy", "npz",
-];
+pub const SUPPORTED_EXTENSIONS: &[&str] =
+    &["ply", "obj", "off", "tif", "tiff", "asc", "npy", "npz"];
 
 /// Why a file could not be turned into a [`crate::Mesh`].
 #[derive(Debug)]
@@ -62,7 +61,11 @@ impl InputError {
         }
     }
 
-    pub(crate) fn element(file: &str, element: impl Into<String>, message: impl Into<String>) -> Self {
+    pub(crate) fn element(
+        file: &str,
+        element: impl Into<String>,
+        message: impl Into<String>,
+    ) -> Self {
         InputError::Element {
             file: file.to_owned(),
             element: element.into(),
@@ -108,12 +111,23 @@ impl fmt::Display for InputError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             InputError::Io { file, source } => {
-                write!(f, "{file}: cannot read file: {}", one_line(&source.to_string()))
+                write!(
+                    f,
+                    "{file}: cannot read file: {}",
+                    one_line(&source.to_string())
+                )
             }
             InputError::UnknownExtension { file, extension } => {
-                let list: Vec<String> = SUPPORTED_EXTENSIONS.iter().map(|e| format!(".{e}")).collect();
+                let list: Vec<String> = SUPPORTED_EXTENSIONS
+                    .iter()
+                    .map(|e| format!(".{e}"))
+                    .collect();
                 if extension.is_empty() {
-                    write!(f, "{file}: no file extension; supported: {}", list.join(", "))
+                    write!(
+                        f,
+                        "{file}: no file extension; supported: {}",
+                        list.join(", ")
+                    )
                 } else {
                     write!(
                         f,
@@ -122,14 +136,20 @@ impl fmt::Display for InputError {
                     )
                 }
             }
-            InputError::Line { file, line, message } => write!(f, "{file}: line {line}: {message}"),
+            InputError::Line {
+                file,
+                line,
+                message,
+            } => write!(f, "{file}: line {line}: {message}"),
             InputError::Element {
                 file,
                 element,
                 message,
             } => write!(f, "{file}: {element}: {message}"),
             InputError::Malformed { file, message } => write!(f, "{file}: {message}"),
-            InputError::Unsupported { file, feature } => write!(f, "{file}: unsupported: {feature}"),
+            InputError::Unsupported { file, feature } => {
+                write!(f, "{file}: unsupported: {feature}")
+            }
             InputError::NpzArrayMissing {
                 file,
                 name,
@@ -168,7 +188,10 @@ mod tests {
     #[test]
     fn messages_are_single_line_and_name_the_file() {
         let errors = [
-            InputError::io("a.ply", io::Error::new(io::ErrorKind::NotFound, "gone\nreally")),
+            InputError::io(
+                "a.ply",
+                io::Error::new(io::ErrorKind::NotFound, "gone\nreally"),
+            ),
             InputError::UnknownExtension {
                 file: "a.stl".into(),
                 extension: "stl".into(),
@@ -192,7 +215,10 @@ mod tests {
             assert!(!s.contains('\n') && !s.contains('\t'), "{s}");
             assert!(s.starts_with(e.file()), "{s}");
         }
-        assert_eq!(errors[2].to_string(), "bunny.off: line 12: expected 3 coordinates, found 2");
+        assert_eq!(
+            errors[2].to_string(),
+            "bunny.off: line 12: expected 3 coordinates, found 2"
+        );
         assert!(errors[1].to_string().contains(".ply, .obj, .off"));
     }
 }

@@ -43,18 +43,18 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Grid, InputError> {
             break;
         }
         tokens.next();
-        let (_, value) = tokens
-            .next()
-            .ok_or_else(|| InputError::line(file, line, format!("header key '{key}' has no value")))?;
+        let (_, value) = tokens.next().ok_or_else(|| {
+            InputError::line(file, line, format!("header key '{key}' has no value"))
+        })?;
         let num = || {
-            value
-                .parse::<f64>()
-                .map_err(|_| InputError::line(file, line, format!("invalid value '{value}' for '{key}'")))
+            value.parse::<f64>().map_err(|_| {
+                InputError::line(file, line, format!("invalid value '{value}' for '{key}'"))
+            })
         };
         let count = || {
-            value
-                .parse::<usize>()
-                .map_err(|_| InputError::line(file, line, format!("invalid value '{value}' for '{key}'")))
+            value.parse::<usize>().map_err(|_| {
+                InputError::line(file, line, format!("invalid value '{value}' for '{key}'"))
+            })
         };
         match key.to_ascii_lowercase().as_str() {
             "ncols" => h.ncols = Some(count()?),
@@ -68,10 +68,17 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Grid, InputError> {
             "dy" | "ydim" => h.dy = Some(num()?),
             "nodata_value" => h.nodata = Some(num()?),
             "byteorder" => {}
-            _ => return Err(InputError::line(file, line, format!("unknown header key '{key}'"))),
+            _ => {
+                return Err(InputError::line(
+                    file,
+                    line,
+                    format!("unknown header key '{key}'"),
+                ));
+            }
         }
     }
-    let missing = |what: &str| InputError::malformed(file, format!("ESRI grid header lacks '{what}'"));
+    let missing =
+        |what: &str| InputError::malformed(file, format!("ESRI grid header lacks '{what}'"));
     let ncols = h.ncols.ok_or_else(|| missing("ncols"))?;
     let nrows = h.nrows.ok_or_else(|| missing("nrows"))?;
     let (x, x_corner) = h.x.ok_or_else(|| missing("xllcorner"))?;
@@ -82,7 +89,10 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Grid, InputError> {
         _ => return Err(missing("cellsize")),
     };
     if !(dx > 0.0 && dy > 0.0 && dx.is_finite() && dy.is_finite()) {
-        return Err(InputError::malformed(file, format!("cell size must be positive, got {dx} x {dy}")));
+        return Err(InputError::malformed(
+            file,
+            format!("cell size must be positive, got {dx} x {dy}"),
+        ));
     }
     let total = (ncols as u64).saturating_mul(nrows as u64);
     check_vertex_count(file, total)?;
@@ -101,14 +111,21 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Grid, InputError> {
         }
         let v = token.parse::<f64>().map_err(|_| {
             let (r, c) = (values.len() / ncols.max(1), values.len() % ncols.max(1));
-            InputError::line(file, line, format!("invalid value '{token}' at row {r}, column {c}"))
+            InputError::line(
+                file,
+                line,
+                format!("invalid value '{token}' at row {r}, column {c}"),
+            )
         })?;
         values.push(v);
     }
     if values.len() < total {
         return Err(InputError::malformed(
             file,
-            format!("expected {nrows} x {ncols} = {total} values, found {} (file ends at line {last_line})", values.len()),
+            format!(
+                "expected {nrows} x {ncols} = {total} values, found {} (file ends at line {last_line})",
+                values.len()
+            ),
         ));
     }
     let south_west = [
@@ -152,7 +169,11 @@ mod tests {
 
     #[test]
     fn centre_origin_and_dx_dy() {
-        let g = parse("ncols 2\nnrows 2\nxllcenter 1\nyllcenter 2\ndx 0.5\ndy 0.25\n1 2 3 4\n", "t.asc").unwrap();
+        let g = parse(
+            "ncols 2\nnrows 2\nxllcenter 1\nyllcenter 2\ndx 0.5\ndy 0.25\n1 2 3 4\n",
+            "t.asc",
+        )
+        .unwrap();
         assert_eq!(g.origin, [1.0, 2.0]);
         assert_eq!(g.spacing, [0.5, 0.25]);
     }
@@ -160,13 +181,34 @@ mod tests {
     #[test]
     fn errors_name_the_line() {
         let cases = [
-            ("ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 x\n", "t.asc: line 6: invalid value 'x' at row 0, column 1"),
-            ("ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n", "t.asc: line 7: unexpected value '3' after the 2 grid values"),
-            ("ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n", "t.asc: expected 2 x 2 = 4 values, found 3 (file ends at line 7)"),
-            ("ncols two\n", "t.asc: line 1: invalid value 'two' for 'ncols'"),
-            ("ncols 2\nnrows 2\nxllcorner 0\ncellsize 1\n1 2 3 4\n", "t.asc: ESRI grid header lacks 'yllcorner'"),
-            ("ncols 2\nfoo 1\n", "t.asc: line 2: unknown header key 'foo'"),
-            ("ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize -1\n1 2 3 4\n", "t.asc: cell size must be positive, got -1 x -1"),
+            (
+                "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 x\n",
+                "t.asc: line 6: invalid value 'x' at row 0, column 1",
+            ),
+            (
+                "ncols 2\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n",
+                "t.asc: line 7: unexpected value '3' after the 2 grid values",
+            ),
+            (
+                "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3\n",
+                "t.asc: expected 2 x 2 = 4 values, found 3 (file ends at line 7)",
+            ),
+            (
+                "ncols two\n",
+                "t.asc: line 1: invalid value 'two' for 'ncols'",
+            ),
+            (
+                "ncols 2\nnrows 2\nxllcorner 0\ncellsize 1\n1 2 3 4\n",
+                "t.asc: ESRI grid header lacks 'yllcorner'",
+            ),
+            (
+                "ncols 2\nfoo 1\n",
+                "t.asc: line 2: unknown header key 'foo'",
+            ),
+            (
+                "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize -1\n1 2 3 4\n",
+                "t.asc: cell size must be positive, got -1 x -1",
+            ),
         ];
         for (text, expected) in cases {
             assert_eq!(parse(text, "t.asc").unwrap_err().to_string(), expected);

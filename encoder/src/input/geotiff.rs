@@ -33,8 +33,16 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
     let (width, height) = decoder.dimensions().map_err(bad)?;
     let (cols, rows) = (width as usize, height as usize);
     check_vertex_count(file, width as u64 * height as u64)?;
-    let samples = decoder.find_tag_unsigned::<u16>(Tag::SamplesPerPixel).map_err(bad)?.unwrap_or(1).max(1) as usize;
-    let planar = decoder.find_tag_unsigned::<u16>(Tag::PlanarConfiguration).map_err(bad)?.unwrap_or(1) == 2;
+    let samples = decoder
+        .find_tag_unsigned::<u16>(Tag::SamplesPerPixel)
+        .map_err(bad)?
+        .unwrap_or(1)
+        .max(1) as usize;
+    let planar = decoder
+        .find_tag_unsigned::<u16>(Tag::PlanarConfiguration)
+        .map_err(bad)?
+        .unwrap_or(1)
+        == 2;
 
     let f64_tag = |decoder: &mut Decoder<_>, tag| -> Result<Option<Vec<f64>>, InputError> {
         match decoder.find_tag(tag).map_err(bad)? {
@@ -48,10 +56,9 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
     let pixel_is_point = match decoder.find_tag(Tag::GeoKeyDirectoryTag).map_err(bad)? {
         Some(v) => {
             let keys = v.into_u16_vec().map_err(bad)?;
-            keys.get(4..)
-                .unwrap_or(&[])
-                .chunks_exact(4)
-                .any(|k| k[0] == GT_RASTER_TYPE_GEO_KEY && k[1] == 0 && k[3] == RASTER_PIXEL_IS_POINT)
+            keys.get(4..).unwrap_or(&[]).chunks_exact(4).any(|k| {
+                k[0] == GT_RASTER_TYPE_GEO_KEY && k[1] == 0 && k[3] == RASTER_PIXEL_IS_POINT
+            })
         }
         None => false,
     };
@@ -59,10 +66,9 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
         Some(v) => {
             let text = v.into_string().map_err(bad)?;
             let text = text.trim_matches(|c: char| c.is_whitespace() || c == '\0');
-            Some(
-                text.parse::<f64>()
-                    .map_err(|_| InputError::malformed(file, format!("GDAL_NODATA '{text}' is not a number")))?,
-            )
+            Some(text.parse::<f64>().map_err(|_| {
+                InputError::malformed(file, format!("GDAL_NODATA '{text}' is not a number"))
+            })?)
         }
         None => None,
     };
@@ -70,11 +76,19 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
     let image = decoder.read_image().map_err(bad)?;
     let all = to_f64(image);
     let stride = if planar { 1 } else { samples };
-    let values: Vec<f64> = all.iter().step_by(stride).take(rows * cols).copied().collect();
+    let values: Vec<f64> = all
+        .iter()
+        .step_by(stride)
+        .take(rows * cols)
+        .copied()
+        .collect();
     if values.len() != rows * cols {
         return Err(InputError::malformed(
             file,
-            format!("image holds {} samples, expected {rows} x {cols}", values.len()),
+            format!(
+                "image holds {} samples, expected {rows} x {cols}",
+                values.len()
+            ),
         ));
     }
 
@@ -86,7 +100,10 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
         }
         (_, _, Some(m)) if m.len() >= 8 => {
             if m[1] != 0.0 || m[4] != 0.0 {
-                return Err(InputError::unsupported(file, "rotated or sheared ModelTransformationTag"));
+                return Err(InputError::unsupported(
+                    file,
+                    "rotated or sheared ModelTransformationTag",
+                ));
             }
             (true, m[3], m[7], m[0], -m[5])
         }
@@ -97,12 +114,18 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
     // sample at (0, 0).
     let half = if pixel_is_point { 0.0 } else { 0.5 };
     let (west, south) = if georeferenced {
-        (x0 + half * sx, y0 - (rows.saturating_sub(1) as f64 + half) * sy)
+        (
+            x0 + half * sx,
+            y0 - (rows.saturating_sub(1) as f64 + half) * sy,
+        )
     } else {
         (0.0, 0.0)
     };
     if !(sx.is_finite() && sy.is_finite() && sx != 0.0 && sy != 0.0) {
-        return Err(InputError::malformed(file, format!("invalid pixel scale {sx} x {sy}")));
+        return Err(InputError::malformed(
+            file,
+            format!("invalid pixel scale {sx} x {sy}"),
+        ));
     }
     Grid::from_north_first(rows, cols, values, [west, south], [sx, sy], nodata)
         .ok_or_else(|| InputError::malformed(file, "image size mismatch"))
@@ -146,10 +169,16 @@ mod tests {
         let mut enc = TiffEncoder::new(&mut buf).unwrap();
         let mut image = enc.new_image::<C>(3, 2).unwrap();
         if geo {
-            image.encoder().write_tag(Tag::ModelPixelScaleTag, &[10.0f64, 20.0, 0.0][..]).unwrap();
             image
                 .encoder()
-                .write_tag(Tag::ModelTiepointTag, &[0.0f64, 0.0, 0.0, 1000.0, 5000.0, 0.0][..])
+                .write_tag(Tag::ModelPixelScaleTag, &[10.0f64, 20.0, 0.0][..])
+                .unwrap();
+            image
+                .encoder()
+                .write_tag(
+                    Tag::ModelTiepointTag,
+                    &[0.0f64, 0.0, 0.0, 1000.0, 5000.0, 0.0][..],
+                )
                 .unwrap();
         }
         if let Some(nd) = nodata {
@@ -183,7 +212,11 @@ mod tests {
 
     #[test]
     fn plain_tiff_and_nodata() {
-        let bytes = write::<colortype::Gray32Float>(&[1.0, -9999.0, 3.0, 4.0, 5.0, 6.0], false, Some("-9999"));
+        let bytes = write::<colortype::Gray32Float>(
+            &[1.0, -9999.0, 3.0, 4.0, 5.0, 6.0],
+            false,
+            Some("-9999"),
+        );
         let f = TempFile::new("plain.tiff", &bytes);
         let g = read(&f.0, "plain.tiff").unwrap();
         assert_eq!(g.spacing, [1.0, 1.0]);
@@ -200,7 +233,12 @@ mod tests {
     fn rgb_takes_first_band_and_garbage_fails() {
         let mut buf = Cursor::new(Vec::new());
         let mut enc = TiffEncoder::new(&mut buf).unwrap();
-        enc.write_image::<colortype::RGB8>(2, 2, &[1, 100, 100, 2, 100, 100, 3, 100, 100, 4, 100, 100]).unwrap();
+        enc.write_image::<colortype::RGB8>(
+            2,
+            2,
+            &[1, 100, 100, 2, 100, 100, 3, 100, 100, 4, 100, 100],
+        )
+        .unwrap();
         let f = TempFile::new("rgb.tif", &buf.into_inner());
         let g = read(&f.0, "rgb.tif").unwrap();
         assert_eq!(g.elevations, vec![3.0, 4.0, 1.0, 2.0]);

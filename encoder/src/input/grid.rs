@@ -94,8 +94,16 @@ impl Grid {
 pub fn grid_to_mesh(grid: &Grid) -> Mesh {
     let (rows, cols) = (grid.rows, grid.cols);
     let n = rows.checked_mul(cols).expect("grid size overflows usize");
-    assert_eq!(grid.elevations.len(), n, "grid has {} samples, expected {rows} x {cols}", grid.elevations.len());
-    assert!(n as u64 <= u32::MAX as u64 + 1, "grid too large for 32-bit indices");
+    assert_eq!(
+        grid.elevations.len(),
+        n,
+        "grid has {} samples, expected {rows} x {cols}",
+        grid.elevations.len()
+    );
+    assert!(
+        n as u64 <= u32::MAX as u64 + 1,
+        "grid too large for 32-bit indices"
+    );
 
     let [x0, y0] = grid.origin;
     let [dx, dy] = grid.spacing;
@@ -124,12 +132,19 @@ pub fn grid_to_mesh(grid: &Grid) -> Mesh {
                 if !all_valid && !tri.iter().all(|&v| grid.is_valid(v as usize)) {
                     continue;
                 }
-                triangles.push(if mirrored { [tri[0], tri[2], tri[1]] } else { tri });
+                triangles.push(if mirrored {
+                    [tri[0], tri[2], tri[1]]
+                } else {
+                    tri
+                });
             }
         }
     }
 
-    let mut mesh = Mesh { positions, triangles };
+    let mut mesh = Mesh {
+        positions,
+        triangles,
+    };
     if !all_valid {
         remove_unreferenced(&mut mesh);
         split_nonmanifold_vertices(&mut mesh);
@@ -207,7 +222,15 @@ mod tests {
 
     #[test]
     fn north_first_rows_are_flipped() {
-        let g = Grid::from_north_first(3, 2, vec![1., 2., 3., 4., 5., 6.], [0.0, 0.0], [1.0, 1.0], None).unwrap();
+        let g = Grid::from_north_first(
+            3,
+            2,
+            vec![1., 2., 3., 4., 5., 6.],
+            [0.0, 0.0],
+            [1.0, 1.0],
+            None,
+        )
+        .unwrap();
         assert_eq!(g.elevations, vec![5., 6., 3., 4., 1., 2.]);
         assert!(Grid::from_north_first(3, 2, vec![1.0], [0.0, 0.0], [1.0, 1.0], None).is_none());
     }

@@ -107,12 +107,17 @@ where
     scratch.clear();
     for i in indices {
         if i < 0 || i as u64 >= vertex_count as u64 {
-            return Err(format!("vertex index {i} out of range (the file has {vertex_count} vertices)"));
+            return Err(format!(
+                "vertex index {i} out of range (the file has {vertex_count} vertices)"
+            ));
         }
         scratch.push(i as u32);
     }
     if scratch.len() < 3 {
-        return Err(format!("polygon with {} vertices (at least 3 needed)", scratch.len()));
+        return Err(format!(
+            "polygon with {} vertices (at least 3 needed)",
+            scratch.len()
+        ));
     }
     for k in 1..scratch.len() - 1 {
         triangles.push([scratch[0], scratch[k], scratch[k + 1]]);
@@ -146,7 +151,10 @@ pub(crate) mod test_util {
         pub fn new(name: &str, contents: &[u8]) -> TempFile {
             static COUNTER: AtomicUsize = AtomicUsize::new(0);
             let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-            let path = std::env::temp_dir().join(format!("splitstream-input-{}-{n}-{name}", std::process::id()));
+            let path = std::env::temp_dir().join(format!(
+                "splitstream-input-{}-{n}-{name}",
+                std::process::id()
+            ));
             std::fs::write(&path, contents).expect("write temp file");
             TempFile(path)
         }
@@ -185,7 +193,10 @@ mod tests {
     #[test]
     fn empty_and_garbage_files_fail_cleanly() {
         for ext in SUPPORTED_EXTENSIONS {
-            for (i, contents) in [&b""[..], b"\x00\x01garbage\xff\xfe\nmore garbage 1 2 3\n"].iter().enumerate() {
+            for (i, contents) in [&b""[..], b"\x00\x01garbage\xff\xfe\nmore garbage 1 2 3\n"]
+                .iter()
+                .enumerate()
+            {
                 let f = TempFile::new(&format!("garbage{i}.{ext}"), contents);
                 let result = read_mesh(&f.0, &ReadOptions::default());
                 // OBJ without vertices or faces is an empty mesh, not an error.
@@ -202,14 +213,25 @@ mod tests {
 
     #[test]
     fn z_scale_and_spacing_options() {
-        let f = TempFile::new("g.asc", b"ncols 2\nnrows 2\nxllcenter 0\nyllcenter 0\ncellsize 1\n1 2\n3 4\n");
+        let f = TempFile::new(
+            "g.asc",
+            b"ncols 2\nnrows 2\nxllcenter 0\nyllcenter 0\ncellsize 1\n1 2\n3 4\n",
+        );
         let options = ReadOptions {
             z_scale: 2.0,
             grid_spacing: Some((10.0, 20.0)),
             ..ReadOptions::default()
         };
         let m = read_mesh(&f.0, &options).unwrap();
-        assert_eq!(m.positions, vec![[0.0, 0.0, 6.0], [10.0, 0.0, 8.0], [0.0, 20.0, 2.0], [10.0, 20.0, 4.0]]);
+        assert_eq!(
+            m.positions,
+            vec![
+                [0.0, 0.0, 6.0],
+                [10.0, 0.0, 8.0],
+                [0.0, 20.0, 2.0],
+                [10.0, 20.0, 4.0]
+            ]
+        );
     }
 
     #[test]
@@ -218,8 +240,16 @@ mod tests {
         let mut scratch = Vec::new();
         push_polygon(&mut tris, [0, 1, 2, 3, 4], 5, &mut scratch).unwrap();
         assert_eq!(tris, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
-        assert!(push_polygon(&mut tris, [0, 5, 1], 5, &mut scratch).unwrap_err().contains("index 5"));
+        assert!(
+            push_polygon(&mut tris, [0, 5, 1], 5, &mut scratch)
+                .unwrap_err()
+                .contains("index 5")
+        );
         assert!(push_polygon(&mut tris, [0, -1, 1], 5, &mut scratch).is_err());
-        assert!(push_polygon(&mut tris, [0, 1], 5, &mut scratch).unwrap_err().contains("2 vertices"));
+        assert!(
+            push_polygon(&mut tris, [0, 1], 5, &mut scratch)
+                .unwrap_err()
+                .contains("2 vertices")
+        );
     }
 }

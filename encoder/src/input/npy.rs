@@ -24,7 +24,8 @@ use super::{InputError, check_vertex_count};
 
 pub(super) fn read_npy(path: &Path, file: &str) -> Result<Grid, InputError> {
     let f = File::open(path).map_err(|e| InputError::io(file, e))?;
-    let npy = NpyFile::new(BufReader::new(f)).map_err(|e| InputError::malformed(file, format!("invalid .npy: {e}")))?;
+    let npy = NpyFile::new(BufReader::new(f))
+        .map_err(|e| InputError::malformed(file, format!("invalid .npy: {e}")))?;
     let (rows, cols, values) = read_2d(npy, file, "array")?;
     north_first_grid(file, rows, cols, values, [0.0, 0.0], [1.0, 1.0])
 }
@@ -42,7 +43,11 @@ fn north_first_grid(
 }
 
 /// Shape and values (row-major, as f64) of a 2-D array.
-fn read_2d<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<(usize, usize, Vec<f64>), InputError> {
+fn read_2d<R: Read>(
+    npy: NpyFile<R>,
+    file: &str,
+    name: &str,
+) -> Result<(usize, usize, Vec<f64>), InputError> {
     let shape = npy.shape().to_vec();
     let [rows, cols] = shape[..] else {
         return Err(InputError::malformed(
@@ -57,7 +62,10 @@ fn read_2d<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<(usize, u
     if values.len() != rows * cols {
         return Err(InputError::malformed(
             file,
-            format!("{name} has {} values, expected {rows} x {cols}", values.len()),
+            format!(
+                "{name} has {} values, expected {rows} x {cols}",
+                values.len()
+            ),
         ));
     }
     if fortran {
@@ -76,7 +84,10 @@ fn read_2d<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<(usize, u
 fn read_values<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<Vec<f64>, InputError> {
     let dtype = npy.dtype();
     let DType::Plain(ts) = &dtype else {
-        return Err(InputError::unsupported(file, format!("{name} has a structured dtype")));
+        return Err(InputError::unsupported(
+            file,
+            format!("{name} has a structured dtype"),
+        ));
     };
     let err = |e: std::io::Error| InputError::malformed(file, format!("cannot read {name}: {e}"));
     fn widen<T: Copy + Into<f64>>(v: Vec<T>) -> Vec<f64> {
@@ -88,26 +99,45 @@ fn read_values<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<Vec<f
         (TypeChar::Int, 1) => widen(npy.into_vec::<i8>().map_err(err)?),
         (TypeChar::Int, 2) => widen(npy.into_vec::<i16>().map_err(err)?),
         (TypeChar::Int, 4) => widen(npy.into_vec::<i32>().map_err(err)?),
-        (TypeChar::Int, 8) => npy.into_vec::<i64>().map_err(err)?.into_iter().map(|v| v as f64).collect(),
+        (TypeChar::Int, 8) => npy
+            .into_vec::<i64>()
+            .map_err(err)?
+            .into_iter()
+            .map(|v| v as f64)
+            .collect(),
         (TypeChar::Uint, 1) => widen(npy.into_vec::<u8>().map_err(err)?),
         (TypeChar::Uint, 2) => widen(npy.into_vec::<u16>().map_err(err)?),
         (TypeChar::Uint, 4) => widen(npy.into_vec::<u32>().map_err(err)?),
-        (TypeChar::Uint, 8) => npy.into_vec::<u64>().map_err(err)?.into_iter().map(|v| v as f64).collect(),
-        _ => return Err(InputError::unsupported(file, format!("{name} has dtype '{ts}'"))),
+        (TypeChar::Uint, 8) => npy
+            .into_vec::<u64>()
+            .map_err(err)?
+            .into_iter()
+            .map(|v| v as f64)
+            .collect(),
+        _ => {
+            return Err(InputError::unsupported(
+                file,
+                format!("{name} has dtype '{ts}'"),
+            ));
+        }
     })
 }
 
 pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<Grid, InputError> {
     let bad = |e: std::io::Error| InputError::malformed(file, format!("invalid .npz: {e}"));
     let mut archive = NpzArchive::open(path).map_err(|e| match e.kind() {
-        std::io::ErrorKind::NotFound | std::io::ErrorKind::PermissionDenied => InputError::io(file, e),
+        std::io::ErrorKind::NotFound | std::io::ErrorKind::PermissionDenied => {
+            InputError::io(file, e)
+        }
         _ => bad(e),
     })?;
     // Archive order (array_names() iterates a hash map).
     let zip = archive.zip_archive();
     let mut names = Vec::new();
     for i in 0..zip.len() {
-        let entry = zip.by_index(i).map_err(|e| InputError::malformed(file, format!("invalid .npz: {e}")))?;
+        let entry = zip
+            .by_index(i)
+            .map_err(|e| InputError::malformed(file, format!("invalid .npz: {e}")))?;
         if let Some(name) = npyz::npz::array_name_from_file_name(entry.name()) {
             names.push(name.to_owned());
         }
@@ -133,7 +163,15 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
                     break;
                 }
             }
-            found.ok_or_else(|| InputError::malformed(file, format!("no two-dimensional array in the archive (arrays: {})", names.join(", "))))?
+            found.ok_or_else(|| {
+                InputError::malformed(
+                    file,
+                    format!(
+                        "no two-dimensional array in the archive (arrays: {})",
+                        names.join(", ")
+                    ),
+                )
+            })?
         }
     };
     let npy = archive
@@ -164,12 +202,19 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
     let dx = dx.unwrap_or(1.0);
     let dy = dy.or(dx.into()).unwrap_or(1.0);
     if !(dx.is_finite() && dy.is_finite() && dx != 0.0 && dy != 0.0) {
-        return Err(InputError::malformed(file, format!("invalid spacing dx={dx}, dy={dy}")));
+        return Err(InputError::malformed(
+            file,
+            format!("invalid spacing dx={dx}, dy={dy}"),
+        ));
     }
     let (dx, dy) = (dx.abs(), dy.abs());
     let x0 = xmin.unwrap_or(0.0);
     // Columns run toward xmax, so a reversed x extent mirrors them.
-    let dx = if xmax.zip(xmin).is_some_and(|(hi, lo)| hi < lo) { -dx } else { dx };
+    let dx = if xmax.zip(xmin).is_some_and(|(hi, lo)| hi < lo) {
+        -dx
+    } else {
+        dx
+    };
     let y0 = ymin.unwrap_or(0.0);
     let grid = match ymax {
         // Rows run north from ymin: row 0 is the southern edge.
@@ -182,7 +227,14 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
             nodata: None,
         },
         // Rows run south from ymin (jacksboro), or no ymax: ymin is the south edge.
-        Some(_) => north_first_grid(file, rows, cols, values, [x0, y0 - rows.saturating_sub(1) as f64 * dy], [dx, dy])?,
+        Some(_) => north_first_grid(
+            file,
+            rows,
+            cols,
+            values,
+            [x0, y0 - rows.saturating_sub(1) as f64 * dy],
+            [dx, dy],
+        )?,
         None => north_first_grid(file, rows, cols, values, [x0, y0], [dx, dy])?,
     };
     Ok(grid)
@@ -196,7 +248,10 @@ mod tests {
 
     /// A minimal .npy file: version 1.0 header, padded to 64 bytes.
     fn npy_bytes(descr: &str, fortran: bool, shape: &str, data: &[u8]) -> Vec<u8> {
-        let mut header = format!("{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}", if fortran { "True" } else { "False" });
+        let mut header = format!(
+            "{{'descr': '{descr}', 'fortran_order': {}, 'shape': {shape}, }}",
+            if fortran { "True" } else { "False" }
+        );
         while (10 + header.len() + 1) % 64 != 0 {
             header.push(' ');
         }
@@ -217,11 +272,36 @@ mod tests {
         // 2 rows x 3 cols, row 0 = north = [1, 2, 3].
         let expect_south_first = vec![4.0, 5.0, 6.0, 1.0, 2.0, 3.0];
         let cases = [
-            npy_bytes("<f4", false, "(2, 3)", &le(&[1f32, 2., 3., 4., 5., 6.], f32::to_le_bytes)),
-            npy_bytes(">f8", false, "(2, 3)", &le(&[1f64, 2., 3., 4., 5., 6.], f64::to_be_bytes)),
-            npy_bytes("<i2", false, "(2, 3)", &le(&[1i16, 2, 3, 4, 5, 6], i16::to_le_bytes)),
-            npy_bytes("<u2", true, "(2, 3)", &le(&[1u16, 4, 2, 5, 3, 6], u16::to_le_bytes)),
-            npy_bytes("<i8", false, "(2, 3)", &le(&[1i64, 2, 3, 4, 5, 6], i64::to_le_bytes)),
+            npy_bytes(
+                "<f4",
+                false,
+                "(2, 3)",
+                &le(&[1f32, 2., 3., 4., 5., 6.], f32::to_le_bytes),
+            ),
+            npy_bytes(
+                ">f8",
+                false,
+                "(2, 3)",
+                &le(&[1f64, 2., 3., 4., 5., 6.], f64::to_be_bytes),
+            ),
+            npy_bytes(
+                "<i2",
+                false,
+                "(2, 3)",
+                &le(&[1i16, 2, 3, 4, 5, 6], i16::to_le_bytes),
+            ),
+            npy_bytes(
+                "<u2",
+                true,
+                "(2, 3)",
+                &le(&[1u16, 4, 2, 5, 3, 6], u16::to_le_bytes),
+            ),
+            npy_bytes(
+                "<i8",
+                false,
+                "(2, 3)",
+                &le(&[1i64, 2, 3, 4, 5, 6], i64::to_le_bytes),
+            ),
             npy_bytes("|u1", false, "(2, 3)", &[1, 2, 3, 4, 5, 6]),
         ];
         for (i, bytes) in cases.iter().enumerate() {
@@ -240,14 +320,20 @@ mod tests {
     fn npy_errors() {
         let cases = [
             (npy_bytes("<f4", false, "(6,)", &[0; 24]), "two-dimensional"),
-            (npy_bytes("<f4", false, "(2, 3)", &[0; 10]), "cannot read array"),
+            (
+                npy_bytes("<f4", false, "(2, 3)", &[0; 10]),
+                "cannot read array",
+            ),
             (npy_bytes("<c8", false, "(1, 1)", &[0; 8]), "unsupported"),
             (b"\x93NUMPY\x01".to_vec(), "invalid .npy"),
         ];
         for (bytes, needle) in cases {
             let f = TempFile::new("bad.npy", &bytes);
             let msg = read_npy(&f.0, "bad.npy").unwrap_err().to_string();
-            assert!(msg.starts_with("bad.npy: ") && msg.contains(needle), "{msg}");
+            assert!(
+                msg.starts_with("bad.npy: ") && msg.contains(needle),
+                "{msg}"
+            );
         }
     }
 
@@ -299,7 +385,12 @@ mod tests {
 
     #[test]
     fn npz_uses_metadata_like_jacksboro() {
-        let elevation = npy_bytes("<i2", false, "(2, 3)", &le(&[1i16, 2, 3, 4, 5, 6], i16::to_le_bytes));
+        let elevation = npy_bytes(
+            "<i2",
+            false,
+            "(2, 3)",
+            &le(&[1i16, 2, 3, 4, 5, 6], i16::to_le_bytes),
+        );
         let bytes = npz(&[
             ("dx", scalar(0.5)),
             ("elevation", elevation.clone()),
@@ -307,7 +398,10 @@ mod tests {
             ("xmin", scalar(-84.0)),
             ("ymin", scalar(36.5)),
             ("ymax", scalar(36.0)),
-            ("other", npy_bytes("<f8", false, "(1, 1)", &1f64.to_le_bytes())),
+            (
+                "other",
+                npy_bytes("<f8", false, "(1, 1)", &1f64.to_le_bytes()),
+            ),
         ]);
         let f = TempFile::new("dem.npz", &bytes);
         let g = read_npz(&f.0, "dem.npz", None).unwrap();
@@ -321,14 +415,22 @@ mod tests {
         // Named array, missing array, no 2-D array.
         let g = read_npz(&f.0, "dem.npz", Some("other")).unwrap();
         assert_eq!((g.rows, g.cols), (1, 1));
-        let msg = read_npz(&f.0, "dem.npz", Some("nope")).unwrap_err().to_string();
-        assert!(msg.contains("no array named 'nope'") && msg.contains("dx, elevation"), "{msg}");
+        let msg = read_npz(&f.0, "dem.npz", Some("nope"))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("no array named 'nope'") && msg.contains("dx, elevation"),
+            "{msg}"
+        );
         let f2 = TempFile::new("flat.npz", &npz(&[("dx", scalar(1.0))]));
         let msg = read_npz(&f2.0, "flat.npz", None).unwrap_err().to_string();
         assert!(msg.contains("no two-dimensional array"), "{msg}");
 
         // Without ymax, ymin is the south edge; rows still run north to south.
-        let f3 = TempFile::new("plain.npz", &npz(&[("elevation", elevation), ("ymin", scalar(10.0))]));
+        let f3 = TempFile::new(
+            "plain.npz",
+            &npz(&[("elevation", elevation), ("ymin", scalar(10.0))]),
+        );
         let g = read_npz(&f3.0, "plain.npz", None).unwrap();
         assert_eq!(g.origin, [0.0, 10.0]);
         assert_eq!(g.spacing, [1.0, 1.0]);

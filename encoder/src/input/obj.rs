@@ -42,21 +42,19 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
         ignore_points: true,
         ignore_lines: true,
     };
-    let (models, _materials) = tobj::load_obj_buf(&mut Cursor::new(filtered.as_bytes()), &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| InputError::malformed(file, format!("invalid OBJ: {e}")))?;
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut Cursor::new(filtered.as_bytes()), &options, |_| {
+            Err(tobj::LoadError::OpenFileFailed)
+        })
+        .map_err(|e| InputError::malformed(file, format!("invalid OBJ: {e}")))?;
 
     let mut mesh = Mesh::default();
     for model in models {
         let base = mesh.positions.len() as u64;
         let positions = &model.mesh.positions;
         check_vertex_count(file, base + positions.len() as u64 / 3)?;
-        mesh.positions.extend(
-            positions
-                .chunks_exact(3)
-                .map(|p| [p[0], p[1], p[2]]),
-        );
+        mesh.positions
+            .extend(positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
         mesh.triangles.extend(
             model
                 .mesh
@@ -85,13 +83,21 @@ vt 0 0\nvn 0 0 1\no first\ng a\nusemtl red\nf 1/1/1 2/1/1 3/1/1 4/1/1\ng b\nf -4
         let stats = check_mesh(&m).unwrap();
         assert_eq!(stats.components, 1);
         // Geographic precision survives (tobj built with f64 positions).
-        let m = parse("v 12345678.123456 -0.1 1e-9\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "p.obj").unwrap();
+        let m = parse(
+            "v 12345678.123456 -0.1 1e-9\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+            "p.obj",
+        )
+        .unwrap();
         assert_eq!(m.positions[0], [12345678.123456, -0.1, 1e-9]);
     }
 
     #[test]
     fn bad_indices_fail() {
-        for text in ["v 0 0 0\nf 1 2 3\n", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n", "v 0 0\n"] {
+        for text in [
+            "v 0 0 0\nf 1 2 3\n",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n",
+            "v 0 0\n",
+        ] {
             let msg = parse(text, "bad.obj").unwrap_err().to_string();
             assert!(msg.starts_with("bad.obj: invalid OBJ: "), "{msg}");
         }

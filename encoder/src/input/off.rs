@@ -24,7 +24,12 @@ fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
         .filter(|(_, l)| !l.is_empty())
 }
 
-fn parse_count(file: &str, line: usize, token: Option<&str>, what: &str) -> Result<usize, InputError> {
+fn parse_count(
+    file: &str,
+    line: usize,
+    token: Option<&str>,
+    what: &str,
+) -> Result<usize, InputError> {
     let token = token.ok_or_else(|| InputError::line(file, line, format!("missing {what}")))?;
     token
         .parse::<usize>()
@@ -38,15 +43,27 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
         .ok_or_else(|| InputError::malformed(file, "empty file (expected an 'OFF' header)"))?;
     let mut tokens = header.split_whitespace();
     let keyword = tokens.next().unwrap_or("");
-    let known = ["OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF"];
+    let known = [
+        "OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF",
+    ];
     if !known.contains(&keyword) {
         if keyword.ends_with("OFF") {
-            return Err(InputError::unsupported(file, format!("OFF variant '{keyword}'")));
+            return Err(InputError::unsupported(
+                file,
+                format!("OFF variant '{keyword}'"),
+            ));
         }
-        return Err(InputError::line(file, line_no, format!("expected an 'OFF' header, found '{keyword}'")));
+        return Err(InputError::line(
+            file,
+            line_no,
+            format!("expected an 'OFF' header, found '{keyword}'"),
+        ));
     }
     let mut rest: Vec<&str> = tokens.collect();
-    if rest.first().is_some_and(|t| t.eq_ignore_ascii_case("BINARY")) {
+    if rest
+        .first()
+        .is_some_and(|t| t.eq_ignore_ascii_case("BINARY"))
+    {
         return Err(InputError::unsupported(file, "binary OFF"));
     }
     let mut counts_line = line_no;
@@ -66,19 +83,27 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
     let mut last_line = counts_line;
     for i in 0..nv {
         let (n, l) = lines.next().ok_or_else(|| {
-            InputError::line(file, last_line, format!("file ends after {i} of {nv} vertices"))
+            InputError::line(
+                file,
+                last_line,
+                format!("file ends after {i} of {nv} vertices"),
+            )
         })?;
         last_line = n;
         let mut p = [0.0; 3];
         let mut found = 0;
         for (k, token) in l.split_whitespace().take(3).enumerate() {
-            p[k] = token
-                .parse::<f64>()
-                .map_err(|_| InputError::line(file, n, format!("vertex {i}: invalid coordinate '{token}'")))?;
+            p[k] = token.parse::<f64>().map_err(|_| {
+                InputError::line(file, n, format!("vertex {i}: invalid coordinate '{token}'"))
+            })?;
             found += 1;
         }
         if found < 3 {
-            return Err(InputError::line(file, n, format!("expected 3 coordinates, found {found}")));
+            return Err(InputError::line(
+                file,
+                n,
+                format!("expected 3 coordinates, found {found}"),
+            ));
         }
         positions.push(p);
     }
@@ -86,26 +111,40 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
     let mut triangles = Vec::with_capacity(nf.min(1 << 24));
     let mut scratch = Vec::new();
     for i in 0..nf {
-        let (n, l) = lines
-            .next()
-            .ok_or_else(|| InputError::line(file, last_line, format!("file ends after {i} of {nf} faces")))?;
+        let (n, l) = lines.next().ok_or_else(|| {
+            InputError::line(
+                file,
+                last_line,
+                format!("file ends after {i} of {nf} faces"),
+            )
+        })?;
         last_line = n;
         let mut tokens = l.split_whitespace();
         let count = parse_count(file, n, tokens.next(), "face vertex count")?;
         let mut indices = Vec::with_capacity(count);
         for _ in 0..count {
             let token = tokens.next().ok_or_else(|| {
-                InputError::line(file, n, format!("face {i}: expected {count} vertex indices, found {}", indices.len()))
+                InputError::line(
+                    file,
+                    n,
+                    format!(
+                        "face {i}: expected {count} vertex indices, found {}",
+                        indices.len()
+                    ),
+                )
             })?;
-            let index = token
-                .parse::<i64>()
-                .map_err(|_| InputError::line(file, n, format!("face {i}: invalid vertex index '{token}'")))?;
+            let index = token.parse::<i64>().map_err(|_| {
+                InputError::line(file, n, format!("face {i}: invalid vertex index '{token}'"))
+            })?;
             indices.push(index);
         }
         push_polygon(&mut triangles, indices, nv, &mut scratch)
             .map_err(|m| InputError::line(file, n, format!("face {i}: {m}")))?;
     }
-    Ok(Mesh { positions, triangles })
+    Ok(Mesh {
+        positions,
+        triangles,
+    })
 }
 
 #[cfg(test)]
@@ -127,20 +166,45 @@ mod tests {
 
     #[test]
     fn counts_on_next_line() {
-        let m = parse("COFF\n3 1 3\n0 0 0 1 1 1 1\n1 0 0 1 1 1 1\n0 1 0 1 1 1 1\n3 0 1 2\n", "t.off").unwrap();
+        let m = parse(
+            "COFF\n3 1 3\n0 0 0 1 1 1 1\n1 0 0 1 1 1 1\n0 1 0 1 1 1 1\n3 0 1 2\n",
+            "t.off",
+        )
+        .unwrap();
         assert_eq!(m.triangles, vec![[0, 1, 2]]);
     }
 
     #[test]
     fn errors_name_the_line() {
         let cases = [
-            ("OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n", "bunny.off: line 4: expected 3 coordinates, found 2"),
-            ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n", "bunny.off: line 6: face 0: vertex index 5 out of range (the file has 3 vertices)"),
-            ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n", "bunny.off: line 6: face 0: expected 3 vertex indices, found 2"),
-            ("OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "bunny.off: line 6: file ends after 1 of 2 faces"),
-            ("OFF\n3 1 0\n0 0 0\n1 x 0\n", "bunny.off: line 4: vertex 1: invalid coordinate 'x'"),
-            ("OFF\nthree 1 0\n", "bunny.off: line 2: invalid vertex count 'three'"),
-            ("PLY\n", "bunny.off: line 1: expected an 'OFF' header, found 'PLY'"),
+            (
+                "OFF\n3 1 0\n0 0 0\n1 0\n0 1 0\n3 0 1 2\n",
+                "bunny.off: line 4: expected 3 coordinates, found 2",
+            ),
+            (
+                "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 5\n",
+                "bunny.off: line 6: face 0: vertex index 5 out of range (the file has 3 vertices)",
+            ),
+            (
+                "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1\n",
+                "bunny.off: line 6: face 0: expected 3 vertex indices, found 2",
+            ),
+            (
+                "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n",
+                "bunny.off: line 6: file ends after 1 of 2 faces",
+            ),
+            (
+                "OFF\n3 1 0\n0 0 0\n1 x 0\n",
+                "bunny.off: line 4: vertex 1: invalid coordinate 'x'",
+            ),
+            (
+                "OFF\nthree 1 0\n",
+                "bunny.off: line 2: invalid vertex count 'three'",
+            ),
+            (
+                "PLY\n",
+                "bunny.off: line 1: expected an 'OFF' header, found 'PLY'",
+            ),
             ("", "bunny.off: empty file (expected an 'OFF' header)"),
             ("OFF BINARY\n", "bunny.off: unsupported: binary OFF"),
             ("4OFF\n", "bunny.off: unsupported: OFF variant '4OFF'"),

@@ -42,7 +42,11 @@ impl Element {
         PropertyAccessResult::Set
     }
 
-    fn set_other_list(&mut self, name: &str, values: impl Iterator<Item = i64>) -> PropertyAccessResult {
+    fn set_other_list(
+        &mut self,
+        name: &str,
+        values: impl Iterator<Item = i64>,
+    ) -> PropertyAccessResult {
         if !is_index_list(name) {
             return PropertyAccessResult::Ignored;
         }
@@ -91,10 +95,18 @@ impl PropertyAccess for Element {
         PropertyAccessResult::Ignored
     }
     fn begin_list_int(&mut self, name: &str, _len: usize) -> BeginList<'_, i32> {
-        if is_index_list(name) { BeginList::Fill(&mut self.indices_i32) } else { BeginList::UseSetter }
+        if is_index_list(name) {
+            BeginList::Fill(&mut self.indices_i32)
+        } else {
+            BeginList::UseSetter
+        }
     }
     fn begin_list_uint(&mut self, name: &str, _len: usize) -> BeginList<'_, u32> {
-        if is_index_list(name) { BeginList::Fill(&mut self.indices_u32) } else { BeginList::UseSetter }
+        if is_index_list(name) {
+            BeginList::Fill(&mut self.indices_u32)
+        } else {
+            BeginList::UseSetter
+        }
     }
     fn set_list_char(&mut self, name: &str, v: Vec<i8>) -> PropertyAccessResult {
         self.set_other_list(name, v.into_iter().map(i64::from))
@@ -125,12 +137,17 @@ impl PropertyAccess for Element {
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let f = File::open(path).map_err(|e| InputError::io(file, e))?;
     let mut reader = BufReader::new(f);
-    let ply = Parser::<Element>::new().read_ply(&mut reader).map_err(|e| match e.line() {
-        Some(line) if e.kind() != std::io::ErrorKind::UnexpectedEof || line > 0 => {
-            InputError::malformed(file, format!("PLY line {line}: {}", strip_line_prefix(&e.to_string())))
-        }
-        _ => InputError::malformed(file, format!("invalid PLY: {e}")),
-    })?;
+    let ply = Parser::<Element>::new()
+        .read_ply(&mut reader)
+        .map_err(|e| match e.line() {
+            Some(line) if e.kind() != std::io::ErrorKind::UnexpectedEof || line > 0 => {
+                InputError::malformed(
+                    file,
+                    format!("PLY line {line}: {}", strip_line_prefix(&e.to_string())),
+                )
+            }
+            _ => InputError::malformed(file, format!("invalid PLY: {e}")),
+        })?;
 
     let vertex_def = ply
         .header
@@ -141,9 +158,17 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
         match vertex_def.properties.get(axis).map(|p| &p.data_type) {
             Some(PropertyType::Scalar(_)) => {}
             Some(PropertyType::List(..)) => {
-                return Err(InputError::malformed(file, format!("PLY vertex property '{axis}' is a list")));
+                return Err(InputError::malformed(
+                    file,
+                    format!("PLY vertex property '{axis}' is a list"),
+                ));
             }
-            None => return Err(InputError::malformed(file, format!("PLY vertex element has no '{axis}' property"))),
+            None => {
+                return Err(InputError::malformed(
+                    file,
+                    format!("PLY vertex element has no '{axis}' property"),
+                ));
+            }
         }
     }
     let face_def = ply
@@ -170,10 +195,18 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let mut triangles = Vec::with_capacity(faces.len());
     let mut scratch = Vec::new();
     for (i, face) in faces.iter().enumerate() {
-        push_polygon(&mut triangles, face.indices(), positions.len(), &mut scratch)
-            .map_err(|m| InputError::element(file, format!("face {i}"), m))?;
+        push_polygon(
+            &mut triangles,
+            face.indices(),
+            positions.len(),
+            &mut scratch,
+        )
+        .map_err(|m| InputError::element(file, format!("face {i}"), m))?;
     }
-    Ok(Mesh { positions, triangles })
+    Ok(Mesh {
+        positions,
+        triangles,
+    })
 }
 
 /// `ply-rs-bw` prefixes messages with "Line N:"; we print our own.
@@ -197,13 +230,23 @@ element face 2\nproperty list uchar int vertex_indices\nend_header\n\
 
     fn expected() -> Mesh {
         Mesh {
-            positions: vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.], [2., 0.5, 0.]],
+            positions: vec![
+                [0., 0., 0.],
+                [1., 0., 0.],
+                [1., 1., 0.],
+                [0., 1., 0.],
+                [2., 0.5, 0.],
+            ],
             triangles: vec![[0, 1, 2], [0, 2, 3], [1, 4, 2]],
         }
     }
 
     fn binary(big_endian: bool, index_name: &str) -> Vec<u8> {
-        let fmt = if big_endian { "binary_big_endian" } else { "binary_little_endian" };
+        let fmt = if big_endian {
+            "binary_big_endian"
+        } else {
+            "binary_little_endian"
+        };
         let mut out = format!(
             "ply\nformat {fmt} 1.0\nelement vertex 5\nproperty double x\nproperty double y\nproperty double z\n\
 element edge 1\nproperty int vertex1\nproperty int vertex2\n\
@@ -212,16 +255,28 @@ element face 2\nproperty list uchar uint {index_name}\nend_header\n"
         .into_bytes();
         for p in expected().positions {
             for c in p {
-                out.extend(if big_endian { c.to_be_bytes() } else { c.to_le_bytes() });
+                out.extend(if big_endian {
+                    c.to_be_bytes()
+                } else {
+                    c.to_le_bytes()
+                });
             }
         }
         for i in [0i32, 1] {
-            out.extend(if big_endian { i.to_be_bytes() } else { i.to_le_bytes() });
+            out.extend(if big_endian {
+                i.to_be_bytes()
+            } else {
+                i.to_le_bytes()
+            });
         }
         for face in [&[0u32, 1, 2, 3][..], &[1, 4, 2]] {
             out.push(face.len() as u8);
             for &i in face {
-                out.extend(if big_endian { i.to_be_bytes() } else { i.to_le_bytes() });
+                out.extend(if big_endian {
+                    i.to_be_bytes()
+                } else {
+                    i.to_le_bytes()
+                });
             }
         }
         out
@@ -237,7 +292,11 @@ element face 2\nproperty list uchar uint {index_name}\nend_header\n"
 
     #[test]
     fn reads_binary_both_endians_and_index_names() {
-        for (big, name) in [(false, "vertex_indices"), (true, "vertex_index"), (true, "vertex_indices")] {
+        for (big, name) in [
+            (false, "vertex_indices"),
+            (true, "vertex_index"),
+            (true, "vertex_indices"),
+        ] {
             let f = TempFile::new("bin.ply", &binary(big, name));
             let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
             assert_eq!(m, expected(), "big endian {big}, {name}");
@@ -259,17 +318,29 @@ element face 2\nproperty list uchar uint {index_name}\nend_header\n"
     fn bad_index_and_missing_properties() {
         let bad = ASCII.replace("3 1 4 2", "3 1 7 2");
         let f = TempFile::new("bad.ply", bad.as_bytes());
-        let msg = read_mesh(&f.0, &ReadOptions::default()).unwrap_err().to_string();
-        assert!(msg.ends_with("bad.ply: face 1: vertex index 7 out of range (the file has 5 vertices)"), "{msg}");
+        let msg = read_mesh(&f.0, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.ends_with("bad.ply: face 1: vertex index 7 out of range (the file has 5 vertices)"),
+            "{msg}"
+        );
 
-        let noz = ASCII.replace("property float z\n", "").replace(" 0 255\n", " 255\n").replace(" 0 0\n", " 0\n");
+        let noz = ASCII
+            .replace("property float z\n", "")
+            .replace(" 0 255\n", " 255\n")
+            .replace(" 0 0\n", " 0\n");
         let f = TempFile::new("noz.ply", noz.as_bytes());
-        let msg = read_mesh(&f.0, &ReadOptions::default()).unwrap_err().to_string();
+        let msg = read_mesh(&f.0, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
         assert!(msg.contains("no 'z' property"), "{msg}");
 
         let garbage = ASCII.replace("1 1 0 0", "1 one 0 0");
         let f = TempFile::new("garbage.ply", garbage.as_bytes());
-        let msg = read_mesh(&f.0, &ReadOptions::default()).unwrap_err().to_string();
+        let msg = read_mesh(&f.0, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
         assert!(msg.contains("line") && !msg.contains('\n'), "{msg}");
     }
 }

@@ -59,18 +59,36 @@ impl RepairReport {
 impl fmt::Display for RepairReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         let items = [
-            (self.out_of_range_dropped, "triangles with out-of-range indices dropped"),
+            (
+                self.out_of_range_dropped,
+                "triangles with out-of-range indices dropped",
+            ),
             (self.degenerate_dropped, "degenerate triangles dropped"),
             (self.duplicates_dropped, "duplicate triangles dropped"),
             (self.nonmanifold_edges, "non-manifold edges"),
-            (self.nonmanifold_edge_triangles_dropped, "triangles dropped from non-manifold edges"),
+            (
+                self.nonmanifold_edge_triangles_dropped,
+                "triangles dropped from non-manifold edges",
+            ),
             (self.triangles_flipped, "triangles flipped"),
             (self.non_orientable_components, "non-orientable components"),
-            (self.non_orientable_triangles_dropped, "triangles dropped to orient them"),
-            (self.nonmanifold_vertices_split, "non-manifold vertices split"),
+            (
+                self.non_orientable_triangles_dropped,
+                "triangles dropped to orient them",
+            ),
+            (
+                self.nonmanifold_vertices_split,
+                "non-manifold vertices split",
+            ),
             (self.vertex_copies_added, "vertex copies added"),
-            (self.unreferenced_vertices_removed, "unreferenced vertices removed"),
-            (self.non_finite_vertices, "vertices with non-finite coordinates (not repairable)"),
+            (
+                self.unreferenced_vertices_removed,
+                "unreferenced vertices removed",
+            ),
+            (
+                self.non_finite_vertices,
+                "vertices with non-finite coordinates (not repairable)",
+            ),
         ];
         let parts: Vec<String> = items
             .iter()
@@ -89,7 +107,11 @@ impl fmt::Display for RepairReport {
 pub fn repair_mesh(mesh: &Mesh) -> (Mesh, RepairReport) {
     let mut report = RepairReport::default();
     let nv = mesh.positions.len();
-    report.non_finite_vertices = mesh.positions.iter().filter(|p| !p.iter().all(|c| c.is_finite())).count();
+    report.non_finite_vertices = mesh
+        .positions
+        .iter()
+        .filter(|p| !p.iter().all(|c| c.is_finite()))
+        .count();
 
     let mut tris = Vec::with_capacity(mesh.triangles.len());
     for &t @ [a, b, c] in &mesh.triangles {
@@ -104,7 +126,10 @@ pub fn repair_mesh(mesh: &Mesh) -> (Mesh, RepairReport) {
 
     report.duplicates_dropped = drop_duplicates(&mut tris, nv);
     let (edges, dropped, table) = drop_nonmanifold_edge_extras(&mut tris, nv);
-    (report.nonmanifold_edges, report.nonmanifold_edge_triangles_dropped) = (edges, dropped);
+    (
+        report.nonmanifold_edges,
+        report.nonmanifold_edge_triangles_dropped,
+    ) = (edges, dropped);
     let orient = orient(&mut tris, nv, table);
     report.triangles_flipped = orient.flipped;
     report.non_orientable_components = orient.non_orientable_components;
@@ -114,7 +139,10 @@ pub fn repair_mesh(mesh: &Mesh) -> (Mesh, RepairReport) {
         positions: mesh.positions.clone(),
         triangles: tris,
     };
-    (report.nonmanifold_vertices_split, report.vertex_copies_added) = split_nonmanifold_vertices(&mut out);
+    (
+        report.nonmanifold_vertices_split,
+        report.vertex_copies_added,
+    ) = split_nonmanifold_vertices(&mut out);
     report.unreferenced_vertices_removed = remove_unreferenced(&mut out);
     (out, report)
 }
@@ -145,7 +173,10 @@ fn retain_marked(tris: &mut Vec<[u32; 3]>, drop: &[bool]) -> usize {
 
 /// Keeps the two lowest-indexed triangles on every edge; returns
 /// `(edges, triangles dropped, edge table if still valid)`.
-fn drop_nonmanifold_edge_extras(tris: &mut Vec<[u32; 3]>, nv: usize) -> (usize, usize, Option<Buckets<u64>>) {
+fn drop_nonmanifold_edge_extras(
+    tris: &mut Vec<[u32; 3]>,
+    nv: usize,
+) -> (usize, usize, Option<Buckets<u64>>) {
     let edges = edge_table(tris, nv);
     let mut drop = vec![false; tris.len()];
     let mut count = 0;
@@ -184,24 +215,27 @@ fn orient(tris: &mut Vec<[u32; 3]>, nv: usize, edges: Option<Buckets<u64>>) -> O
     };
     let edges = edges.unwrap_or_else(|| edge_table(tris, nv));
     let inconsistent = (0..nv).into_par_iter().any(|lo| {
-        edge_groups(edges.get(lo)).any(|(_, g)| g.len() == 2 && record_reversed(g[0]) == record_reversed(g[1]))
+        edge_groups(edges.get(lo))
+            .any(|(_, g)| g.len() == 2 && record_reversed(g[0]) == record_reversed(g[1]))
     });
     if !inconsistent {
         return result;
     }
     // Neighbour records: other << 1 | same_direction.
     let adjacency: Buckets<u64> = Buckets::build(tris.len(), || {
-        (0..nv).flat_map(|lo| edge_groups(edges.get(lo))).flat_map(|(_, g)| {
-            let pair = match *g {
-                [r0, r1] => {
-                    let (t0, t1) = (record_triangle(r0), record_triangle(r1));
-                    let same = (record_reversed(r0) == record_reversed(r1)) as u64;
-                    Some([(t0, (t1 as u64) << 1 | same), (t1, (t0 as u64) << 1 | same)])
-                }
-                _ => None,
-            };
-            pair.into_iter().flatten()
-        })
+        (0..nv)
+            .flat_map(|lo| edge_groups(edges.get(lo)))
+            .flat_map(|(_, g)| {
+                let pair = match *g {
+                    [r0, r1] => {
+                        let (t0, t1) = (record_triangle(r0), record_triangle(r1));
+                        let same = (record_reversed(r0) == record_reversed(r1)) as u64;
+                        Some([(t0, (t1 as u64) << 1 | same), (t1, (t0 as u64) << 1 | same)])
+                    }
+                    _ => None,
+                };
+                pair.into_iter().flatten()
+            })
     });
     drop(edges);
 
@@ -228,7 +262,11 @@ fn orient(tris: &mut Vec<[u32; 3]>, nv: usize, edges: Option<Buckets<u64>>) -> O
                 if dropped[n] {
                     continue;
                 }
-                let want = if same { KEEP + FLIP - state[t] } else { state[t] };
+                let want = if same {
+                    KEEP + FLIP - state[t]
+                } else {
+                    state[t]
+                };
                 if state[n] == UNSEEN {
                     state[n] = want;
                     component.push(n);
@@ -267,9 +305,11 @@ pub(crate) fn split_nonmanifold_vertices(mesh: &mut Mesh) -> (usize, usize) {
     let tris = &mesh.triangles;
     // Corner records: triangle << 2 | corner, in triangle order per vertex.
     let corners: Buckets<u64> = Buckets::build(nv, || {
-        tris.iter()
-            .enumerate()
-            .flat_map(|(t, tri)| tri.iter().enumerate().map(move |(k, &v)| (v as usize, (t as u64) << 2 | k as u64)))
+        tris.iter().enumerate().flat_map(|(t, tri)| {
+            tri.iter()
+                .enumerate()
+                .map(move |(k, &v)| (v as usize, (t as u64) << 2 | k as u64))
+        })
     });
     // Per vertex (in parallel): the fan index of each corner, when there is
     // more than one fan.
@@ -396,7 +436,11 @@ mod tests {
         bad.triangles.push([0, 1, 99]);
         let t = bad.triangles[3];
         bad.triangles.push([t[2], t[0], t[1]]);
-        bad.triangles[5] = [bad.triangles[5][0], bad.triangles[5][2], bad.triangles[5][1]];
+        bad.triangles[5] = [
+            bad.triangles[5][0],
+            bad.triangles[5][2],
+            bad.triangles[5][1],
+        ];
         bad.positions.push([9.0, 9.0, 9.0]);
         let (r, report) = repair_mesh(&bad);
         check_mesh(&r).unwrap();
@@ -407,7 +451,10 @@ mod tests {
         assert_eq!(report.unreferenced_vertices_removed, 1);
         assert_eq!(r, m, "minority flip restores the original exactly");
         let text = report.to_string();
-        assert!(text.contains("1 triangles flipped") && !text.contains('\n'), "{text}");
+        assert!(
+            text.contains("1 triangles flipped") && !text.contains('\n'),
+            "{text}"
+        );
     }
 
     #[test]
@@ -415,7 +462,8 @@ mod tests {
         // Fin on an interior edge plus a bowtie at vertex 5.
         let mut m = grid_mesh(4, 4);
         let nv = m.positions.len() as u32;
-        m.positions.extend([[0.5, 0.5, 5.0], [7.0, 7.0, 0.0], [8.0, 7.0, 0.0]]);
+        m.positions
+            .extend([[0.5, 0.5, 5.0], [7.0, 7.0, 0.0], [8.0, 7.0, 0.0]]);
         m.triangles.push([5, 10, nv]);
         m.triangles.push([5, nv + 1, nv + 2]);
         let (r, report) = repair_mesh(&m);
@@ -438,7 +486,11 @@ mod tests {
         for i in 0..n {
             // At the seam the strip's top meets its bottom (twist).
             let (a, b) = (top(i), bottom(i));
-            let (c, d) = if i + 1 == n { (bottom(0), top(0)) } else { (top(i + 1), bottom(i + 1)) };
+            let (c, d) = if i + 1 == n {
+                (bottom(0), top(0))
+            } else {
+                (top(i + 1), bottom(i + 1))
+            };
             tris.push([a, b, d]);
             tris.push([a, d, c]);
         }

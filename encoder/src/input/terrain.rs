@@ -28,29 +28,38 @@ fn splitmix64(mut z: u64) -> u64 {
 
 /// Sixteen unit gradients (cos, sin of k * 22.5 degrees): a table lookup is
 /// several times cheaper than `sin_cos` and looks the same after fBm.
-const GRADIENTS: [(f64, f64); 16] = [
-    (1.0, 0.0),
-    (0.923_879_532_511_286_7, 0.382_683_432_365_089_8),
-    (0.707_106_781_186_547_6, 0.707_106_781_186_547_6),
-    (0.382_683_432_365_089_8, 0.923_879_532_511_286_7),
-    (0.0, 1.0),
-    (-0.382_683_432_365_089_8, 0.923_879_532_511_286_7),
-    (-0.707_106_781_186_547_6, 0.707_106_781_186_547_6),
-    (-0.923_879_532_511_286_7, 0.382_683_432_365_089_8),
-    (-1.0, 0.0),
-    (-0.923_879_532_511_286_7, -0.382_683_432_365_089_8),
-    (-0.707_106_781_186_547_6, -0.707_106_781_186_547_6),
-    (-0.382_683_432_365_089_8, -0.923_879_532_511_286_7),
-    (0.0, -1.0),
-    (0.382_683_432_365_089_8, -0.923_879_532_511_286_7),
-    (0.707_106_781_186_547_6, -0.707_106_781_186_547_6),
-    (0.923_879_532_511_286_7, -0.382_683_432_365_089_8),
-];
+const GRADIENTS: [(f64, f64); 16] = {
+    const H: f64 = std::f64::consts::FRAC_1_SQRT_2;
+    /// cos and sin of 22.5 degrees.
+    const C: f64 = 0.923_879_532_511_286_7;
+    const S: f64 = 0.382_683_432_365_089_8;
+    [
+        (1.0, 0.0),
+        (C, S),
+        (H, H),
+        (S, C),
+        (0.0, 1.0),
+        (-S, C),
+        (-H, H),
+        (-C, S),
+        (-1.0, 0.0),
+        (-C, -S),
+        (-H, -H),
+        (-S, -C),
+        (0.0, -1.0),
+        (S, -C),
+        (H, -H),
+        (C, -S),
+    ]
+};
 
 /// Pseudo-random unit gradient at a lattice point.
 #[inline]
 fn gradient(seed: u64, ix: i64, iy: i64) -> (f64, f64) {
-    let h = splitmix64(seed ^ (ix as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ (iy as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F));
+    let h = splitmix64(
+        seed ^ (ix as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (iy as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F),
+    );
     GRADIENTS[(h >> 60) as usize]
 }
 
@@ -82,33 +91,48 @@ fn gradient_noise(seed: u64, x: f64, y: f64) -> f64 {
 /// is raised to the power 1.6 so valleys are broad and peaks sharp, as in
 /// real mountain ranges.
 pub fn fractal_terrain(side: usize, seed: u64) -> Mesh {
-    let spacing = if side > 1 { EXTENT_M / (side - 1) as f64 } else { EXTENT_M };
+    let spacing = if side > 1 {
+        EXTENT_M / (side - 1) as f64
+    } else {
+        EXTENT_M
+    };
     // Base frequency 2 per side, doubling until a feature spans ~4 samples;
     // finer octaves would only alias.
     let octaves = ((side.max(4) as f64 / 2.0).log2().floor() as usize).max(1);
-    let seeds: Vec<u64> = (0..octaves as u64).map(|o| splitmix64(seed ^ splitmix64(o))).collect();
+    let seeds: Vec<u64> = (0..octaves as u64)
+        .map(|o| splitmix64(seed ^ splitmix64(o)))
+        .collect();
 
     let mut elevations = vec![0.0f64; side * side];
-    elevations.par_chunks_mut(side.max(1)).enumerate().for_each(|(r, row)| {
-        for (c, z) in row.iter_mut().enumerate() {
-            // Map coordinates in units of the map side.
-            let (u, v) = (c as f64 / side as f64, r as f64 / side as f64);
-            let mut frequency = 2.0;
-            let mut amplitude = 1.0;
-            let mut sum = 0.0;
-            for &s in &seeds {
-                sum += amplitude * gradient_noise(s, u * frequency, v * frequency);
-                frequency *= 2.0;
-                amplitude *= 0.5;
+    elevations
+        .par_chunks_mut(side.max(1))
+        .enumerate()
+        .for_each(|(r, row)| {
+            for (c, z) in row.iter_mut().enumerate() {
+                // Map coordinates in units of the map side.
+                let (u, v) = (c as f64 / side as f64, r as f64 / side as f64);
+                let mut frequency = 2.0;
+                let mut amplitude = 1.0;
+                let mut sum = 0.0;
+                for &s in &seeds {
+                    sum += amplitude * gradient_noise(s, u * frequency, v * frequency);
+                    frequency *= 2.0;
+                    amplitude *= 0.5;
+                }
+                *z = sum;
             }
-            *z = sum;
-        }
-    });
+        });
 
     let (lo, hi) = elevations
         .par_iter()
-        .fold(|| (f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &z| (lo.min(z), hi.max(z)))
-        .reduce(|| (f64::INFINITY, f64::NEG_INFINITY), |a, b| (a.0.min(b.0), a.1.max(b.1)));
+        .fold(
+            || (f64::INFINITY, f64::NEG_INFINITY),
+            |(lo, hi), &z| (lo.min(z), hi.max(z)),
+        )
+        .reduce(
+            || (f64::INFINITY, f64::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
     let range = if hi > lo { hi - lo } else { 1.0 };
     elevations.par_iter_mut().for_each(|z| {
         let t = (*z - lo) / range;
@@ -143,10 +167,16 @@ mod tests {
         assert_eq!((lo[0], lo[1], hi[0], hi[1]), (0.0, 0.0, EXTENT_M, EXTENT_M));
         assert!((hi[2] - lo[2] - RELIEF_M).abs() < 1e-6, "{lo:?} {hi:?}");
         let stats = check_mesh(&a).unwrap();
-        assert_eq!((stats.components, stats.boundary_loops, stats.genus), (1, 1, 0));
+        assert_eq!(
+            (stats.components, stats.boundary_loops, stats.genus),
+            (1, 1, 0)
+        );
         // Rough, not a plane: neighbouring samples differ, but smoothly.
         let z = |r: usize, c: usize| a.positions[r * 65 + c][2];
-        let steps: f64 = (0..64).map(|c| (z(30, c + 1) - z(30, c)).abs()).sum::<f64>() / 64.0;
+        let steps: f64 = (0..64)
+            .map(|c| (z(30, c + 1) - z(30, c)).abs())
+            .sum::<f64>()
+            / 64.0;
         assert!(steps > 1.0 && steps < 200.0, "mean step {steps}");
     }
 

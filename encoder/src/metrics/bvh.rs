@@ -58,9 +58,14 @@ impl Bvh {
         if self.nodes.is_empty() {
             return best;
         }
-        let mut stack: Vec<(u32, f64)> = Vec::with_capacity(64);
-        stack.push((0, box_dist2(&self.nodes[0], p)));
-        while let Some((i, d)) = stack.pop() {
+        // Median splits keep the depth under 33 for any u32 triangle count,
+        // and the stack never holds more than depth + 1 entries.
+        let mut stack = [(0u32, 0.0f64); 64];
+        stack[0] = (0, box_dist2(&self.nodes[0], p));
+        let mut len = 1;
+        while len > 0 {
+            len -= 1;
+            let (i, d) = stack[len];
             if d >= best {
                 continue;
             }
@@ -81,11 +86,11 @@ impl Bvh {
             } else {
                 ((r, dr), (l, dl))
             };
-            if far.1 < best {
-                stack.push(far);
-            }
-            if near.1 < best {
-                stack.push(near);
+            for child in [far, near] {
+                if child.1 < best {
+                    stack[len] = child;
+                    len += 1;
+                }
             }
         }
         best

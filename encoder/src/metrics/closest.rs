@@ -58,7 +58,7 @@ pub fn closest_point(p: [f64; 3], [a, b, c]: [[f64; 3]; 3]) -> [f64; 3] {
         return lerp(b, c, (d4 - d3) / ((d4 - d3) + (d5 - d6)));
     }
     let sum = va + vb + vc;
-    if !(sum > 0.0) || !sum.is_finite() {
+    if sum <= 0.0 || !sum.is_finite() {
         return degenerate(p, [a, b, c]);
     }
     let (v, w) = (vb / sum, vc / sum);

@@ -52,8 +52,8 @@ pub fn surface_distance(a: &Mesh, b: &Mesh, samples_per_mesh: usize, seed: u64) 
             )
         },
     );
-    let mut distances = one_way(&on_a, &bvh_b);
-    distances.extend(one_way(&on_b, &bvh_a));
+    let mut distances = one_way(&on_a.points(), &bvh_b);
+    distances.extend(one_way(&on_b.points(), &bvh_a));
     let count = distances.len();
     // Sequential sums, so the result does not depend on thread scheduling.
     let (mut max, mut sum, mut sum2) = (0.0f64, 0.0, 0.0);
@@ -72,11 +72,11 @@ pub fn surface_distance(a: &Mesh, b: &Mesh, samples_per_mesh: usize, seed: u64) 
 }
 
 /// Distance from every sample to the surface in `bvh`, in sample order.
-fn one_way(samples: &Sampler, bvh: &Bvh) -> Vec<f64> {
-    (0..samples.len())
-        .into_par_iter()
+fn one_way(samples: &[[f64; 3]], bvh: &Bvh) -> Vec<f64> {
+    samples
+        .par_iter()
         .with_min_len(1024)
-        .map(|i| bvh.nearest_dist2(samples.point(i)).sqrt())
+        .map(|&p| bvh.nearest_dist2(p).sqrt())
         .collect()
 }
 

@@ -2,6 +2,8 @@
 //! by area. Point `i` is a pure function of `(mesh, seed, i)`, so sampling
 //! parallelises without changing the result.
 
+use rayon::prelude::*;
+
 use super::rng::unit;
 use crate::mesh::Mesh;
 use crate::quadric::{cross, norm, sub};
@@ -59,29 +61,57 @@ impl<'m> Sampler<'m> {
         }
     }
 
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.vertices.len() + self.area_samples
     }
 
-    /// Sample `i` of [`Self::len`].
-    pub fn point(&self, i: usize) -> [f64; 3] {
-        if let Some(&v) = self.vertices.get(i) {
-            return self.mesh.positions[v as usize];
-        }
-        let k = 3 * (i - self.vertices.len()) as u64;
+    /// All samples: the used vertices in index order, then the area samples
+    /// sorted along the surface (by triangle), so that consecutive distance
+    /// queries walk nearby parts of the other mesh's BVH and stay in cache.
+    /// Area sample `j` draws values `3j..3j + 3` of the seed's stream.
+    pub fn points(&self) -> Vec<[f64; 3]> {
         let total = self.cumulative.last().copied().unwrap_or(0.0);
-        let target = unit(self.seed, k) * total;
-        let t = self
-            .cumulative
-            .partition_point(|&c| c <= target)
-            .min(self.triangles.len() - 1);
+        // Sorting the (unique) triangle choices first replaces a binary
+        // search per sample by one merge walk over the cumulative areas.
+        let mut picks: Vec<(u64, u32)> = (0..self.area_samples as u32)
+            .into_par_iter()
+            .map(|j| ((unit(self.seed, 3 * u64::from(j)) * total).to_bits(), j))
+            .collect();
+        picks.par_sort_unstable();
+        let mut triangle = 0;
+        let chosen: Vec<(u32, u32)> = picks
+            .iter()
+            .map(|&(bits, j)| {
+                let target = f64::from_bits(bits);
+                while triangle + 1 < self.triangles.len() && self.cumulative[triangle] <= target {
+                    triangle += 1;
+                }
+                (triangle as u32, j)
+            })
+            .collect();
+        let mut points: Vec<[f64; 3]> = self
+            .vertices
+            .iter()
+            .map(|&v| self.mesh.positions[v as usize])
+            .collect();
+        points.par_extend(
+            chosen
+                .par_iter()
+                .map(|&(t, j)| self.on_triangle(t as usize, 3 * u64::from(j) + 1)),
+        );
+        points
+    }
+
+    /// A point uniform on triangle `t` from stream values `k` and `k + 1`.
+    fn on_triangle(&self, t: usize, k: u64) -> [f64; 3] {
         let [a, b, c] = self.triangles[t].map(|v| self.mesh.positions[v as usize]);
-        // Uniform on the triangle: sqrt warps the first coordinate so area,
-        // not parameter space, is uniform.
-        let s = unit(self.seed, k + 1).sqrt();
-        let r = unit(self.seed, k + 2);
+        // sqrt warps the first coordinate so that area, not parameter space,
+        // is uniform.
+        let s = unit(self.seed, k).sqrt();
+        let r = unit(self.seed, k + 1);
         let (wa, wb, wc) = (1.0 - s, s * (1.0 - r), s * r);
-        [0, 1, 2].map(|j| wa * a[j] + wb * b[j] + wc * c[j])
+        [0, 1, 2].map(|i| wa * a[i] + wb * b[i] + wc * c[i])
     }
 }
 
@@ -106,10 +136,12 @@ mod tests {
         };
         let s = Sampler::new(&mesh, 4000, 9);
         assert_eq!(s.len(), 6 + 4000, "the unused vertex is not sampled");
-        let right = (6..s.len()).filter(|&i| s.point(i)[0] >= 10.0).count();
+        let points = s.points();
+        assert_eq!(points.len(), s.len());
+        assert_eq!(points[..6], mesh.positions[..6]);
+        let right = points[6..].iter().filter(|p| p[0] >= 10.0).count();
         assert!((right as f64 / 4000.0 - 0.75).abs() < 0.03);
-        for i in 6..s.len() {
-            let p = s.point(i);
+        for p in &points[6..] {
             let (x, y) = if p[0] >= 10.0 {
                 ((p[0] - 10.0) / 3.0, p[1] / 2.0)
             } else {
@@ -117,7 +149,8 @@ mod tests {
             };
             assert!(x >= 0.0 && y >= 0.0 && x + y <= 1.0 + 1e-12 && p[2] == 0.0);
         }
-        assert_eq!(s.point(100), Sampler::new(&mesh, 4000, 9).point(100));
+        assert_eq!(points, Sampler::new(&mesh, 4000, 9).points());
+        assert_ne!(points, Sampler::new(&mesh, 4000, 10).points());
     }
 
     #[test]

@@ -225,6 +225,20 @@ fn wing_pairs(state: &MeshState<'_>, ring: &Ring) -> Vec<(usize, usize)> {
     pairs
 }
 
+/// Whether the ring has a wing pair that stays valid after `earlier`
+/// splits of the same round (each decrements a wing deficit at most once).
+fn has_robust_pair(state: &MeshState<'_>, ring: &Ring, earlier: usize) -> bool {
+    let robust = |x: u32| {
+        x == NONE || {
+            let d = state.deficits()[x as usize];
+            d == LEAF || d as usize > earlier
+        }
+    };
+    let v = ring.vertices();
+    let k = v.len();
+    (0..k).any(|o| robust(v[o]) && (o + 1..k).any(|j| robust(v[j]) && !(v[o] == NONE && v[j] == NONE)))
+}
+
 fn pick_deficit(b: u8, valence: usize) -> u8 {
     let d = match b % 4 {
         0 => 0,
@@ -374,12 +388,12 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
     let refinement_levels = 4 - choices.below(4);
     let bv = base.positions.len() as u32;
     let bt = base.triangles.len() as u32;
-    let deficits: Vec<u8> = (0..bv)
-        .map(|_| match choices.byte() % 5 {
-            0 | 1 => 0,
-            2 => 1,
-            3 => 2,
-            _ => LEAF,
+    let deficits: Vec<u8> = (0..bv as usize)
+        .map(|i| match (choices.byte() as usize + i) % 5 {
+            0 | 3 => 0,
+            1 => LEAF,
+            2 => 2,
+            _ => 1,
         })
         .collect();
 
@@ -418,10 +432,13 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                 if state.deficits()[v as usize] != 0 {
                     continue;
                 }
+                // Earlier splits of this round decrement each wing at most
+                // once: a pair of wings whose deficits exceed the number of
+                // splits flagged so far is still valid when `v` splits.
                 let eligible = flagged.len() < room
                     && state.ring(v, &mut ring).is_ok()
                     && ring.vertices().iter().all(|x| !flagged.contains(x))
-                    && !wing_pairs(&state, &ring).is_empty();
+                    && has_robust_pair(&state, &ring, flagged.len());
                 let b = choices.byte();
                 let f = if eligible {
                     if first_eligible.is_none() {

@@ -1,0 +1,144 @@
+//! Writes the seed corpora of the fuzz targets (decoder-core/fuzz) and the
+//! tetrahedron stream of the embedded size demo.
+//!
+//! ```text
+//! cargo run -p splitstream-decoder-core --example write_seed_streams -- decoder-core/fuzz/corpus
+//! ```
+//!
+//! Writes `<dir>/decode_bytes/*.sps` (complete valid streams: the hand-made
+//! ones of tests/handmade.rs and generated deep ones), `<dir>/decode_mutated/*`
+//! (one byte per seed stream: no mutation), `<dir>/round_records/*` (choice
+//! strings of the generator) and `<dir>/tetrahedron.sps`.
+
+#[path = "../fuzz/src/streams.rs"]
+mod streams;
+
+use std::path::PathBuf;
+
+use splitstream_decoder_core::PositionMode;
+use splitstream_decoder_core::limits::LEAF;
+use splitstream_decoder_core::writer::{
+    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+};
+use streams::{BaseMesh, Choices};
+
+fn params(codec: ChunkCodec) -> StreamParams {
+    StreamParams {
+        position_mode: PositionMode::Optimal,
+        bits: 8,
+        origin: [0.0; 3],
+        scale: [1.0; 3],
+        codec,
+        chunk_limit: 4,
+    }
+}
+
+/// One optimal-mode split record level (as in tests/handmade.rs).
+fn one_split(o: u8, d: u8, e: [i32; 3], m: [i32; 3], v: u32, t: u32) -> LevelPayload {
+    let mut s = vec![SubstreamWriter::default(); 8];
+    s[0].bit(true);
+    s[1].byte(o);
+    s[2].byte(d);
+    s[3].bit(false);
+    s[4].byte(LEAF);
+    s[5].byte(LEAF);
+    for k in 0..3 {
+        s[6].signed(e[k]);
+        s[7].signed(m[k]);
+    }
+    LevelPayload {
+        round_splits: vec![1],
+        substreams: s,
+        vertex_count: v,
+        triangle_count: t,
+        geometric_error: 0.0,
+    }
+}
+
+/// The hand-made streams: tetrahedron with one split (stored and deflate),
+/// triangle with a boundary split, and a base-only octahedron.
+pub fn handmade() -> Vec<(&'static str, Vec<u8>)> {
+    let tetra = streams::base_level(&streams::tetrahedron(), &[0, LEAF, LEAF, LEAF]);
+    let tri = streams::base_level(&streams::triangle(), &[0, LEAF, LEAF]);
+    let octa: BaseMesh = streams::octahedron();
+    vec![
+        (
+            "tetrahedron_stored",
+            write_stream(
+                &params(ChunkCodec::Stored),
+                &[tetra.clone(), one_split(0, 1, [2; 3], [-1; 3], 5, 6)],
+            ),
+        ),
+        (
+            "tetrahedron_deflate",
+            write_stream(
+                &params(ChunkCodec::Deflate(9)),
+                &[tetra, one_split(0, 1, [2; 3], [-1; 3], 5, 6)],
+            ),
+        ),
+        (
+            "triangle_boundary",
+            write_stream(
+                &params(ChunkCodec::Stored),
+                &[tri, one_split(0, 1, [0, 4, 0], [0, -2, 0], 4, 2)],
+            ),
+        ),
+        (
+            "octahedron_base",
+            write_stream(
+                &params(ChunkCodec::Stored),
+                &[streams::base_level(&octa, &[LEAF; 6])],
+            ),
+        ),
+    ]
+}
+
+fn main() {
+    let dir: PathBuf = std::env::args_os()
+        .nth(1)
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from("decoder-core/fuzz/corpus"));
+    for sub in ["decode_bytes", "decode_mutated", "round_records"] {
+        std::fs::create_dir_all(dir.join(sub)).unwrap();
+    }
+    let mut n = 0;
+    for (name, bytes) in handmade() {
+        streams::decode_full(&bytes)
+            .error
+            .map(|e| panic!("{name}: {e}"));
+        std::fs::write(dir.join("decode_bytes").join(format!("{name}.sps")), &bytes).unwrap();
+        n += 1;
+    }
+    std::fs::write(dir.join("tetrahedron.sps"), &handmade()[0].1).unwrap();
+    for (i, g) in streams::seed_generated().iter().enumerate() {
+        streams::check_against(g, &streams::decode_full(&g.stream)).unwrap();
+        std::fs::write(
+            dir.join("decode_bytes").join(format!("gen_{i:02}_{}.sps", g.base)),
+            &g.stream,
+        )
+        .unwrap();
+        std::fs::write(dir.join("decode_mutated").join(format!("seed_{i:02}")), [i as u8]).unwrap();
+        println!(
+            "seed {i:2}: {:<12} {:>5} bytes, {} levels, {} rounds, {} splits",
+            g.base,
+            g.stream.len(),
+            g.levels.len(),
+            g.hashes.len() - 1,
+            g.splits
+        );
+        n += 2;
+    }
+    for b in 0..streams::bases().len() as u8 {
+        std::fs::write(dir.join("round_records").join(format!("zeros_{b}")), [b, 0]).unwrap();
+        n += 1;
+    }
+    for seed in 1..=10u64 {
+        let bytes = streams::pseudo_random_bytes(seed, 512);
+        let g = streams::generate(&mut Choices::new(&bytes), false);
+        assert!(g.error.is_none());
+        std::fs::write(dir.join("round_records").join(format!("random_{seed:02}")), &bytes)
+            .unwrap();
+        n += 1;
+    }
+    println!("wrote {n} files under {}", dir.display());
+}

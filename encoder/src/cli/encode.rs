@@ -1,0 +1,108 @@
+//! `splitstream encode`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use splitstream_decoder_core::PositionMode;
+use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_encoder::emit::{EncodeOptions, encode};
+use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
+
+use super::{CliResult, Codec, Position};
+
+pub struct Args {
+    pub input: PathBuf,
+    pub output: PathBuf,
+    pub bits: u8,
+    pub levels: usize,
+    pub base_vertices: Option<usize>,
+    pub position: Position,
+    pub max_error: Option<f64>,
+    pub codec: Codec,
+    pub chunk_size: u32,
+    pub lock_boundary: bool,
+    pub repair: bool,
+    pub permutation: Option<PathBuf>,
+    pub npz_array: Option<String>,
+    pub z_scale: f64,
+    pub admit: f64,
+}
+
+pub fn run(a: Args) -> CliResult {
+    if !(1..=31).contains(&a.bits) {
+        return Err(format!("--bits {} is outside 1..=31", a.bits));
+    }
+    if a.levels == 0 || a.levels > 64 {
+        return Err(format!("--levels {} is outside 1..=64", a.levels));
+    }
+    if !(a.admit > 0.0 && a.admit <= 1.0) {
+        return Err(format!("--admit {} is outside (0, 1]", a.admit));
+    }
+    if a.chunk_size == 0 {
+        return Err("--chunk-size must be at least 1".into());
+    }
+    let started = Instant::now();
+    let read = ReadOptions {
+        npz_array: a.npz_array.clone(),
+        z_scale: a.z_scale,
+        ..ReadOptions::default()
+    };
+    let mut mesh = read_mesh(&a.input, &read).map_err(|e| e.to_string())?;
+    if a.repair {
+        let (fixed, report) = repair_mesh(&mesh);
+        eprintln!("repair: {report}");
+        mesh = fixed;
+    }
+    let stats = check_mesh(&mesh).map_err(|e| format!("{}: {e}", a.input.display()))?;
+    let read_seconds = started.elapsed().as_secs_f64();
+    let options = EncodeOptions {
+        bits: a.bits,
+        levels: a.levels,
+        base_vertices: a.base_vertices,
+        position_mode: match a.position {
+            Position::Optimal => PositionMode::Optimal,
+            Position::Constrained => PositionMode::Constrained,
+        },
+        max_error: a.max_error,
+        codec: match a.codec {
+            Codec::Deflate => ChunkCodec::Deflate(9),
+            Codec::Stored => ChunkCodec::Stored,
+        },
+        chunk_limit: a.chunk_size,
+        lock_boundary: a.lock_boundary,
+        admit_quantile: a.admit,
+    };
+    let n = mesh.positions.len();
+    let bar = ProgressBar::new(n as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} collapses")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    bar.set_message("simplifying");
+    let encoded = encode(&mesh, &options, |done| bar.set_position(done as u64))
+        .map_err(|e| e.to_string())?;
+    bar.finish_and_clear();
+    std::fs::write(&a.output, &encoded.stream).map_err(|e| format!("{}: {e}", a.output.display()))?;
+    if let Some(path) = &a.permutation {
+        let text: String = encoded.permutation.iter().map(|v| format!("{v}\n")).collect();
+        std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    let bytes = encoded.stream.len();
+    println!(
+        "{}: {} vertices, {} triangles ({} boundary edges) -> {} bytes, {:.2} bits/vertex, {} levels, {} rounds",
+        a.output.display(),
+        n,
+        stats.triangles,
+        stats.boundary_edges,
+        bytes,
+        8.0 * bytes as f64 / n as f64,
+        encoded.level_vertex_counts.len(),
+        encoded.rounds,
+    );
+    println!(
+        "time: read+check {:.2} s, simplify {:.2} s, emit {:.2} s",
+        read_seconds, encoded.simplify_seconds, encoded.emit_seconds
+    );
+    Ok(())
+}

@@ -1,0 +1,159 @@
+//! Command-line definitions and dispatch.
+
+mod decode;
+mod demo;
+mod encode;
+mod info;
+mod output;
+mod verify;
+
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+/// One-line errors for the command line.
+pub type CliResult = Result<(), String>;
+
+#[derive(Parser)]
+#[command(name = "splitstream", version, about = "Progressive streaming of terrain and 3D meshes")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Position {
+    /// Two deltas per split: the merged vertex anywhere (QEM optimum).
+    Optimal,
+    /// One delta and a placement code: the merged vertex on P, C or midway.
+    Constrained,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Codec {
+    Deflate,
+    Stored,
+}
+
+#[derive(Subcommand)]
+pub enum Command {
+    /// Encode a mesh (.ply .obj .off) or elevation grid (.tif .asc .npy .npz).
+    Encode {
+        input: PathBuf,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Quantization bits per axis (1..=31).
+        #[arg(long, default_value_t = 14)]
+        bits: u8,
+        /// Levels of detail, base mesh included.
+        #[arg(long, default_value_t = 5)]
+        levels: usize,
+        /// Base mesh vertex count (default: vertices / 2^(levels-1)).
+        #[arg(long)]
+        base_vertices: Option<usize>,
+        #[arg(long, value_enum, default_value_t = Position::Optimal)]
+        position: Position,
+        /// Largest quadric error a collapse may have.
+        #[arg(long)]
+        max_error: Option<f64>,
+        #[arg(long, value_enum, default_value_t = Codec::Deflate)]
+        codec: Codec,
+        /// Largest raw chunk in bytes (bounds decoder buffers).
+        #[arg(long, default_value_t = 16384)]
+        chunk_size: u32,
+        /// Keep boundary vertices in place (patch borders).
+        #[arg(long)]
+        lock_boundary: bool,
+        /// Fix what the checker rejects: drop degenerate/duplicate triangles,
+        /// reorient, split non-manifold vertices.
+        #[arg(long)]
+        repair: bool,
+        /// Write the input vertex id of each decoded vertex, one per line.
+        #[arg(long)]
+        permutation: Option<PathBuf>,
+        /// .npz only: the array with the elevations.
+        #[arg(long)]
+        npz_array: Option<String>,
+        /// Multiply z by this (e.g. to match x/y units).
+        #[arg(long, default_value_t = 1.0)]
+        z_scale: f64,
+        /// Fraction of candidate collapses admitted per step (0..1].
+        #[arg(long, default_value_t = 0.5)]
+        admit: f64,
+    },
+    /// Decode a stream to .ply or .obj, in decoded vertex order.
+    Decode {
+        input: PathBuf,
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Stop after this level (0 = base mesh).
+        #[arg(long)]
+        level: Option<u16>,
+    },
+    /// Header, level table, bits per field and per vertex, decoder memory.
+    Info {
+        input: PathBuf,
+        #[arg(long)]
+        json: bool,
+    },
+    /// Decode fully, checking every checksum and rule; print the state hash.
+    Verify { input: PathBuf },
+    /// The main job on a built-in default: generate a terrain, encode it,
+    /// decode it level by level and print the level table.
+    Demo {
+        /// Side of the generated square terrain, in samples.
+        #[arg(long, default_value_t = 512)]
+        side: usize,
+    },
+}
+
+pub fn run(cli: Cli) -> CliResult {
+    match cli.command {
+        Command::Encode {
+            input,
+            output,
+            bits,
+            levels,
+            base_vertices,
+            position,
+            max_error,
+            codec,
+            chunk_size,
+            lock_boundary,
+            repair,
+            permutation,
+            npz_array,
+            z_scale,
+            admit,
+        } => encode::run(encode::Args {
+            input,
+            output,
+            bits,
+            levels,
+            base_vertices,
+            position,
+            max_error,
+            codec,
+            chunk_size,
+            lock_boundary,
+            repair,
+            permutation,
+            npz_array,
+            z_scale,
+            admit,
+        }),
+        Command::Decode {
+            input,
+            output,
+            level,
+        } => decode::run(&input, &output, level),
+        Command::Info { input, json } => info::run(&input, json),
+        Command::Verify { input } => verify::run(&input),
+        Command::Demo { side } => demo::run(side),
+    }
+}
+
+/// Reads a whole file, naming it in the error.
+pub fn read_file(path: &std::path::Path) -> Result<Vec<u8>, String> {
+    std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))
+}
