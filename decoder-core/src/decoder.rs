@@ -53,7 +53,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
         let header = Header::parse(head)?;
         let table = LevelTable::parse(head, &header)?;
         let full = layout_for(&header, &table, header.level_count - 1);
-        if full.total as u64 != header.workspace_bytes {
+        if full.total != header.workspace_bytes {
             return Err(Error::InvalidHeader(
                 "declared workspace size differs from SPEC §9",
             ));
@@ -68,7 +68,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
             fit -= 1;
             if fit == 0 {
                 return Err(Error::WorkspaceTooSmall {
-                    needed: layout_for(&header, &table, 0).total,
+                    needed: usize::try_from(layout_for(&header, &table, 0).total).unwrap_or(usize::MAX),
                     available: workspace.len(),
                 });
             }
@@ -128,6 +128,14 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
         self.state.state_hash()
     }
 
+    /// Level `k`'s bytes within the whole `stream` (SPEC §4.1).
+    pub fn level_bytes<'s>(&self, k: u16, stream: &'s [u8]) -> Result<&'s [u8], Error> {
+        let range = self.level_range(k);
+        let start = usize::try_from(range.start).map_err(|_| Error::Truncated)?;
+        let end = usize::try_from(range.end).map_err(|_| Error::Truncated)?;
+        stream.get(start..end).ok_or(Error::Truncated)
+    }
+
     /// The byte range of level `k` in the stream.
     pub fn level_range(&self, k: u16) -> core::ops::Range<u64> {
         let e = self.table.get(k);
@@ -158,6 +166,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
                 return Err(e);
             }
         };
+        self.state.set_triangle_limit(info.triangle_count);
         let mut ld = open_level(self, level, info, header, bytes);
         if level == 0 {
             let result = read_base(
@@ -186,11 +195,10 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
     /// number of levels decoded (base included).
     pub fn decode_available(&mut self, stream: &[u8]) -> Result<u16, Error> {
         while let Some(k) = self.next_level() {
-            let range = self.level_range(k);
-            let bytes = stream
-                .get(range.start as usize..range.end as usize)
-                .ok_or(Error::Truncated)?;
-            if let Err(e) = self.decode_level(k, bytes) {
+            let result = self
+                .level_bytes(k, stream)
+                .and_then(|bytes| self.decode_level(k, bytes));
+            if let Err(e) = result {
                 self.poisoned = true;
                 return Err(e);
             }

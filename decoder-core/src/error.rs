@@ -18,7 +18,7 @@ pub enum Error {
     ChecksumMismatch(ChecksumScope),
     /// §3, §4, §5: the bytes end before the structure they must hold.
     Truncated,
-    /// §4.1: level table entries are inconsistent (offsets, counts, ordering).
+    /// §4.2: level table entries are inconsistent (offsets, counts, ordering).
     InvalidLevelTable(&'static str),
     /// §5.1, §5.2: a level header or chunk directory is malformed.
     InvalidLevelHeader(&'static str),
@@ -46,9 +46,9 @@ pub enum Error {
     DependentSplits,
     /// §6.3: the base mesh is not a consistently oriented 2-manifold.
     NonManifold(&'static str),
-    /// §6.3, §7.5: a decoded coordinate outside `0 .. 2^bits`.
+    /// §6.3, §7.4: a decoded coordinate outside `0 .. 2^bits`.
     PositionOutOfRange,
-    /// §7.5: the constrained-mode placement code is not 0, 1 or 2.
+    /// §7.4: the constrained-mode placement code is not 0, 1 or 2.
     InvalidPlacement,
     /// API misuse: levels must be fed in order, once each.
     LevelOutOfOrder { expected: u16, got: u16 },

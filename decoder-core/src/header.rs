@@ -87,6 +87,9 @@ impl Header {
             return Err(Error::InvalidHeader("triangle capacity"));
         }
         let max_chunk_len = u32_at(bytes, 24)?;
+        if max_chunk_len == 0 {
+            return Err(Error::InvalidHeader("max chunk length is 0"));
+        }
         let mut origin = [0.0; 3];
         let mut scale = [0.0; 3];
         for k in 0..3 {

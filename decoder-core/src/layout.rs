@@ -10,26 +10,21 @@ use crate::state::{MeshState, StateMemory};
 /// Alignment of every region, and of the buffer start the layout assumes.
 pub const ALIGN: usize = 8;
 
-/// Byte ranges of the workspace regions for given capacities.
+/// Byte ranges of the workspace regions for given capacities. Sizes are
+/// computed in u64 so that 32-bit targets (wasm32) cannot overflow.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Layout {
     pub vertex_capacity: u32,
     pub triangle_capacity: u32,
     pub max_chunk_len: u32,
-    positions: (usize, usize),
-    corners: (usize, usize),
-    opposite: (usize, usize),
-    vertex_corner: (usize, usize),
-    deficit: (usize, usize),
-    candidates: (usize, usize),
-    buffers: (usize, usize),
-    chunk_buffer_len: usize,
+    ranges: [(u64, u64); 7],
+    chunk_buffer_len: u64,
     /// Total bytes, from an 8-aligned start.
-    pub total: usize,
+    pub total: u64,
 }
 
-fn round_up(n: usize) -> usize {
-    n.div_ceil(ALIGN) * ALIGN
+fn round_up(n: u64) -> u64 {
+    n.div_ceil(ALIGN as u64) * ALIGN as u64
 }
 
 impl Layout {
@@ -43,13 +38,10 @@ impl Layout {
         base_triangles: u32,
         max_chunk_len: u32,
     ) -> Layout {
-        let v = vertex_capacity as usize;
-        let t = triangle_capacity as usize;
-        let opposite_len = (3 * t).max(
-            3 * base_triangles as usize
-                + MeshState::base_scratch_len(base_vertices, base_triangles),
-        );
-        let chunk_buffer_len = round_up(max_chunk_len as usize);
+        let v = vertex_capacity as u64;
+        let t = triangle_capacity as u64;
+        let opposite_len = (3 * t).max(6 * base_triangles as u64 + base_vertices as u64 + 1);
+        let chunk_buffer_len = round_up(max_chunk_len as u64);
         let sizes = [
             12 * v,
             12 * t,
@@ -57,9 +49,9 @@ impl Layout {
             4 * v,
             v,
             8 * v.div_ceil(64),
-            SLOTS * chunk_buffer_len,
+            SLOTS as u64 * chunk_buffer_len,
         ];
-        let mut ranges = [(0usize, 0usize); 7];
+        let mut ranges = [(0u64, 0u64); 7];
         let mut at = 0;
         for (range, size) in ranges.iter_mut().zip(sizes) {
             *range = (at, at + size);
@@ -69,27 +61,21 @@ impl Layout {
             vertex_capacity,
             triangle_capacity,
             max_chunk_len,
-            positions: ranges[0],
-            corners: ranges[1],
-            opposite: ranges[2],
-            vertex_corner: ranges[3],
-            deficit: ranges[4],
-            candidates: ranges[5],
-            buffers: ranges[6],
+            ranges,
             chunk_buffer_len,
             total: at,
         }
     }
 
     /// Bytes a caller must provide when it cannot guarantee an 8-aligned buffer.
-    pub fn bytes_unaligned(&self) -> usize {
-        self.total + ALIGN - 1
+    pub fn bytes_unaligned(&self) -> u64 {
+        self.total + ALIGN as u64 - 1
     }
 
     /// Whether `buffer` holds this layout once aligned.
     pub fn fits(&self, buffer: &[u8]) -> bool {
         let skip = buffer.as_ptr().align_offset(ALIGN).min(ALIGN);
-        buffer.len().saturating_sub(skip) >= self.total
+        buffer.len().saturating_sub(skip) as u64 >= self.total
     }
 
     /// Carves `buffer` into the state arrays and the per-substream chunk buffers.
@@ -98,26 +84,28 @@ impl Layout {
         buffer: &'ws mut [u8],
     ) -> Result<(StateMemory<'ws>, [&'ws mut [u8]; SLOTS]), Error> {
         let skip = buffer.as_ptr().align_offset(ALIGN).min(ALIGN);
-        let available = buffer.len().saturating_sub(skip);
-        if available < self.total {
-            return Err(Error::WorkspaceTooSmall {
-                needed: self.total + skip,
-                available: buffer.len(),
-            });
+        let too_small = Error::WorkspaceTooSmall {
+            needed: usize::try_from(self.total).unwrap_or(usize::MAX).saturating_add(skip),
+            available: buffer.len(),
+        };
+        if !self.fits(buffer) {
+            return Err(too_small);
         }
+        // fits() proved total <= buffer.len(), so these conversions succeed.
+        let r = self.ranges.map(|(a, b)| (a as usize, b as usize));
         let (_, rest) = buffer.split_at_mut(skip);
-        let (region, _) = rest.split_at_mut(self.total);
-        let (positions, rest) = take(region, self.positions, 0);
-        let (corners, rest) = take(rest, self.corners, self.positions.1);
-        let (opposite, rest) = take(rest, self.opposite, self.corners.1);
-        let (vertex_corner, rest) = take(rest, self.vertex_corner, self.opposite.1);
-        let (deficit, rest) = take(rest, self.deficit, self.vertex_corner.1);
-        let (candidates, rest) = take(rest, self.candidates, self.deficit.1);
-        let (buffers, _) = take(rest, self.buffers, self.candidates.1);
+        let (region, _) = rest.split_at_mut(self.total as usize);
+        let (positions, rest) = take(region, r[0], 0);
+        let (corners, rest) = take(rest, r[1], r[0].1);
+        let (opposite, rest) = take(rest, r[2], r[1].1);
+        let (vertex_corner, rest) = take(rest, r[3], r[2].1);
+        let (deficit, rest) = take(rest, r[4], r[3].1);
+        let (candidates, rest) = take(rest, r[5], r[4].1);
+        let (buffers, _) = take(rest, r[6], r[5].1);
         let mut buffers = buffers;
         let mut slots: [&mut [u8]; SLOTS] = Default::default();
         for slot in slots.iter_mut() {
-            let (head, tail) = buffers.split_at_mut(self.chunk_buffer_len);
+            let (head, tail) = buffers.split_at_mut(self.chunk_buffer_len as usize);
             *slot = head;
             buffers = tail;
         }

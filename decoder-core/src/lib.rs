@@ -35,12 +35,12 @@ mod level_table;
 pub mod limits;
 #[cfg(feature = "alloc")]
 pub mod owned;
-mod record;
+pub mod record;
 mod ring;
 mod round;
 mod split;
 mod state;
-mod substream;
+pub mod substream;
 #[cfg(feature = "alloc")]
 pub mod writer;
 
@@ -63,5 +63,6 @@ pub use state::{MeshState, StateMemory, next, prev};
 pub fn workspace_len(head: &[u8]) -> Result<usize, Error> {
     let header = Header::parse(head)?;
     let table = LevelTable::parse(head, &header)?;
-    Ok(layout_for(&header, &table, header.level_count - 1).bytes_unaligned())
+    let bytes = layout_for(&header, &table, header.level_count - 1).bytes_unaligned();
+    usize::try_from(bytes).map_err(|_| Error::CapacityExceeded)
 }

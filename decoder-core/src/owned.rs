@@ -48,10 +48,7 @@ pub fn decode_all(stream: &[u8], hash_rounds: bool) -> Result<DecodedMesh, Error
     let mut decoder = ws.decoder(stream)?;
     let mut round_hashes = Vec::new();
     while let Some(k) = decoder.next_level() {
-        let range = decoder.level_range(k);
-        let bytes = stream
-            .get(range.start as usize..range.end as usize)
-            .ok_or(Error::Truncated)?;
+        let bytes = decoder.level_bytes(k, stream)?;
         let mut level = decoder.begin_level(k, bytes)?;
         if k == 0 && hash_rounds {
             round_hashes.push(level.state().state_hash());

@@ -21,7 +21,9 @@ const fn base_slot(id: u8) -> usize {
 
 const _: () = assert!(slot(substream::PLACEMENT) < SLOTS);
 
-/// Feeds a round from a level's substreams.
+/// Feeds a round from a level's substreams: the stream decoder's
+/// [`RecordSource`]. Public so that other drivers (a GPU decoder's host,
+/// the conformance suite's deliberately broken decoder) reuse the parsing.
 pub struct StreamSource<'s, 'l, 'b> {
     pub subs: &'s mut Substreams<'l, 'b>,
     pub mode: PositionMode,

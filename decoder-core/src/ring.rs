@@ -91,12 +91,17 @@ impl MeshState<'_> {
     fn boundary_ring(&self, start: u32, ring: &mut Ring) -> Result<(), Error> {
         // Walk clockwise to the first wedge after the gap.
         let mut first = start;
-        for _ in 0..MAX_SPLIT_VALENCE {
+        let mut steps = 0;
+        loop {
             let o = self.opposite[prev(first) as usize];
             if o == NONE {
                 break;
             }
             first = prev(o);
+            steps += 1;
+            if steps == MAX_SPLIT_VALENCE {
+                return Err(Error::ValenceOverflow);
+            }
         }
         ring.vertices[0] = NONE;
         ring.corners[0] = NONE;

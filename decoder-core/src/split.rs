@@ -82,6 +82,9 @@ impl MeshState<'_> {
         if c >= self.vertex_capacity() || c != self.vertex_count {
             return Err(Error::CapacityExceeded);
         }
+        if t as u64 + added as u64 > self.triangle_limit as u64 {
+            return Err(Error::LevelCountMismatch);
+        }
         if t as u64 + added as u64 > self.triangle_capacity() as u64 {
             return Err(Error::CapacityExceeded);
         }

@@ -30,6 +30,8 @@ pub struct MeshState<'ws> {
     pub(crate) candidates: &'ws mut [u64],
     pub(crate) vertex_count: u32,
     pub(crate) triangle_count: u32,
+    /// Triangle count the current level may reach (SPEC §7.6).
+    pub(crate) triangle_limit: u32,
     pub(crate) bits: u8,
 }
 
@@ -66,6 +68,7 @@ impl<'ws> MeshState<'ws> {
             candidates,
             vertex_count: 0,
             triangle_count: 0,
+            triangle_limit: u32::MAX,
             bits,
         }
     }
@@ -93,6 +96,13 @@ impl<'ws> MeshState<'ws> {
     pub fn triangle_capacity(&self) -> u32 {
         let n = (self.corners.len().min(self.opposite.len()) / 3) as u64;
         n.min(crate::limits::MAX_TRIANGLES as u64) as u32
+    }
+
+    /// Bounds the triangle count of the level being decoded: a split that
+    /// would pass it fails with [`crate::Error::LevelCountMismatch`]
+    /// (SPEC §7.6), whatever the workspace could hold.
+    pub fn set_triangle_limit(&mut self, limit: u32) {
+        self.triangle_limit = limit;
     }
 
     /// Quantized positions of the current vertices, in decoded order.

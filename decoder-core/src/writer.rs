@@ -147,7 +147,7 @@ pub fn write_stream(params: &StreamParams, levels: &[LevelPayload]) -> Vec<u8> {
         max_chunk_len: max_chunk,
         origin: params.origin,
         scale: params.scale,
-        workspace_bytes: layout.total as u64,
+        workspace_bytes: layout.total,
     };
     let mut out = vec![0u8; head_len(level_count)];
     let mut head = [0u8; HEADER_LEN];

@@ -18,7 +18,7 @@ fn canonical(t: [u32; 3]) -> [u32; 3] {
 pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {
     let encoded = encode(mesh, options, |_| {}).expect("encode");
     let decoded = decode_all(&encoded.stream, false).expect("decode");
-    let q = quantize(mesh, options.bits);
+    let q = quantize(mesh, options.bits, options.units);
     assert_eq!(decoded.positions.len(), mesh.positions.len());
     for (d, &e) in encoded.permutation.iter().enumerate() {
         assert_eq!(decoded.positions[d], q.positions[e as usize], "vertex {e}");

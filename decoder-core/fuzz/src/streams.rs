@@ -400,7 +400,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
     let vcap = bv + MAX_SPLITS;
     let tcap = bt + 2 * MAX_SPLITS;
     let layout = Layout::new(vcap, tcap, bv, bt, 1);
-    let mut memory = vec![0u8; layout.bytes_unaligned()];
+    let mut memory = vec![0u8; layout.bytes_unaligned() as usize];
     let (mem, _) = layout.carve(&mut memory).expect("layout fits");
     let mut state = MeshState::new(mem, bits);
     {

@@ -73,6 +73,11 @@ impl CornerTable {
         self.vertex[c as usize]
     }
 
+    /// Whether corner `c`'s triangle is still part of the mesh.
+    pub fn corner_alive(&self, c: u32) -> bool {
+        self.vertex.get(c as usize).is_some_and(|&v| v != NONE)
+    }
+
     pub fn o(&self, c: u32) -> u32 {
         self.opposite[c as usize]
     }

@@ -84,20 +84,20 @@ pub fn simplify_sequential(mesh: &Mesh, options: &BaselineOptions) -> BaselineRe
     let mut max_collapse_error = 0.0f64;
     while s.alive_count > options.target_vertices {
         let Some(entry) = s.heap.pop() else { break };
-        let (u, v) = (entry.u, entry.v);
-        if !s.alive[u as usize] || !s.alive[v as usize] {
+        if !s.table.corner_alive(entry.corner) {
             continue;
         }
-        if options.max_error.is_some_and(|m| entry.error > m) {
-            break;
-        }
         // Lazy deletion: an entry is current only if re-scoring the edge
-        // gives the same error; otherwise a fresher entry exists.
+        // gives the same key; otherwise a fresher entry exists.
+        let (u, v) = s.edge(entry.corner);
         let Some((p, error, q)) = s.target(u, v) else {
             continue;
         };
-        if error_key(error) != error_key(entry.error) {
+        if error_key(error) != entry.error.to_bits() {
             continue;
+        }
+        if options.max_error.is_some_and(|m| error > m) {
+            break;
         }
         match s.plan(u, v, p) {
             Ok(plan) => {

@@ -70,12 +70,16 @@ impl<'o> Simplifier<'o> {
             if o != NONE && o < c {
                 continue; // the other side scores this edge
             }
-            let (u, v) = (self.table.v(next(c)), self.table.v(prev(c)));
-            if let Some(e) = self.score(u, v) {
+            if let Some(e) = self.score(c) {
                 entries.push(e);
             }
         }
         self.heap = Queue::from_entries(entries);
+    }
+
+    /// The edge facing live corner `c`, as (survivor, removed) vertices.
+    pub fn edge(&self, c: u32) -> (u32, u32) {
+        (self.table.v(next(c)), self.table.v(prev(c)))
     }
 
     /// Where edge `(u, v)` would collapse to and at what error; `None` when
@@ -97,9 +101,39 @@ impl<'o> Simplifier<'o> {
         Some((p, e, q))
     }
 
-    fn score(&self, u: u32, v: u32) -> Option<Entry> {
+    /// The queue entry of the edge facing live corner `c`.
+    fn score(&self, c: u32) -> Option<Entry> {
+        let (u, v) = self.edge(c);
         let (_, error, _) = self.target(u, v)?;
-        Some(Entry { error, u, v })
+        Some(Entry::new(error, c))
+    }
+
+    /// Queues every edge around `v` except the one to `skip`, once each.
+    fn queue_edges_of(&mut self, v: u32, skip: u32) {
+        let mut fan = std::mem::take(&mut self.fans[2]);
+        self.table.fan(v, &mut fan);
+        for &c in &fan.corners {
+            // prev(c) faces the edge (v, vertex[next c]); together these
+            // cover every edge but the one closing an open fan, which only
+            // next(c) of the last triangle faces.
+            let mut edges = [prev(c), NONE];
+            if self.table.o(next(c)) == NONE {
+                edges[1] = next(c);
+            }
+            for e in edges {
+                if e == NONE {
+                    continue;
+                }
+                let (x, y) = self.edge(e);
+                if x == skip || y == skip {
+                    continue;
+                }
+                if let Some(entry) = self.score(e) {
+                    self.heap.push(entry);
+                }
+            }
+        }
+        self.fans[2] = fan;
     }
 
     /// A fresh mark token; old marks become meaningless without clearing.
@@ -135,29 +169,16 @@ impl<'o> Simplifier<'o> {
     pub fn requeue_around(&mut self, a: u32) {
         self.refused[a as usize] = false;
         self.collect_neighbours(a);
-        let ring = std::mem::take(&mut self.neighbours);
-        let mut retry = Vec::new();
-        for &n in &ring {
-            if self.refused[n as usize] {
-                self.refused[n as usize] = false;
-                retry.push(n);
-            }
-        }
-        for &n in &ring {
-            if let Some(e) = self.score(a, n) {
-                self.heap.push(e);
-            }
-        }
-        self.neighbours = ring;
+        let retry: Vec<u32> = self
+            .neighbours
+            .iter()
+            .copied()
+            .filter(|&n| self.refused[n as usize])
+            .collect();
+        self.queue_edges_of(a, NONE);
         for n in retry {
-            self.collect_neighbours(n);
-            let ring = std::mem::take(&mut self.neighbours);
-            for &z in ring.iter().filter(|&&z| z != a) {
-                if let Some(e) = self.score(n, z) {
-                    self.heap.push(e);
-                }
-            }
-            self.neighbours = ring;
+            self.refused[n as usize] = false;
+            self.queue_edges_of(n, a);
         }
     }
 }

@@ -18,10 +18,7 @@ pub fn run(input: &Path, output: &Path, level: Option<u16>) -> CliResult {
         return Err(format!("--level {stop}: the stream has levels 0..={last}"));
     }
     while let Some(k) = decoder.next_level().filter(|&k| k <= stop) {
-        let range = decoder.level_range(k);
-        let bytes = stream
-            .get(range.start as usize..range.end as usize)
-            .ok_or_else(|| format!("{}: stream truncated in level {k}", input.display()))?;
+        let bytes = decoder.level_bytes(k, &stream).map_err(fail)?;
         decoder.decode_level(k, bytes).map_err(fail)?;
     }
     let positions: Vec<[f64; 3]> = decoder.positions().iter().map(|&q| decoder.dequantize(q)).collect();

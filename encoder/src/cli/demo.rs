@@ -40,8 +40,7 @@ pub fn run(side: usize) -> CliResult {
     println!("level   vertices  triangles   bytes  total bytes  geometric error (m)  decode ms");
     let mut total = splitstream_decoder_core::head_len(decoder.header().level_count) as u64;
     while let Some(k) = decoder.next_level() {
-        let range = decoder.level_range(k);
-        let bytes = &stream[range.start as usize..range.end as usize];
+        let bytes = decoder.level_bytes(k, stream).map_err(fail)?;
         let t = Instant::now();
         decoder.decode_level(k, bytes).map_err(fail)?;
         let ms = t.elapsed().as_secs_f64() * 1e3;

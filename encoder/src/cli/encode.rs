@@ -8,6 +8,8 @@ use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
+use splitstream_encoder::quantize::Units;
+use splitstream_encoder::Mesh;
 
 use super::{CliResult, Codec, Position};
 
@@ -27,6 +29,7 @@ pub struct Args {
     pub npz_array: Option<String>,
     pub z_scale: f64,
     pub admit: f64,
+    pub geographic: bool,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -72,7 +75,13 @@ pub fn run(a: Args) -> CliResult {
         chunk_limit: a.chunk_size,
         lock_boundary: a.lock_boundary,
         admit_quantile: a.admit,
+        units: if a.geographic { Units::Geographic } else { Units::Linear },
     };
+    if !a.geographic && looks_geographic(&mesh) {
+        eprintln!(
+            "note: x and y look like longitude/latitude in degrees; pass --geographic to measure errors in metres"
+        );
+    }
     let n = mesh.positions.len();
     let bar = ProgressBar::new(n as u64);
     bar.set_style(
@@ -105,4 +114,15 @@ pub fn run(a: Args) -> CliResult {
         read_seconds, encoded.simplify_seconds, encoded.emit_seconds
     );
     Ok(())
+}
+
+/// Degrees-sized x/y extents inside lon/lat ranges next to a z range in
+/// the hundreds: a geographic grid whose errors would be meaningless in
+/// raw units.
+fn looks_geographic(mesh: &Mesh) -> bool {
+    let Some((lo, hi)) = mesh.bounding_box() else {
+        return false;
+    };
+    let xy = (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    lo[0] >= -180.0 && hi[0] <= 180.0 && lo[1] >= -90.0 && hi[1] <= 90.0 && xy < 5.0 && hi[2] - lo[2] > 50.0 * xy
 }

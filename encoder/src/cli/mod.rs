@@ -80,6 +80,10 @@ pub enum Command {
         /// Fraction of candidate collapses admitted per step (0..1].
         #[arg(long, default_value_t = 0.5)]
         admit: f64,
+        /// x and y are longitude and latitude in degrees (z in metres):
+        /// errors are measured in metres.
+        #[arg(long)]
+        geographic: bool,
     },
     /// Decode a stream to .ply or .obj, in decoded vertex order.
     Decode {
@@ -125,6 +129,7 @@ pub fn run(cli: Cli) -> CliResult {
             npz_array,
             z_scale,
             admit,
+            geographic,
         } => encode::run(encode::Args {
             input,
             output,
@@ -141,6 +146,7 @@ pub fn run(cli: Cli) -> CliResult {
             npz_array,
             z_scale,
             admit,
+            geographic,
         }),
         Command::Decode {
             input,

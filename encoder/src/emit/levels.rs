@@ -15,8 +15,8 @@ pub struct LevelPlan {
 
 /// Splits the steps into at most `levels - 1` refinement levels whose vertex
 /// counts are as close as possible to a geometric sequence from the base
-/// size to the full size. `scale` converts grid units to model units.
-pub fn plan_levels(s: &Simplification, levels: usize, scale: f64) -> LevelPlan {
+/// size to the full size. Errors are in the simplifier's metric units.
+pub fn plan_levels(s: &Simplification, levels: usize) -> LevelPlan {
     let steps = s.steps.len();
     // Vertex count after undoing the last i steps (i = 0: the base).
     let mut counts = vec![s.alive_count as f64];
@@ -54,7 +54,7 @@ pub fn plan_levels(s: &Simplification, levels: usize, scale: f64) -> LevelPlan {
             .fold(0.0f64, f64::max);
         prefix_max[k + 1] = prefix_max[k].max(step_max);
     }
-    let error_after = |undone: usize| (prefix_max[steps - undone] * scale) as f32;
+    let error_after = |undone: usize| prefix_max[steps - undone] as f32;
     let mut rounds = Vec::with_capacity(bounds.len());
     let mut errors = vec![error_after(0)];
     let mut start = 0;

@@ -9,7 +9,7 @@ use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, write_stream};
 
 use crate::mesh::Mesh;
-use crate::quantize::{QuantizedMesh, quantize};
+use crate::quantize::{QuantizedMesh, Units, quantize};
 use crate::simplify::{SimplifyOptions, simplify};
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
@@ -31,6 +31,8 @@ pub struct EncodeOptions {
     pub chunk_limit: u32,
     pub lock_boundary: bool,
     pub admit_quantile: f64,
+    /// Units of the input coordinates, for the error metric.
+    pub units: Units,
 }
 
 impl Default for EncodeOptions {
@@ -45,6 +47,7 @@ impl Default for EncodeOptions {
             chunk_limit: 16 * 1024,
             lock_boundary: false,
             admit_quantile: SimplifyOptions::default().admit_quantile,
+            units: Units::Linear,
         }
     }
 }
@@ -94,7 +97,7 @@ pub fn encode(
     if options.levels == 0 {
         return Err(EncodeError::BadOption("--levels must be at least 1".into()));
     }
-    let quantized = quantize(mesh, options.bits);
+    let quantized = quantize(mesh, options.bits, options.units);
     encode_quantized(&quantized, options, progress)
 }
 
@@ -122,7 +125,7 @@ pub fn encode_quantized(
     let simplification = simplify(mesh, &simplify_options, progress);
     let simplify_seconds = started.elapsed().as_secs_f64();
     let started = std::time::Instant::now();
-    let plan = plan_levels(&simplification, options.levels, mesh.scale[0]);
+    let plan = plan_levels(&simplification, options.levels);
     let replayed = replay(mesh, &simplification, &plan, options.position_mode)
         .map_err(EncodeError::Replay)?;
     let params = StreamParams {

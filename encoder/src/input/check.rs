@@ -92,6 +92,7 @@ pub enum MeshError {
     /// Two triangles traverse the same directed edge.
     InconsistentOrientation {
         edge: [u32; 2],
+        positions: [[f64; 3]; 2],
         triangles: [usize; 2],
     },
     /// The triangles around a vertex form more than one fan.
@@ -184,10 +185,19 @@ impl fmt::Display for MeshError {
                 triangles.len(),
                 triangles
             ),
-            MeshError::InconsistentOrientation { edge, triangles } => write!(
+            MeshError::InconsistentOrientation {
+                edge,
+                positions,
+                triangles,
+            } => write!(
                 f,
-                "triangles {} and {} both traverse edge {}->{} in the same direction (inconsistent orientation)",
-                triangles[0], triangles[1], edge[0], edge[1]
+                "triangles {} and {} both traverse edge {}->{} {}-{} in the same direction (inconsistent orientation)",
+                triangles[0],
+                triangles[1],
+                edge[0],
+                edge[1],
+                P(positions[0]),
+                P(positions[1])
             ),
             MeshError::NonManifoldVertex {
                 vertex,
@@ -412,6 +422,7 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
     if let Some((second, edge, first)) = worst_orientation {
         return Err(MeshError::InconsistentOrientation {
             edge,
+            positions: edge.map(|v| pos[v as usize]),
             triangles: [first, second],
         });
     }
@@ -667,6 +678,7 @@ mod tests {
             e,
             MeshError::InconsistentOrientation {
                 edge: [0, 1],
+                positions: [[0.0, 0.0, 0.5], [1.0, 1.0, 0.5]],
                 triangles: [0, 1]
             }
         );

@@ -13,7 +13,7 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
-use tiff::decoder::{Decoder, DecodingResult};
+use tiff::decoder::{Decoder, DecodingResult, Limits};
 use tiff::tags::Tag;
 
 use super::grid::Grid;
@@ -29,7 +29,14 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
         tiff::TiffError::UnsupportedError(u) => InputError::unsupported(file, format!("TIFF {u}")),
         e => InputError::malformed(file, format!("invalid TIFF: {e}")),
     };
-    let mut decoder = Decoder::new(BufReader::new(f)).map_err(bad)?;
+    // The default 256 MiB buffer limit rejects ordinary 1 m DEM tiles;
+    // 4 GiB still refuses absurd headers before allocating.
+    let mut limits = Limits::default();
+    limits.decoding_buffer_size = usize::try_from(4u64 << 30).unwrap_or(usize::MAX);
+    limits.intermediate_buffer_size = 1 << 30;
+    let mut decoder = Decoder::new(BufReader::new(f))
+        .map_err(bad)?
+        .with_limits(limits);
     let (width, height) = decoder.dimensions().map_err(bad)?;
     let (cols, rows) = (width as usize, height as usize);
     check_vertex_count(file, width as u64 * height as u64)?;

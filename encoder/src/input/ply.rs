@@ -9,8 +9,10 @@ use std::fs::File;
 use std::io::BufReader;
 use std::path::Path;
 
-use ply_rs_bw::parser::Parser;
-use ply_rs_bw::ply::{BeginList, Property, PropertyAccess, PropertyAccessResult, PropertyType};
+use ply_rs_bw::parser::{ParseError, Parser, Reader};
+use ply_rs_bw::ply::{
+    BeginList, Encoding, Property, PropertyAccess, PropertyAccessResult, PropertyType,
+};
 
 use crate::Mesh;
 
@@ -136,21 +138,15 @@ impl PropertyAccess for Element {
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let f = File::open(path).map_err(|e| InputError::io(file, e))?;
-    let mut reader = BufReader::new(f);
-    let ply = Parser::<Element>::new()
-        .read_ply(&mut reader)
-        .map_err(|e| match e.line() {
-            Some(line) if e.kind() != std::io::ErrorKind::UnexpectedEof || line > 0 => {
-                InputError::malformed(
-                    file,
-                    format!("PLY line {line}: {}", strip_line_prefix(&e.to_string())),
-                )
-            }
-            _ => InputError::malformed(file, format!("invalid PLY: {e}")),
-        })?;
-
-    let vertex_def = ply
-        .header
+    let parser = Parser::<Element>::new();
+    let mut reader = Reader::new(BufReader::new(f));
+    let header = parser
+        .read_header(&mut reader)
+        .map_err(|e| ply_error(file, &e, true))?;
+    let payload = parser
+        .read_payload(&mut reader, &header)
+        .map_err(|e| ply_error(file, &e, header.encoding == Encoding::Ascii))?;
+    let vertex_def = header
         .elements
         .get("vertex")
         .ok_or_else(|| InputError::malformed(file, "PLY has no 'vertex' element"))?;
@@ -171,8 +167,7 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
             }
         }
     }
-    let face_def = ply
-        .header
+    let face_def = header
         .elements
         .get("face")
         .ok_or_else(|| InputError::malformed(file, "PLY has no 'face' element"))?;
@@ -188,8 +183,8 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     }
 
     let empty = Vec::new();
-    let vertices = ply.payload.get("vertex").unwrap_or(&empty);
-    let faces = ply.payload.get("face").unwrap_or(&empty);
+    let vertices = payload.get("vertex").unwrap_or(&empty);
+    let faces = payload.get("face").unwrap_or(&empty);
     check_vertex_count(file, vertices.len() as u64)?;
     let positions: Vec<[f64; 3]> = vertices.iter().map(|v| v.xyz).collect();
     let mut triangles = Vec::with_capacity(faces.len());
@@ -209,11 +204,28 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     })
 }
 
-/// `ply-rs-bw` prefixes messages with "Line N:"; we print our own.
-fn strip_line_prefix(message: &str) -> &str {
-    match message.strip_prefix("Line ") {
-        Some(rest) => rest.split_once(": ").map_or(message, |(_, m)| m),
-        None => message,
+/// Turns a `ply-rs-bw` error into one readable line: the line number only
+/// where lines mean something (header, ascii payload), and the offending
+/// text plus the innermost cause instead of the nested restatements.
+fn ply_error(file: &str, e: &ParseError, text: bool) -> InputError {
+    let message = e.to_string();
+    let message = match message.strip_prefix("Line ") {
+        Some(rest) => rest.split_once(": ").map_or(message.as_str(), |(_, m)| m),
+        None => message.as_str(),
+    };
+    let message = match (
+        message.split_once("String: '"),
+        message.rsplit_once("Error: "),
+    ) {
+        (Some((_, rest)), Some((_, cause))) => {
+            let quoted = rest.split_once('\'').map_or(rest, |(q, _)| q).trim();
+            format!("cannot parse '{quoted}': {cause}")
+        }
+        _ => message.to_owned(),
+    };
+    match e.line() {
+        Some(line) if text && line > 0 => InputError::line(file, line, message),
+        _ => InputError::malformed(file, format!("invalid PLY: {message}")),
     }
 }
 

@@ -10,6 +10,9 @@ use super::closest::{closest_point, dist2};
 
 const LEAF_SIZE: usize = 4;
 
+/// A `hint` for [`Bvh::nearest_dist2`] that names no leaf.
+pub const NO_HINT: u32 = u32::MAX;
+
 #[derive(Clone, Copy)]
 struct Node {
     lo: [f64; 3],
@@ -53,10 +56,19 @@ impl Bvh {
 
     /// Squared distance from `p` to the nearest triangle (infinite when there
     /// are none).
-    pub fn nearest_dist2(&self, p: [f64; 3]) -> f64 {
+    ///
+    /// `hint` is a leaf to try first (any value; [`NO_HINT`] for none) and
+    /// comes back as the leaf holding the nearest triangle: for samples
+    /// visited in surface order the previous answer is nearly always close,
+    /// so the search starts with a tight bound and prunes most of the tree.
+    /// The result does not depend on the hint.
+    pub fn nearest_dist2(&self, p: [f64; 3], hint: &mut u32) -> f64 {
         let mut best = f64::INFINITY;
         if self.nodes.is_empty() {
             return best;
+        }
+        if let Some(node) = self.nodes.get(*hint as usize).filter(|n| n.count > 0) {
+            best = self.leaf_dist2(node, p);
         }
         // Median splits keep the depth under 33 for any u32 triangle count,
         // and the stack never holds more than depth + 1 entries.
@@ -71,9 +83,10 @@ impl Bvh {
             }
             let node = &self.nodes[i as usize];
             if node.count > 0 {
-                let first = node.index as usize;
-                for tri in &self.triangles[first..first + node.count as usize] {
-                    best = best.min(dist2(p, closest_point(p, *tri)));
+                let d = self.leaf_dist2(node, p);
+                if d < best {
+                    best = d;
+                    *hint = i;
                 }
                 continue;
             }
@@ -94,6 +107,14 @@ impl Bvh {
             }
         }
         best
+    }
+
+    fn leaf_dist2(&self, leaf: &Node, p: [f64; 3]) -> f64 {
+        let first = leaf.index as usize;
+        self.triangles[first..first + leaf.count as usize]
+            .iter()
+            .map(|tri| dist2(p, closest_point(p, *tri)))
+            .fold(f64::INFINITY, f64::min)
     }
 }
 
@@ -163,18 +184,24 @@ mod tests {
             .collect();
         let triangles: Vec<[u32; 3]> = (0..200).map(|i| [3 * i, 3 * i + 1, 3 * i + 2]).collect();
         let bvh = Bvh::new(&positions, &triangles);
+        let mut hint = NO_HINT;
         for q in 0..300 {
             let p = [0, 1, 2].map(|k| 3.0 * unit(2, 3 * q + k) - 1.0);
             let brute = triangles
                 .iter()
                 .map(|t| dist2(p, closest_point(p, t.map(|v| positions[v as usize]))))
                 .fold(f64::INFINITY, f64::min);
-            assert_eq!(bvh.nearest_dist2(p), brute);
+            assert_eq!(bvh.nearest_dist2(p, &mut hint), brute);
+            // Any hint, even a wrong or stale one, gives the same answer.
+            assert_eq!(bvh.nearest_dist2(p, &mut (q as u32)), brute);
         }
     }
 
     #[test]
     fn empty_is_infinitely_far() {
-        assert_eq!(Bvh::new(&[], &[]).nearest_dist2([0.0; 3]), f64::INFINITY);
+        assert_eq!(
+            Bvh::new(&[], &[]).nearest_dist2([0.0; 3], &mut 0),
+            f64::INFINITY
+        );
     }
 }

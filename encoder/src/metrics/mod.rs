@@ -76,7 +76,10 @@ fn one_way(samples: &[[f64; 3]], bvh: &Bvh) -> Vec<f64> {
     samples
         .par_iter()
         .with_min_len(1024)
-        .map(|&p| bvh.nearest_dist2(p).sqrt())
+        .map_init(
+            || bvh::NO_HINT,
+            |hint, &p| bvh.nearest_dist2(p, hint).sqrt(),
+        )
         .collect()
 }
 

@@ -93,23 +93,16 @@ fn empty_meshes() {
 }
 
 /// Speed of 1M samples per side between a 1M-vertex, 2M-triangle terrain
-/// and its half-size simplification:
+/// and a half-resolution sampling of the same landscape:
 /// `cargo test --release -p splitstream-encoder metrics_speed -- --ignored --nocapture`.
 #[test]
 #[ignore = "benchmark; run in release"]
 fn metrics_speed_on_a_million_vertices() {
-    use crate::baseline::{BaselineOptions, simplify_sequential, tests::terrain};
+    use crate::baseline::tests::terrain;
     use std::time::Instant;
 
     let fine = terrain(1000);
-    let coarse = simplify_sequential(
-        &fine,
-        &BaselineOptions {
-            target_vertices: 500_000,
-            ..BaselineOptions::default()
-        },
-    )
-    .mesh;
+    let coarse = terrain(708);
     let start = Instant::now();
     let r = surface_distance(&fine, &coarse, 1_000_000, 7);
     println!(
@@ -120,5 +113,5 @@ fn metrics_speed_on_a_million_vertices() {
         coarse.triangle_count(),
         start.elapsed().as_secs_f64()
     );
-    assert!(r.hausdorff < 1e-3 * r.diagonal);
+    assert!(r.hausdorff < 0.01 * r.diagonal);
 }

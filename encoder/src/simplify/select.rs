@@ -23,10 +23,6 @@ impl Best {
         error_key: u32::MAX,
         target: [0; 3],
     };
-
-    pub fn target_geometry(&self) -> [f64; 3] {
-        self.target.map(|x| x as f64)
-    }
 }
 
 /// Total order of collapse requests: error first, then the lower id wins
@@ -35,9 +31,10 @@ pub fn pair_key(b: &Best, v: u32) -> u64 {
     ((b.error_key as u64) << 32) | v.min(b.other) as u64
 }
 
-/// Where the collapse of edge (v, u) puts the merged vertex, and its error.
-/// Computed from the lower id first, so both endpoints get identical results.
-fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
+/// Where the collapse of edge (v, u) puts the merged vertex, and its error
+/// (`None` when locked boundaries forbid it). Computed from the lower id
+/// first, so both endpoints get identical results.
+pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
     let (p, c) = (v.min(u), v.max(u));
     let (pi, ci) = (p as usize, c as usize);
     let q = s.quadrics[pi] + s.quadrics[ci];
@@ -54,7 +51,7 @@ fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
             std::array::from_fn(|k| (pp[k] as i64 + ((pc[k] as i64 - pp[k] as i64) >> 1)) as u32);
         let mut best = (pp, q.error(s.geometry[pi]));
         for cand in [pc, mid] {
-            let e = q.error(cand.map(|x| x as f64));
+            let e = q.error(s.to_metric(cand));
             if e < best.1 {
                 best = (cand, e);
             }
@@ -63,9 +60,35 @@ fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
     } else {
         let (t, _) = collapse_target(&q, s.geometry[pi], s.geometry[ci], false);
         let top = ((1u64 << s.bits) - 1) as f64;
-        t.map(|x| x.round().clamp(0.0, top) as u32)
+        std::array::from_fn(|k| (t[k] / s.metric[k]).round().clamp(0.0, top) as u32)
     };
-    Some((target, q.error(target.map(|x| x as f64))))
+    Some((target, q.error(s.to_metric(target))))
+}
+
+/// Cached collapse of the edge facing one corner (the paper's Edge array).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EdgeSlot {
+    pub error: f64,
+    pub target: [u32; 3],
+}
+
+impl EdgeSlot {
+    pub const FORBIDDEN: EdgeSlot = EdgeSlot {
+        error: f64::INFINITY,
+        target: [0; 3],
+    };
+}
+
+/// The slot of the edge facing corner `c` (the edge from next(c) to prev(c)).
+pub fn edge_slot(s: &State, c: u32) -> EdgeSlot {
+    let (a, b) = (s.table.v(next(c)), s.table.v(prev(c)));
+    if a == NONE {
+        return EdgeSlot::FORBIDDEN;
+    }
+    match evaluate(s, a, b) {
+        Some((target, error)) => EdgeSlot { error, target },
+        None => EdgeSlot::FORBIDDEN,
+    }
 }
 
 /// Scale of the current mesh, for the tie-breaks.
@@ -81,7 +104,7 @@ fn cell_of(p: [f64; 3], cell: f64) -> [i64; 3] {
     p.map(|x| (x / cell).floor() as i64)
 }
 
-/// The best valid collapse of `v` (§2 step a).
+/// The best valid collapse of `v` (§2 step a), from the cached edge slots.
 pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) -> Best {
     if !s.alive[v as usize] {
         return Best::NONE;
@@ -92,17 +115,19 @@ pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) ->
     candidates.clear();
     let home = (scale.cell > 0.0).then(|| cell_of(s.geometry(v), scale.cell));
     for &c in &fan.corners {
-        for u in [s.table.v(next(c)), s.table.v(prev(c))] {
+        // Edge (v, next c) faces prev c; edge (v, prev c) faces next c.
+        for (u, facing) in [(s.table.v(next(c)), prev(c)), (s.table.v(prev(c)), next(c))] {
             if candidates.iter().any(|x: &Candidate| x.other == u) {
                 continue;
             }
-            let Some((target, error)) = evaluate(s, v, u) else {
+            let slot = s.edges[facing as usize];
+            if slot.error == f64::INFINITY {
                 continue;
-            };
-            let error_key = if error <= scale.flat {
+            }
+            let error_key = if slot.error <= scale.flat {
                 0
             } else {
-                (error as f32).to_bits()
+                (slot.error as f32).to_bits()
             };
             let other_cell = home.is_some_and(|h| h != cell_of(s.geometry(u), scale.cell));
             candidates.push(Candidate {
@@ -110,9 +135,9 @@ pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) ->
                 other: u,
                 best: Best {
                     other: u,
-                    error,
+                    error: slot.error,
                     error_key,
-                    target,
+                    target: slot.target,
                 },
             });
         }
@@ -121,7 +146,7 @@ pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) ->
     let mut found = Best::NONE;
     for cand in &candidates {
         let (p, c) = (v.min(cand.other), v.max(cand.other));
-        if check_collapse(s, p, c, cand.best.target_geometry(), scratch).is_ok() {
+        if check_collapse(s, p, c, s.to_metric(cand.best.target), scratch).is_ok() {
             found = cand.best;
             break;
         }

@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use super::check::{CheckScratch, check_collapse};
-use super::select::{Best, Scale, best_edge, pair_key};
+use super::select::{Best, EdgeSlot, Scale, best_edge, edge_slot, pair_key};
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
@@ -63,9 +63,9 @@ pub struct Collapse {
     /// Split valences P and C had before the collapse ([`LEAF`] if original).
     pub split_valence_p: u8,
     pub split_valence_c: u8,
-    /// Quadric error of the collapse.
+    /// Quadric error of the collapse (metric units).
     pub error: f64,
-    /// The error as a distance in grid units: sqrt(error / total weight of
+    /// The error as a distance in metric units: sqrt(error / total weight of
     /// the merged quadric), an RMS distance to the planes it summarises.
     pub distance: f64,
 }
@@ -91,7 +91,11 @@ pub(super) struct State {
     pub boundary: Vec<bool>,
     pub alive: Vec<bool>,
     pub split_valence: Vec<u8>,
+    /// Cached collapse of the edge facing each corner.
+    pub edges: Vec<EdgeSlot>,
     pub bits: u8,
+    /// Grid units to metric units per axis: geometry = position * metric.
+    pub metric: [f64; 3],
     pub constrained: bool,
     pub lock_boundary: bool,
 }
@@ -99,6 +103,11 @@ pub(super) struct State {
 impl State {
     pub fn geometry(&self, v: u32) -> [f64; 3] {
         self.geometry[v as usize]
+    }
+
+    /// Metric coordinates of a grid point.
+    pub fn to_metric(&self, q: [u32; 3]) -> [f64; 3] {
+        std::array::from_fn(|k| q[k] as f64 * self.metric[k])
     }
 }
 
@@ -109,10 +118,11 @@ pub fn simplify(
     mut progress: impl FnMut(usize),
 ) -> Simplification {
     let n = mesh.positions.len();
+    let metric = mesh.metric;
     let geometry: Vec<[f64; 3]> = mesh
         .positions
         .iter()
-        .map(|p| p.map(|x| x as f64))
+        .map(|p| std::array::from_fn(|k| p[k] as f64 * metric[k]))
         .collect();
     let table = CornerTable::new(n, &mesh.triangles);
     let mut boundary = vec![false; n];
@@ -131,10 +141,16 @@ pub fn simplify(
         boundary,
         alive,
         split_valence: vec![LEAF; n],
+        edges: Vec::new(),
         bits: mesh.bits,
+        metric,
         constrained: options.constrained,
         lock_boundary: options.lock_boundary,
     };
+    s.edges = (0..s.table.vertex.len() as u32)
+        .into_par_iter()
+        .map(|c| edge_slot(&s, c))
+        .collect();
     let mut alive_count = s.alive.iter().filter(|&&a| a).count();
     let mut steps = Vec::new();
     let mut step_errors = Vec::new();
@@ -188,6 +204,7 @@ pub fn simplify(
             step_error = step_error.max(b.error);
             collapses.push(collapse);
         }
+        refresh_edges(&mut s, &winners);
         alive_count -= collapses.len();
         steps.push(collapses);
         step_errors.push(step_error);
@@ -254,7 +271,7 @@ fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64]) -> bool {
 fn apply_collapse(s: &mut State, p: u32, b: Best, fans: &mut [Fan; 2]) -> Collapse {
     let c = b.other;
     let mut scratch = CheckScratch::default();
-    let plan = check_collapse(s, p, c, b.target_geometry(), &mut scratch)
+    let plan = check_collapse(s, p, c, s.to_metric(b.target), &mut scratch)
         .expect("the winner was checked in this step and its neighbourhood is untouched");
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
     let weight = q.c[0] + q.c[4] + q.c[7];
@@ -275,12 +292,34 @@ fn apply_collapse(s: &mut State, p: u32, b: Best, fans: &mut [Fan; 2]) -> Collap
     s.table.collapse(p, c, plan.left, plan.right, fans);
     let (pi, ci) = (p as usize, c as usize);
     s.positions[pi] = b.target;
-    s.geometry[pi] = b.target_geometry();
+    s.geometry[pi] = s.to_metric(b.target);
     s.quadrics[pi] = q;
     s.boundary[pi] |= s.boundary[ci];
     s.alive[ci] = false;
     s.split_valence[pi] = plan.valence_r as u8;
     record
+}
+
+/// Re-evaluates the edges around each merged vertex: only their quadric or
+/// position changed.
+fn refresh_edges(s: &mut State, merged: &[u32]) {
+    let updates: Vec<(u32, EdgeSlot)> = merged
+        .par_iter()
+        .flat_map_iter(|&r| {
+            let mut fan = Fan::default();
+            s.table.fan(r, &mut fan);
+            let mut out = Vec::with_capacity(2 * fan.corners.len());
+            for &c in &fan.corners {
+                for k in [next(c), prev(c)] {
+                    out.push((k, edge_slot(s, k)));
+                }
+            }
+            out
+        })
+        .collect();
+    for (c, slot) in updates {
+        s.edges[c as usize] = slot;
+    }
 }
 
 /// Mean length of the live edges, for the sub-grid cell size.

@@ -1,0 +1,197 @@
+//! Decoders compiled into the runner, run in-process.
+//!
+//! To add one (a C ABI, WebAssembly, wgpu or OpenCL decoder), write a
+//! `fn(&[u8]) -> Outcome` that decodes through that implementation and
+//! reports the state hash after the base level and after every round, then
+//! add a [`Builtin`] entry to [`BUILTINS`] (behind a cargo feature if it
+//! needs a toolchain or device that CI machines may lack). A decoder that
+//! lives in another process needs nothing here: see `run --decoder`.
+
+use splitstream_decoder_core::limits::substream;
+use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_decoder_core::record::{StreamSource, read_base};
+use splitstream_decoder_core::substream::Substreams;
+use splitstream_decoder_core::{
+    Error, Header, Inflater, LevelHeader, LevelTable, MeshState, RecordSource, Ring, SplitRecord,
+    layout_for,
+};
+
+use crate::protocol::{Outcome, Verdict};
+
+/// A decoder the runner can call directly.
+pub struct Builtin {
+    pub name: &'static str,
+    pub summary: &'static str,
+    /// Test-only decoders are left out of `run` without `--builtin`.
+    pub hidden: bool,
+    pub decode: fn(&[u8]) -> Outcome,
+}
+
+/// Every built-in decoder; the visible ones make up `run`'s default list.
+pub const BUILTINS: &[Builtin] = &[
+    Builtin {
+        name: "decoder-core",
+        summary: "the reference decoder (decoder-core's Decoder, level by level, round by round)",
+        hidden: false,
+        decode: decoder_core,
+    },
+    // Later: "c-abi" (sdk-native), "wasm" (sdk-wasm), "wgpu" and "opencl" (kernels).
+    Builtin {
+        name: "broken-config",
+        summary: "test only: decoder-core's pieces driven by hand with every configuration bit inverted; must fail",
+        hidden: true,
+        decode: broken_config,
+    },
+];
+
+/// The built-in named `name`.
+pub fn find(name: &str) -> Option<&'static Builtin> {
+    BUILTINS.iter().find(|b| b.name == name)
+}
+
+/// Runs a built-in, turning a panic into a broken outcome.
+pub fn run_builtin(b: &Builtin, stream: &[u8]) -> Outcome {
+    std::panic::catch_unwind(|| (b.decode)(stream))
+        .unwrap_or_else(|_| Outcome::broken(format!("{} panicked", b.name)))
+}
+
+fn finish(hashes: Vec<u64>, result: Result<(), Error>) -> Outcome {
+    Outcome {
+        hashes,
+        verdict: match result {
+            Ok(()) => Verdict::Ok,
+            Err(e) => Verdict::Error(e.class().to_string()),
+        },
+    }
+}
+
+/// The reference decoder through its public API.
+pub fn decoder_core(stream: &[u8]) -> Outcome {
+    let mut hashes = Vec::new();
+    let result = (|| {
+        let mut ws = OwnedWorkspace::for_stream(stream)?;
+        let mut decoder = ws.decoder(stream)?;
+        while let Some(k) = decoder.next_level() {
+            let range = decoder.level_range(k);
+            let bytes = usize::try_from(range.start)
+                .ok()
+                .zip(usize::try_from(range.end).ok())
+                .and_then(|(s, e)| stream.get(s..e))
+                .ok_or(Error::Truncated)?;
+            let mut level = decoder.begin_level(k, bytes)?;
+            if k == 0 {
+                hashes.push(level.state().state_hash());
+            }
+            while level.next_round()?.is_some() {
+                hashes.push(level.state().state_hash());
+            }
+        }
+        Ok(())
+    })();
+    finish(hashes, result)
+}
+
+fn broken_config(stream: &[u8]) -> Outcome {
+    decode_by_pieces(stream, true)
+}
+
+/// Inverts the configuration bit of every split record it passes on.
+struct FlipConfig<S>(S);
+
+impl<S: RecordSource> RecordSource for FlipConfig<S> {
+    fn flag(&mut self, v: u32) -> Result<bool, Error> {
+        self.0.flag(v)
+    }
+
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
+        let mut record = self.0.record(state, r, ring)?;
+        record.config = !record.config;
+        Ok(record)
+    }
+}
+
+/// Decodes with decoder-core's public pieces, in the order of SPEC §10.3
+/// (the order `Decoder` uses); with `flip_config`, every split record's
+/// configuration bit is inverted. Without it this must agree with
+/// [`decoder_core`] on every vector (a test checks it).
+pub fn decode_by_pieces(stream: &[u8], flip_config: bool) -> Outcome {
+    let mut hashes = Vec::new();
+    let result = pieces(stream, flip_config, &mut hashes);
+    finish(hashes, result)
+}
+
+fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(), Error> {
+    let header = Header::parse(stream)?;
+    let table = LevelTable::parse(stream, &header)?;
+    let layout = layout_for(&header, &table, header.level_count - 1);
+    if layout.total != header.workspace_bytes {
+        return Err(Error::InvalidHeader("declared workspace size differs from SPEC §9"));
+    }
+    let mut workspace = vec![0u8; layout.bytes_unaligned() as usize];
+    let (memory, mut buffers) = layout.carve(&mut workspace)?;
+    let mut state = MeshState::new(memory, header.bits);
+    let mut inflater = Box::new(Inflater::new());
+    let mut ring = Box::new(Ring::default());
+    for k in 0..header.level_count {
+        let info = table.get(k);
+        let bytes = usize::try_from(info.offset)
+            .ok()
+            .and_then(|s| stream.get(s..s.checked_add(info.length as usize)?))
+            .ok_or(Error::Truncated)?;
+        // SPEC §5.1: the level header against the table entry.
+        let is_base = k == 0;
+        let level_header = LevelHeader::parse(bytes, is_base, header.max_chunk_len)?;
+        if level_header.round_count != info.round_count {
+            return Err(Error::LevelCountMismatch);
+        }
+        if !is_base {
+            let mut added = 0u64;
+            for r in 0..level_header.round_count {
+                let s = level_header.split_count(r);
+                if s == 0 {
+                    return Err(Error::InvalidLevelHeader("a round without splits"));
+                }
+                added += s as u64;
+            }
+            if table.get(k - 1).vertex_count as u64 + added != info.vertex_count as u64 {
+                return Err(Error::LevelCountMismatch);
+            }
+        }
+        let first_id = if is_base {
+            substream::BASE_POSITIONS
+        } else {
+            substream::FLAGS
+        };
+        let slots = buffers.each_mut().map(|b| &mut **b);
+        let mut subs = Substreams::open(bytes, level_header, first_id, slots, &mut inflater);
+        if is_base {
+            read_base(&mut state, &mut subs, info.vertex_count, info.triangle_count)?;
+        } else {
+            for r in 0..level_header.round_count {
+                let declared = level_header.split_count(r);
+                let source = StreamSource {
+                    subs: &mut subs,
+                    mode: header.position_mode,
+                };
+                let result = if flip_config {
+                    state.run_round(declared, &mut FlipConfig(source), &mut ring)
+                } else {
+                    let mut source = source;
+                    state.run_round(declared, &mut source, &mut ring)
+                };
+                result?;
+                hashes.push(state.state_hash());
+            }
+        }
+        // SPEC §7.6: end of level.
+        subs.finish()?;
+        if state.vertex_count() != info.vertex_count || state.triangle_count() != info.triangle_count
+        {
+            return Err(Error::LevelCountMismatch);
+        }
+        if is_base {
+            hashes.push(state.state_hash());
+        }
+    }
+    Ok(())
+}

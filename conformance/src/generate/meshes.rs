@@ -1,0 +1,205 @@
+//! Input meshes of the encoded vectors; all deterministic.
+
+use std::path::Path;
+
+use splitstream_encoder::Mesh;
+use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
+
+/// An icosphere: `subdivisions` rounds of 4-to-1 splits of an icosahedron,
+/// projected to the unit sphere. Closed, genus 0.
+pub fn icosphere(subdivisions: usize) -> Mesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut positions: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut triangles: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    for _ in 0..subdivisions {
+        let mut midpoints = std::collections::BTreeMap::new();
+        let mut next = Vec::with_capacity(triangles.len() * 4);
+        let mut mid = |a: u32, b: u32, positions: &mut Vec<[f64; 3]>| {
+            *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                let (pa, pb) = (positions[a as usize], positions[b as usize]);
+                positions.push(std::array::from_fn(|k| (pa[k] + pb[k]) / 2.0));
+                (positions.len() - 1) as u32
+            })
+        };
+        for &[a, b, c] in &triangles {
+            let ab = mid(a, b, &mut positions);
+            let bc = mid(b, c, &mut positions);
+            let ca = mid(c, a, &mut positions);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        triangles = next;
+    }
+    for p in &mut positions {
+        let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        *p = p.map(|x| x / l);
+    }
+    Mesh {
+        positions,
+        triangles,
+    }
+}
+
+/// A `w` x `h` bumpy height field; with `hole`, the cells `x0..x1` x
+/// `y0..y1` are cut out (and the vertices left inside dropped), so the mesh
+/// has an outer boundary and a hole.
+pub fn grid(w: usize, h: usize, seed: u64, hole: Option<[usize; 4]>) -> Mesh {
+    let mut positions = Vec::with_capacity(w * h);
+    for y in 0..h {
+        for x in 0..w {
+            let (fx, fy) = (x as f64, y as f64);
+            let z = (fx * 0.7 + seed as f64).sin() * 2.0
+                + (fy * 0.45).cos() * 3.0
+                + ((fx * fy) * 0.05).sin();
+            positions.push([fx * 10.0, fy * 10.0, z]);
+        }
+    }
+    let mut triangles = Vec::new();
+    for y in 0..h - 1 {
+        for x in 0..w - 1 {
+            if let Some([x0, x1, y0, y1]) = hole
+                && (x0..x1).contains(&x)
+                && (y0..y1).contains(&y)
+            {
+                continue;
+            }
+            let i = (y * w + x) as u32;
+            let (r, u, ru) = (i + 1, i + w as u32, i + w as u32 + 1);
+            // Alternate the diagonal so vertex valences vary.
+            if (x + y) % 2 == 0 {
+                triangles.push([i, r, ru]);
+                triangles.push([i, ru, u]);
+            } else {
+                triangles.push([i, r, u]);
+                triangles.push([r, ru, u]);
+            }
+        }
+    }
+    compact(Mesh {
+        positions,
+        triangles,
+    })
+}
+
+/// A closed cone: an apex joined to `n` vertices of the top ring (apex
+/// valence `n`), `rings` rings down the side, and a bottom cap whose centre
+/// also has valence `n`.
+pub fn cone(n: usize, rings: usize) -> Mesh {
+    let mut positions = vec![[0.0, 0.0, 10.0]];
+    for j in 0..rings {
+        let radius = 1.0 + j as f64;
+        let z = 10.0 - 2.5 * (j + 1) as f64;
+        for i in 0..n {
+            let a = std::f64::consts::TAU * i as f64 / n as f64 + 0.1 * j as f64;
+            positions.push([radius * a.cos(), radius * a.sin(), z]);
+        }
+    }
+    positions.push([0.0, 0.0, 10.0 - 2.5 * (rings + 1) as f64]);
+    let bottom = (positions.len() - 1) as u32;
+    let ring = |j: usize, i: usize| (1 + j * n + i % n) as u32;
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        triangles.push([0, ring(0, i), ring(0, i + 1)]);
+    }
+    for j in 0..rings - 1 {
+        for i in 0..n {
+            let (a, b) = (ring(j, i), ring(j, i + 1));
+            let (d, c) = (ring(j + 1, i), ring(j + 1, i + 1));
+            triangles.push([a, d, c]);
+            triangles.push([a, c, b]);
+        }
+    }
+    for i in 0..n {
+        triangles.push([bottom, ring(rings - 1, i + 1), ring(rings - 1, i)]);
+    }
+    Mesh {
+        positions,
+        triangles,
+    }
+}
+
+/// Drops unreferenced vertices, keeping the order of the others.
+fn compact(mesh: Mesh) -> Mesh {
+    let mut map = vec![u32::MAX; mesh.positions.len()];
+    for t in &mesh.triangles {
+        for &v in t {
+            map[v as usize] = 0;
+        }
+    }
+    let mut positions = Vec::new();
+    for (v, m) in map.iter_mut().enumerate() {
+        if *m == 0 {
+            *m = positions.len() as u32;
+            positions.push(mesh.positions[v]);
+        }
+    }
+    let triangles = mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|v| map[v as usize]))
+        .collect();
+    Mesh {
+        positions,
+        triangles,
+    }
+}
+
+/// Reads a real mesh fetched by encoder/data/fetch.sh, repaired if the
+/// encoder's checker rejects it.
+pub fn real(dir: &Path, name: &str) -> Result<Mesh, String> {
+    let path = dir.join(name);
+    if !path.exists() {
+        return Err(format!(
+            "{} is missing: run `bash encoder/data/fetch.sh` first",
+            path.display()
+        ));
+    }
+    let mesh = read_mesh(&path, &ReadOptions::default()).map_err(|e| e.to_string())?;
+    if check_mesh(&mesh).is_ok() {
+        return Ok(mesh);
+    }
+    let (repaired, _) = repair_mesh(&mesh);
+    check_mesh(&repaired).map_err(|e| format!("{name} after repair: {e}"))?;
+    Ok(repaired)
+}
+
+/// Panics unless the encoder accepts `mesh`.
+pub fn checked(mesh: Mesh, what: &str) -> Mesh {
+    if let Err(e) = check_mesh(&mesh) {
+        panic!("generator mesh {what} is not encodable: {e}");
+    }
+    mesh
+}

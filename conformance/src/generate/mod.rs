@@ -1,0 +1,873 @@
+//! The vector generator: every vector of `vectors/<version>/` and its
+//! manifest entry come from here, deterministically (same bytes on every
+//! run and machine). Run it with `conformance/generate.sh`.
+
+mod handmade;
+mod meshes;
+mod mutate;
+
+use std::collections::BTreeMap;
+use std::path::Path;
+
+use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
+use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
+use splitstream_decoder_core::{Fnv1a, Header, LevelHeader, LevelTable, PositionMode, head_len};
+use splitstream_encoder::Mesh;
+use splitstream_encoder::emit::{EncodeOptions, encode};
+
+use crate::builtin;
+use crate::manifest::{FinalMesh, Manifest, SUITE_VERSION, Vector, hex};
+use crate::protocol::Verdict;
+use handmade::{Rec, base, level, tetra_split};
+use mutate::*;
+
+/// The generated set: the manifest and each file's bytes (paths relative
+/// to the set's directory).
+pub struct Generated {
+    pub manifest: Manifest,
+    pub files: BTreeMap<String, Vec<u8>>,
+}
+
+/// One vector before its expectations are computed.
+struct Spec {
+    name: String,
+    description: String,
+    features: Vec<String>,
+    stream: Vec<u8>,
+    /// `None`: valid.
+    error_class: Option<&'static str>,
+}
+
+struct Specs(Vec<Spec>);
+
+impl Specs {
+    fn valid(&mut self, name: &str, description: &str, features: &[&str], stream: Vec<u8>) {
+        self.push(name, description, features, stream, None);
+    }
+
+    fn invalid(
+        &mut self,
+        name: &str,
+        class: &'static str,
+        description: &str,
+        features: &[&str],
+        stream: Vec<u8>,
+    ) {
+        self.push(name, description, features, stream, Some(class));
+    }
+
+    fn push(
+        &mut self,
+        name: &str,
+        description: &str,
+        features: &[&str],
+        stream: Vec<u8>,
+        error_class: Option<&'static str>,
+    ) {
+        assert!(
+            self.0.iter().all(|s| s.name != name),
+            "duplicate vector {name}"
+        );
+        self.0.push(Spec {
+            name: name.to_string(),
+            description: description.to_string(),
+            features: features.iter().map(|s| s.to_string()).collect(),
+            stream,
+            error_class,
+        });
+    }
+}
+
+fn encoded(mesh: &Mesh, options: EncodeOptions) -> Vec<u8> {
+    encode(mesh, &options, |_| {})
+        .unwrap_or_else(|e| panic!("generator: encoding failed: {e}"))
+        .stream
+}
+
+fn opts() -> EncodeOptions {
+    EncodeOptions::default()
+}
+
+/// Generates the whole set. `real_data` is `encoder/data/real` (filled by
+/// `encoder/data/fetch.sh`).
+pub fn generate(real_data: &Path) -> Result<Generated, String> {
+    let mut specs = Specs(Vec::new());
+    valid_vectors(&mut specs, real_data)?;
+    invalid_vectors(&mut specs);
+    let mut files = BTreeMap::new();
+    let mut vectors = Vec::new();
+    for spec in specs.0 {
+        let dir = if spec.error_class.is_none() { "valid" } else { "invalid" };
+        let file = format!("{dir}/{}.sps", spec.name);
+        vectors.push(describe(&spec, &file));
+        files.insert(file, spec.stream);
+    }
+    let manifest = Manifest {
+        format_version: SUITE_VERSION.to_string(),
+        generator: "conformance/generate.sh (splitstream-conformance generate); never edit by hand"
+            .to_string(),
+        protocol: "conformance/README.md".to_string(),
+        vectors,
+    };
+    files.insert("manifest.json".to_string(), manifest.to_json().into_bytes());
+    Ok(Generated { manifest, files })
+}
+
+/// Writes the set into `dir`, removing stream files that are not part of it.
+pub fn write(generated: &Generated, dir: &Path) -> Result<(), String> {
+    let err = |p: &Path, e: std::io::Error| format!("{}: {e}", p.display());
+    for sub in ["valid", "invalid"] {
+        let d = dir.join(sub);
+        std::fs::create_dir_all(&d).map_err(|e| err(&d, e))?;
+        for entry in std::fs::read_dir(&d).map_err(|e| err(&d, e))? {
+            let path = entry.map_err(|e| err(&d, e))?.path();
+            let rel = format!("{sub}/{}", path.file_name().unwrap_or_default().to_string_lossy());
+            if !generated.files.contains_key(&rel) {
+                std::fs::remove_file(&path).map_err(|e| err(&path, e))?;
+            }
+        }
+    }
+    for (rel, bytes) in &generated.files {
+        let path = dir.join(rel);
+        std::fs::write(&path, bytes).map_err(|e| err(&path, e))?;
+    }
+    Ok(())
+}
+
+/// Checks the reference decoder against the intended expectation and
+/// builds the manifest entry.
+fn describe(spec: &Spec, file: &str) -> Vector {
+    let outcome = builtin::decoder_core(&spec.stream);
+    let by_pieces = builtin::decode_by_pieces(&spec.stream, false);
+    assert_eq!(
+        outcome, by_pieces,
+        "{}: decoder-core and its pieces disagree",
+        spec.name
+    );
+    let mut features = spec.features.clone();
+    let (round_hashes, result) = match spec.error_class {
+        None => {
+            assert_eq!(outcome.verdict, Verdict::Ok, "{}: not valid", spec.name);
+            let mesh = decode_all(&spec.stream, true).expect("valid");
+            assert_eq!(mesh.round_hashes, outcome.hashes, "{}", spec.name);
+            let (result, tags) = final_mesh(&spec.stream);
+            features.extend(tags);
+            (mesh.round_hashes, Some(result))
+        }
+        Some(class) => {
+            assert_eq!(
+                outcome.verdict,
+                Verdict::Error(class.to_string()),
+                "{}: the reference decoder does not report the intended class",
+                spec.name
+            );
+            (outcome.hashes, None)
+        }
+    };
+    features.sort();
+    features.dedup();
+    Vector {
+        name: spec.name.clone(),
+        file: file.to_string(),
+        description: spec.description.clone(),
+        features,
+        bytes: spec.stream.len(),
+        valid: spec.error_class.is_none(),
+        error_class: spec.error_class.map(str::to_string),
+        round_hashes: round_hashes.into_iter().map(hex).collect(),
+        result,
+    }
+}
+
+/// Decodes a valid stream round by round for the manifest's summary, and
+/// derives feature tags from what the stream really contains.
+fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
+    let header = Header::parse(stream).expect("valid");
+    let table = LevelTable::parse(stream, &header).expect("valid");
+    let mut tags = vec![
+        match header.position_mode {
+            PositionMode::Optimal => "position-optimal",
+            PositionMode::Constrained => "position-constrained",
+        }
+        .to_string(),
+        format!("levels-{}", header.level_count),
+        format!("bits-{}", header.bits),
+    ];
+    for k in 0..header.level_count {
+        let info = table.get(k);
+        let bytes = &stream[info.offset as usize..(info.offset + info.length as u64) as usize];
+        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len).expect("valid");
+        let mut per_substream = BTreeMap::new();
+        for c in 0..lh.chunk_count {
+            let e = lh.chunk(c).expect("valid");
+            tags.push(if e.codec == 0 { "stored-chunks" } else { "deflate-chunks" }.to_string());
+            *per_substream.entry(e.substream).or_insert(0) += 1;
+        }
+        if per_substream.values().any(|&n| n > 1) {
+            tags.push("multi-chunk-substreams".to_string());
+        }
+    }
+    let mut ws = OwnedWorkspace::for_stream(stream).expect("valid");
+    let mut decoder = ws.decoder(stream).expect("valid");
+    let mut max_vertex_triangles = 0;
+    let mut rounds = 0;
+    let mut track = |triangles: &[[u32; 3]], vertices: usize| {
+        let mut count = vec![0usize; vertices];
+        for t in triangles {
+            for &v in t {
+                count[v as usize] += 1;
+            }
+        }
+        max_vertex_triangles = max_vertex_triangles.max(count.into_iter().max().unwrap_or(0));
+    };
+    while let Some(k) = decoder.next_level() {
+        let range = decoder.level_range(k);
+        let mut level = decoder
+            .begin_level(k, &stream[range.start as usize..range.end as usize])
+            .expect("valid");
+        track(level.state().triangles(), level.state().vertex_count() as usize);
+        while level.next_round().expect("valid").is_some() {
+            rounds += 1;
+            track(level.state().triangles(), level.state().vertex_count() as usize);
+        }
+    }
+    let triangles = decoder.triangles();
+    let mut directed: Vec<(u32, u32)> = triangles
+        .iter()
+        .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
+        .collect();
+    directed.sort_unstable();
+    let boundary_edges = directed
+        .iter()
+        .filter(|&&(a, b)| directed.binary_search(&(b, a)).is_err())
+        .count();
+    tags.push(if boundary_edges == 0 { "closed" } else { "boundary" }.to_string());
+    if max_vertex_triangles >= 32 {
+        tags.push("high-valence".to_string());
+    }
+    let mut geometry = Fnv1a::default();
+    for p in decoder.positions() {
+        for &x in p {
+            geometry.u32(x);
+        }
+    }
+    for t in triangles {
+        for &v in t {
+            geometry.u32(v);
+        }
+    }
+    let result = FinalMesh {
+        levels: decoder.levels_done(),
+        rounds,
+        vertices: decoder.positions().len(),
+        triangles: triangles.len(),
+        boundary_edges,
+        max_vertex_triangles,
+        state_hash: hex(decoder.state_hash()),
+        geometry_hash: hex(geometry.finish()),
+    };
+    (result, tags)
+}
+
+fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
+    // The smallest legal streams, built by hand.
+    s.valid(
+        "minimal-triangle",
+        "A single triangle, base level only: the smallest legal stream.",
+        &["minimal", "handmade", "base-only"],
+        handmade::single_triangle_stream(),
+    );
+    s.valid(
+        "minimal-tetrahedron",
+        "A tetrahedron whose vertices are all leaves, base level only.",
+        &["minimal", "handmade", "base-only"],
+        write_stream(&handmade::stored(), &[handmade::tetrahedron_leaves()]),
+    );
+    s.valid(
+        "handmade-tetra-split-stored",
+        "SPEC Appendix A: a tetrahedron and one split of vertex 0; 4-byte stored chunks.",
+        &["minimal", "handmade", "one-split"],
+        handmade::tetra_stream(ChunkCodec::Stored),
+    );
+    s.valid(
+        "handmade-tetra-split-deflate",
+        "SPEC Appendix A with every chunk a deflate stream of one stored block (larger than its raw bytes).",
+        &["minimal", "handmade", "one-split", "deflate-stored-block"],
+        wrap_chunks_in_deflate(&handmade::tetra_stream(ChunkCodec::Stored)),
+    );
+    s.valid(
+        "handmade-boundary-ghost-wing",
+        "One triangle; a boundary vertex splits with the ghost vertex as one wing (adds one triangle).",
+        &["minimal", "handmade", "one-split", "ghost-wing"],
+        handmade::boundary_ghost_wing_stream(),
+    );
+
+    // Encoded meshes.
+    let sphere3 = meshes::checked(meshes::icosphere(3), "icosphere(3)");
+    let sphere2 = meshes::checked(meshes::icosphere(2), "icosphere(2)");
+    let holed = meshes::checked(meshes::grid(24, 20, 1, Some([8, 15, 6, 12])), "grid with hole");
+    let small_holed = meshes::checked(meshes::grid(14, 12, 4, Some([4, 9, 4, 8])), "small grid with hole");
+    let bumpy = meshes::checked(meshes::grid(30, 30, 2, None), "grid");
+    let locked = meshes::checked(meshes::grid(16, 16, 3, None), "grid for lock_boundary");
+    let cone = meshes::checked(meshes::cone(96, 4), "cone");
+    s.valid(
+        "icosphere-optimal-deflate",
+        "Icosphere (642 vertices, closed), default encoder options: optimal positions, deflate, 5 levels.",
+        &["encoded"],
+        encoded(&sphere3, opts()),
+    );
+    s.valid(
+        "icosphere-constrained-stored",
+        "Icosphere (162 vertices), constrained positions, stored chunks, 10 bits.",
+        &["encoded"],
+        encoded(
+            &sphere2,
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::Stored,
+                bits: 10,
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "grid-hole-optimal-deflate",
+        "Height field with an outer boundary and a rectangular hole, optimal positions, deflate.",
+        &["encoded", "hole"],
+        encoded(&holed, opts()),
+    );
+    s.valid(
+        "grid-hole-constrained-tiny-chunks",
+        "Small height field with a hole, constrained positions, 7-byte stored chunks: every substream spans many chunks and values straddle chunk boundaries.",
+        &["encoded", "hole", "tiny-chunks"],
+        encoded(
+            &small_holed,
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::Stored,
+                chunk_limit: 7,
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "icosphere-tiny-chunks-deflate",
+        "Icosphere (162 vertices), 24-byte chunks, deflate where it helps: stored and deflate chunks mixed within substreams.",
+        &["encoded", "tiny-chunks", "mixed-codecs"],
+        encoded(
+            &sphere2,
+            EncodeOptions {
+                chunk_limit: 24,
+                ..opts()
+            },
+        ),
+    );
+    for (levels, mesh, what) in [(1, &sphere2, "icosphere"), (2, &sphere2, "icosphere"), (8, &bumpy, "grid")] {
+        s.valid(
+            &format!("{what}-levels-{levels}"),
+            &format!("{what} encoded with levels = {levels}."),
+            &["encoded"],
+            encoded(
+                mesh,
+                EncodeOptions {
+                    levels,
+                    ..opts()
+                },
+            ),
+        );
+    }
+    s.valid(
+        "grid-deflate-stored-blocks",
+        "The small height field with a hole, 64-byte chunks, every chunk re-coded as a deflate stream of one stored block.",
+        &["encoded", "hole", "deflate-stored-block"],
+        wrap_chunks_in_deflate(&encoded(
+            &small_holed,
+            EncodeOptions {
+                codec: ChunkCodec::Stored,
+                chunk_limit: 64,
+                ..opts()
+            },
+        )),
+    );
+    s.valid(
+        "cone-high-valence",
+        "Closed cone whose apex and bottom centre have valence 96 (rings of 96 vertices).",
+        &["encoded", "high-valence"],
+        encoded(&cone, opts()),
+    );
+    s.valid(
+        "grid-lock-boundary",
+        "Height field encoded with lock_boundary (boundary vertices stay in the base mesh), 4 levels, 20 bits.",
+        &["encoded", "lock-boundary"],
+        encoded(
+            &locked,
+            EncodeOptions {
+                lock_boundary: true,
+                levels: 4,
+                bits: 20,
+                ..opts()
+            },
+        ),
+    );
+    let terrain = meshes::checked(splitstream_encoder::input::fractal_terrain(33, 7), "terrain");
+    s.valid(
+        "terrain-constrained-deflate",
+        "33x33 fractal terrain (the demo's generator), constrained positions, deflate, 6 levels.",
+        &["encoded", "terrain"],
+        encoded(
+            &terrain,
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                levels: 6,
+                ..opts()
+            },
+        ),
+    );
+    let bunny = meshes::real(real_data, "bunny.ply")?;
+    s.valid(
+        "bunny-npm",
+        "The npm `bunny` package's Stanford bunny (encoder/data/fetch.sh), default encoder options.",
+        &["encoded", "real-mesh"],
+        encoded(&bunny, opts()),
+    );
+    Ok(())
+}
+
+fn flip(mut s: Vec<u8>, at: usize, mask: u8) -> Vec<u8> {
+    s[at] ^= mask;
+    s
+}
+
+fn invalid_vectors(s: &mut Specs) {
+    let sphere = meshes::icosphere(3);
+    let subject = encoded(&sphere, opts());
+    let stored_subject = encoded(
+        &meshes::icosphere(2),
+        EncodeOptions {
+            codec: ChunkCodec::Stored,
+            ..opts()
+        },
+    );
+    let constrained = encoded(
+        &meshes::icosphere(2),
+        EncodeOptions {
+            position_mode: PositionMode::Constrained,
+            codec: ChunkCodec::Stored,
+            ..opts()
+        },
+    );
+    let levels = Header::parse(&subject).expect("valid").level_count;
+    let last = levels - 1;
+    let head = head_len(levels);
+
+    // Truncation at several depths.
+    let cut = |n: usize| subject[..n].to_vec();
+    let level0 = level_range(&subject, 0);
+    let level2 = level_range(&subject, 2);
+    for (name, at, what) in [
+        ("truncated-signature", 5, "inside the 8-byte signature"),
+        ("truncated-header", 60, "inside the 96-byte header"),
+        ("truncated-level-table", head - 10, "inside the level table"),
+        ("truncated-base-level", level0.start + level0.len() / 2, "in the middle of the base level"),
+        ("truncated-mid-level", level2.start + level2.len() / 2, "in the middle of level 2 (levels 0 and 1 decode first)"),
+        ("truncated-last-byte", subject.len() - 1, "one byte before the end"),
+    ] {
+        s.invalid(
+            name,
+            "truncated",
+            &format!("The icosphere stream cut {what}."),
+            &["truncated"],
+            cut(at),
+        );
+    }
+
+    // Checksums.
+    s.invalid(
+        "checksum-header",
+        "checksum-mismatch",
+        "A bit of the header's origin flipped; the header CRC left as it was.",
+        &["checksum"],
+        flip(subject.clone(), 40, 0x01),
+    );
+    s.invalid(
+        "checksum-level-table",
+        "checksum-mismatch",
+        "A bit of level 1's geometric error flipped in the level table; its CRC left as it was.",
+        &["checksum"],
+        flip(subject.clone(), table_entry(1) + 24, 0x01),
+    );
+    s.invalid(
+        "checksum-level-header",
+        "checksum-mismatch",
+        "A bit of a split count of level 1 flipped; the level header CRC left as it was.",
+        &["checksum"],
+        flip(subject.clone(), split_count_at(&subject, 1, 0), 0x01),
+    );
+    let c = chunk_count(&subject, 2) - 1;
+    let payload = chunk_payload(&subject, 2, c);
+    s.invalid(
+        "checksum-chunk",
+        "checksum-mismatch",
+        "A bit of the last chunk of level 2 flipped; its CRC left as it was (met when the chunk is loaded).",
+        &["checksum"],
+        flip(subject.clone(), payload.start + payload.len() / 2, 0x01),
+    );
+
+    // Signature and version.
+    s.invalid(
+        "bad-magic",
+        "bad-magic",
+        "The second signature byte changed from 'S' to 'X'.",
+        &["header"],
+        {
+            let mut b = subject.clone();
+            b[1] = b'X';
+            b
+        },
+    );
+    s.invalid(
+        "unsupported-version",
+        "unsupported-version",
+        "Major version 2 (header CRC recomputed).",
+        &["header", "versioning"],
+        {
+            let mut b = subject.clone();
+            b[8] = 2;
+            fix_header_crc(&mut b);
+            b
+        },
+    );
+    s.valid(
+        "minor-version-1",
+        "Minor version 1 of major 1 with every reserved field zero: decodes exactly as 1.0 (header CRC recomputed).",
+        &["header", "versioning"],
+        {
+            let mut b = handmade::tetra_stream(ChunkCodec::Stored);
+            b[9] = 1;
+            fix_header_crc(&mut b);
+            b
+        },
+    );
+
+    // Header capacities and the declared workspace.
+    let patch_header = |f: &dyn Fn(&mut Header)| {
+        let mut h = Header::parse(&subject).expect("valid");
+        f(&mut h);
+        let mut b = subject.clone();
+        let mut out = [0u8; 96];
+        h.write(&mut out);
+        b[..96].copy_from_slice(&out);
+        b
+    };
+    s.invalid(
+        "capacity-vertices-lie",
+        "capacity-exceeded",
+        "Header vertex_capacity one less than the last level's vertex count (header CRC recomputed).",
+        &["capacity"],
+        patch_header(&|h| h.vertex_capacity -= 1),
+    );
+    s.invalid(
+        "capacity-triangles-lie",
+        "capacity-exceeded",
+        "Header triangle_capacity one less than the last level's triangle count (header CRC recomputed).",
+        &["capacity"],
+        patch_header(&|h| h.triangle_capacity -= 1),
+    );
+    s.invalid(
+        "workspace-bytes-wrong",
+        "malformed",
+        "Header workspace_bytes 8 more than SPEC §9 gives (header CRC recomputed).",
+        &["capacity", "workspace"],
+        patch_header(&|h| h.workspace_bytes += 8),
+    );
+
+    // Reserved fields and codecs (covering CRCs recomputed).
+    s.invalid(
+        "reserved-header-flag",
+        "malformed",
+        "Header flag bit 1 (reserved) set.",
+        &["reserved"],
+        {
+            let mut b = subject.clone();
+            b[10] |= 2;
+            fix_header_crc(&mut b);
+            b
+        },
+    );
+    s.invalid(
+        "reserved-header-byte",
+        "malformed",
+        "Header byte 13 (reserved) not zero.",
+        &["reserved"],
+        {
+            let mut b = subject.clone();
+            b[13] = 1;
+            fix_header_crc(&mut b);
+            b
+        },
+    );
+    s.invalid(
+        "reserved-level-table",
+        "malformed",
+        "The reserved field of level-table entry 0 not zero (table CRC recomputed).",
+        &["reserved"],
+        {
+            let mut b = subject.clone();
+            b[table_entry(0) + 28] = 1;
+            fix_table_crc(&mut b);
+            b
+        },
+    );
+    s.invalid(
+        "reserved-chunk-entry",
+        "malformed",
+        "The reserved field of level 1's first chunk-directory entry not zero (level header CRC recomputed).",
+        &["reserved"],
+        {
+            let mut b = subject.clone();
+            b[chunk_entry_at(&subject, 1, 0) + 2] = 1;
+            fix_level_header_crc(&mut b, 1);
+            b
+        },
+    );
+    s.invalid(
+        "unknown-codec",
+        "malformed",
+        "Codec id 2 on a stored chunk of level 1 (level header CRC recomputed).",
+        &["codec"],
+        {
+            let mut b = stored_subject.clone();
+            assert_eq!(chunk_codec(&b, 1, 0), 0);
+            b[chunk_entry_at(&stored_subject, 1, 0) + 1] = 2;
+            fix_level_header_crc(&mut b, 1);
+            b
+        },
+    );
+    s.invalid(
+        "corrupt-deflate-chunk",
+        "malformed",
+        "A deflate chunk of level 1 whose first byte announces the reserved block type 3; chunk and level header CRCs recomputed.",
+        &["codec"],
+        {
+            let mut b = subject.clone();
+            let c = (0..chunk_count(&b, 1))
+                .find(|&c| chunk_codec(&b, 1, c) == 1)
+                .expect("a deflate chunk in level 1");
+            let at = chunk_payload(&b, 1, c).start;
+            b[at] = 0xFF;
+            fix_chunk_crc(&mut b, 1, c);
+            b
+        },
+    );
+
+    // Record-level faults, re-framed with the writer (all checksums valid).
+    let parts = unframe(&subject);
+    s.invalid(
+        "ring-offset-wing-distance",
+        "ring-offset-out-of-range",
+        "Level 1's first split record with wing distance 255 (o + d beyond the ring).",
+        &["records", "ring-offset"],
+        {
+            let mut p = parts.clone();
+            p.levels[1].substreams[2][0] = 255;
+            reframe(&p)
+        },
+    );
+    s.invalid(
+        "flag-count-declared-less",
+        "count-mismatch",
+        "A round of the last level declares one split fewer than it flags (level counts in the table adjusted to the declaration).",
+        &["records", "flag-count"],
+        {
+            let mut p = parts.clone();
+            let l = &mut p.levels[last as usize];
+            let r = l.round_splits.iter().position(|&n| n >= 2).expect("a round with 2 splits");
+            l.round_splits[r] -= 1;
+            l.vertex_count -= 1;
+            l.triangle_count -= 2;
+            reframe(&p)
+        },
+    );
+    s.invalid(
+        "record-trailing-data",
+        "count-mismatch",
+        "One byte appended to the edge substream of the last level: data after the level's last record.",
+        &["records", "record-count"],
+        {
+            let mut p = parts.clone();
+            p.levels[last as usize].substreams[6].push(0);
+            reframe(&p)
+        },
+    );
+    s.invalid(
+        "record-substream-short",
+        "count-mismatch",
+        "The wing-distance substream of the last level one byte short: it runs out in the last record.",
+        &["records", "record-count"],
+        {
+            let mut p = parts.clone();
+            p.levels[last as usize].substreams[2].pop();
+            reframe(&p)
+        },
+    );
+    s.invalid(
+        "flags-padding-not-zero",
+        "count-mismatch",
+        "A padding bit after the last flag of level 1 set (SPEC §5.4).",
+        &["records", "record-count"],
+        {
+            let mut p = parts.clone();
+            // Find a flag substream whose last byte has free high bits.
+            let flags = &mut p.levels[1].substreams[0];
+            let lastb = flags.last_mut().expect("flags");
+            assert!(*lastb & 0x80 == 0, "the last flag byte has padding");
+            *lastb |= 0x80;
+            reframe(&p)
+        },
+    );
+    s.invalid(
+        "placement-code-3",
+        "malformed",
+        "Constrained mode: the first placement code of level 1 is 3.",
+        &["records", "position-constrained"],
+        {
+            let mut p = unframe(&constrained);
+            p.levels[1].substreams[7][0] = 3;
+            reframe(&p)
+        },
+    );
+
+    // Hand-made faults (SPEC §6.3, §7).
+    let hand = |levels: &[splitstream_decoder_core::writer::LevelPayload]| {
+        write_stream(&handmade::deflated(), levels)
+    };
+    let tetra = handmade::tetrahedron;
+    s.invalid(
+        "ring-offset-handmade",
+        "ring-offset-out-of-range",
+        "Tetrahedron split with o = 2, d = 1 on a ring of 3 (o + d = k).",
+        &["handmade", "ring-offset"],
+        {
+            let mut rec = tetra_split();
+            rec.o = 2;
+            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+        },
+    );
+    s.invalid(
+        "flag-count-handmade",
+        "count-mismatch",
+        "Tetrahedron: one split declared, the only candidate's flag 0.",
+        &["handmade", "flag-count"],
+        hand(&[tetra(), level(&[false], vec![1], &[tetra_split()], 5, 6)]),
+    );
+    s.invalid(
+        "dependent-splits",
+        "dependent-splits",
+        "Tetrahedron with vertices 0 and 1 both candidates and both flagged: adjacent splits in one round.",
+        &["handmade", "independence"],
+        hand(&[
+            handmade::tetrahedron_two_candidates(),
+            level(&[true, true], vec![2], &[tetra_split(), tetra_split()], 6, 8),
+        ]),
+    );
+    s.invalid(
+        "valence-overflow-wing",
+        "valence-overflow",
+        "Vertex 1 (deficit 0, not flagged) is a wing of vertex 0's split.",
+        &["handmade", "valence"],
+        hand(&[
+            handmade::tetrahedron_two_candidates(),
+            level(&[true, false], vec![1], &[tetra_split()], 5, 6),
+        ]),
+    );
+    s.invalid(
+        "valence-overflow-base",
+        "valence-overflow",
+        "Base tetrahedron vertex of valence 3 with deficit 253 (split valence 256 > 255).",
+        &["handmade", "valence", "base-only"],
+        hand(&[base(
+            &handmade::TETRA_POSITIONS,
+            &handmade::TETRA_TRIANGLES,
+            &[253, 255, 255, 255],
+        )]),
+    );
+    s.invalid(
+        "valence-overflow-split",
+        "valence-overflow",
+        "Split record giving P valence 3 and deficit 253 (split valence 256 > 255).",
+        &["handmade", "valence"],
+        {
+            let rec = Rec {
+                dp: 253,
+                ..tetra_split()
+            };
+            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+        },
+    );
+    s.invalid(
+        "non-manifold-bowtie",
+        "non-manifold",
+        "Base mesh of two tetrahedra sharing one vertex (two fans at a vertex).",
+        &["handmade", "base-only", "manifold"],
+        hand(&[base(
+            &[[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [9, 0, 0], [0, 9, 0], [0, 0, 9]],
+            &[
+                [0, 2, 1],
+                [0, 1, 3],
+                [0, 3, 2],
+                [1, 2, 3],
+                [0, 5, 4],
+                [0, 4, 6],
+                [0, 6, 5],
+                [4, 5, 6],
+            ],
+            &[255; 7],
+        )]),
+    );
+    s.invalid(
+        "non-manifold-flipped-face",
+        "non-manifold",
+        "Base tetrahedron with one face reversed: a directed edge used twice.",
+        &["handmade", "base-only", "manifold"],
+        hand(&[base(
+            &handmade::TETRA_POSITIONS,
+            &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 3, 2]],
+            &[255; 4],
+        )]),
+    );
+    s.invalid(
+        "position-out-of-range-base",
+        "position-out-of-range",
+        "Base vertex x = 256 with 8 bits per axis.",
+        &["handmade", "base-only", "positions"],
+        hand(&[base(&[[0, 0, 0], [256, 0, 0], [0, 10, 0]], &[[0, 1, 2]], &[255; 3])]),
+    );
+    s.invalid(
+        "position-out-of-range-split",
+        "position-out-of-range",
+        "A split placing C at x = 300 with 8 bits per axis.",
+        &["handmade", "positions"],
+        {
+            let rec = Rec {
+                e: [300, 2, 2],
+                m: [-150, -1, -1],
+                ..tetra_split()
+            };
+            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+        },
+    );
+    let triangle = || base(&[[0, 0, 0], [10, 0, 0], [0, 10, 0]], &[[0, 1, 2]], &[255; 3]);
+    for (name, bytes, what) in [
+        ("varint-not-minimal", &[0x80u8, 0x00, 0x01, 0x02][..], "index 0 written as 0x80 0x00 (not minimal)"),
+        ("varint-too-long", &[0x80, 0x80, 0x80, 0x80, 0x80, 0x00, 0x01, 0x02][..], "a 6-byte varint"),
+        ("varint-over-32-bits", &[0xFF, 0xFF, 0xFF, 0xFF, 0x1F, 0x01, 0x02][..], "a 5-byte varint above 2^32 - 1"),
+    ] {
+        s.invalid(
+            name,
+            "malformed",
+            &format!("Base triangle substream with {what}."),
+            &["handmade", "varint"],
+            hand(&[handmade::with_raw_substream(triangle(), 1, bytes)]),
+        );
+    }
+}

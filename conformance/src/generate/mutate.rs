@@ -1,0 +1,242 @@
+//! Taking valid streams apart and putting them back together with exactly
+//! one fault: record-level faults are re-framed with decoder-core's writer
+//! (every checksum valid), framing faults are patched in place with the
+//! checksums that cover them recomputed unless the checksum is the fault.
+
+use std::ops::Range;
+
+use splitstream_decoder_core::limits::{CHUNK_ENTRY_LEN, HEADER_LEN, LEVEL_ENTRY_LEN, codec};
+use splitstream_decoder_core::writer::{
+    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+};
+use splitstream_decoder_core::{Header, Inflater, LevelHeader, LevelTable, crc32, head_len};
+
+/// One level's content, substreams as raw bytes.
+#[derive(Clone, Debug)]
+pub struct Level {
+    pub round_splits: Vec<u32>,
+    pub substreams: Vec<Vec<u8>>,
+    pub vertex_count: u32,
+    pub triangle_count: u32,
+    pub geometric_error: f32,
+}
+
+/// A stream taken apart.
+#[derive(Clone, Debug)]
+pub struct Unframed {
+    pub params: StreamParams,
+    pub levels: Vec<Level>,
+}
+
+/// Takes a valid stream apart into its levels' substreams.
+pub fn unframe(stream: &[u8]) -> Unframed {
+    let header = Header::parse(stream).expect("a valid stream");
+    let table = LevelTable::parse(stream, &header).expect("a valid stream");
+    let mut inflater = Box::new(Inflater::new());
+    let mut any_deflate = false;
+    let mut levels = Vec::new();
+    for k in 0..header.level_count {
+        let info = table.get(k);
+        let bytes = &stream[level_range(stream, k)];
+        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len).expect("a valid level");
+        let (count, first_id) = if k == 0 { (3, 9u8) } else { (8, 1u8) };
+        let mut substreams = vec![Vec::new(); count];
+        let mut at = lh.payload_start;
+        for c in 0..lh.chunk_count {
+            let e = lh.chunk(c).expect("a valid chunk");
+            let stored = &bytes[at..at + e.stored_len as usize];
+            let mut raw = vec![0u8; e.raw_len as usize];
+            if e.codec == codec::STORED {
+                raw.copy_from_slice(stored);
+            } else {
+                any_deflate = true;
+                inflater.inflate_exact(stored, &mut raw).expect("a valid chunk");
+            }
+            substreams[(e.substream - first_id) as usize].extend_from_slice(&raw);
+            at += e.stored_len as usize;
+        }
+        levels.push(Level {
+            round_splits: (0..lh.round_count).map(|r| lh.split_count(r)).collect(),
+            substreams,
+            vertex_count: info.vertex_count,
+            triangle_count: info.triangle_count,
+            geometric_error: info.geometric_error,
+        });
+    }
+    Unframed {
+        params: StreamParams {
+            position_mode: header.position_mode,
+            bits: header.bits,
+            origin: header.origin,
+            scale: header.scale,
+            codec: if any_deflate {
+                ChunkCodec::Deflate(9)
+            } else {
+                ChunkCodec::Stored
+            },
+            chunk_limit: header.max_chunk_len,
+        },
+        levels,
+    }
+}
+
+/// Frames the levels again (all checksums, counts and sizes recomputed).
+pub fn reframe(u: &Unframed) -> Vec<u8> {
+    let payloads: Vec<LevelPayload> = u
+        .levels
+        .iter()
+        .map(|l| LevelPayload {
+            round_splits: l.round_splits.clone(),
+            substreams: l
+                .substreams
+                .iter()
+                .map(|bytes| {
+                    let mut w = SubstreamWriter::default();
+                    for &b in bytes {
+                        w.byte(b);
+                    }
+                    w
+                })
+                .collect(),
+            vertex_count: l.vertex_count,
+            triangle_count: l.triangle_count,
+            geometric_error: l.geometric_error,
+        })
+        .collect();
+    write_stream(&u.params, &payloads)
+}
+
+fn u32_at(s: &[u8], at: usize) -> u32 {
+    u32::from_le_bytes(s[at..at + 4].try_into().expect("4 bytes"))
+}
+
+fn level_count(s: &[u8]) -> u16 {
+    u16::from_le_bytes([s[14], s[15]])
+}
+
+/// Recomputes the header CRC (SPEC §3.3).
+pub fn fix_header_crc(s: &mut [u8]) {
+    let crc = crc32(&s[..HEADER_LEN - 4]);
+    s[HEADER_LEN - 4..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
+}
+
+/// Offset of level-table entry `k`.
+pub fn table_entry(k: u16) -> usize {
+    HEADER_LEN + LEVEL_ENTRY_LEN * k as usize
+}
+
+/// Recomputes the level-table CRC (SPEC §4.2).
+pub fn fix_table_crc(s: &mut [u8]) {
+    let end = head_len(level_count(s)) - 4;
+    let crc = crc32(&s[HEADER_LEN..end]);
+    s[end..end + 4].copy_from_slice(&crc.to_le_bytes());
+}
+
+/// Byte range of level `k`, from the level table.
+pub fn level_range(s: &[u8], k: u16) -> Range<usize> {
+    let at = table_entry(k);
+    let offset = u64::from_le_bytes(s[at..at + 8].try_into().expect("8 bytes")) as usize;
+    offset..offset + u32_at(s, at + 8) as usize
+}
+
+/// Where the level header of level `k` keeps its CRC.
+fn level_crc_at(s: &[u8], k: u16) -> usize {
+    let start = level_range(s, k).start;
+    let rounds = u32_at(s, start) as usize;
+    let chunks = u32_at(s, start + 4) as usize;
+    start + 8 + 4 * rounds + CHUNK_ENTRY_LEN * chunks
+}
+
+/// Recomputes the level header CRC of level `k` (SPEC §5.1).
+pub fn fix_level_header_crc(s: &mut [u8], k: u16) {
+    let start = level_range(s, k).start;
+    let at = level_crc_at(s, k);
+    let crc = crc32(&s[start..at]);
+    s[at..at + 4].copy_from_slice(&crc.to_le_bytes());
+}
+
+/// Offset of the split count of round `r` of level `k`.
+pub fn split_count_at(s: &[u8], k: u16, r: usize) -> usize {
+    level_range(s, k).start + 8 + 4 * r
+}
+
+/// Offset of chunk-directory entry `c` of level `k`.
+pub fn chunk_entry_at(s: &[u8], k: u16, c: usize) -> usize {
+    let start = level_range(s, k).start;
+    let rounds = u32_at(s, start) as usize;
+    start + 8 + 4 * rounds + CHUNK_ENTRY_LEN * c
+}
+
+/// Number of chunks of level `k`.
+pub fn chunk_count(s: &[u8], k: u16) -> usize {
+    u32_at(s, level_range(s, k).start + 4) as usize
+}
+
+/// Byte range of chunk `c`'s stored payload in level `k`.
+pub fn chunk_payload(s: &[u8], k: u16, c: usize) -> Range<usize> {
+    let mut at = level_crc_at(s, k) + 4;
+    for i in 0..c {
+        at += u32_at(s, chunk_entry_at(s, k, i) + 8) as usize;
+    }
+    at..at + u32_at(s, chunk_entry_at(s, k, c) + 8) as usize
+}
+
+/// Codec byte of chunk `c` of level `k`.
+pub fn chunk_codec(s: &[u8], k: u16, c: usize) -> u8 {
+    s[chunk_entry_at(s, k, c) + 1]
+}
+
+/// Sets chunk `c`'s CRC to match its payload, then the level header CRC.
+pub fn fix_chunk_crc(s: &mut [u8], k: u16, c: usize) {
+    let crc = crc32(&s[chunk_payload(s, k, c)]);
+    let at = chunk_entry_at(s, k, c) + 12;
+    s[at..at + 4].copy_from_slice(&crc.to_le_bytes());
+    fix_level_header_crc(s, k);
+}
+
+/// Re-codes every stored chunk of a valid stream as a raw-deflate stream of
+/// one uncompressed block (BFINAL = 1, BTYPE = 00: 5 bytes of block header,
+/// then the bytes): valid deflate chunks that are larger than their raw
+/// data, which no sensible encoder writes but every decoder must accept.
+/// Level lengths and offsets, and the CRCs covering them, are recomputed.
+pub fn wrap_chunks_in_deflate(stream: &[u8]) -> Vec<u8> {
+    let levels = level_count(stream);
+    let head = head_len(levels);
+    let mut out = stream[..head].to_vec();
+    for k in 0..levels {
+        let start = level_range(stream, k).start;
+        let chunks = chunk_count(stream, k);
+        let mut level = stream[start..level_crc_at(stream, k) + 4].to_vec();
+        let mut payload = Vec::new();
+        for c in 0..chunks {
+            let raw = &stream[chunk_payload(stream, k, c)];
+            let entry = chunk_entry_at(stream, k, c) - start;
+            let packed = if level[entry + 1] == codec::STORED {
+                assert!(raw.len() <= 0xFFFF);
+                let len = raw.len() as u16;
+                let mut p = vec![0x01];
+                p.extend_from_slice(&len.to_le_bytes());
+                p.extend_from_slice(&(!len).to_le_bytes());
+                p.extend_from_slice(raw);
+                level[entry + 1] = codec::DEFLATE;
+                level[entry + 8..entry + 12].copy_from_slice(&(p.len() as u32).to_le_bytes());
+                level[entry + 12..entry + 16].copy_from_slice(&crc32(&p).to_le_bytes());
+                p
+            } else {
+                raw.to_vec()
+            };
+            payload.extend_from_slice(&packed);
+        }
+        let crc_at = level.len() - 4;
+        let crc = crc32(&level[..crc_at]);
+        level[crc_at..].copy_from_slice(&crc.to_le_bytes());
+        level.extend_from_slice(&payload);
+        let entry = table_entry(k);
+        let offset = out.len() as u64;
+        out[entry..entry + 8].copy_from_slice(&offset.to_le_bytes());
+        out[entry + 8..entry + 12].copy_from_slice(&(level.len() as u32).to_le_bytes());
+        out.extend_from_slice(&level);
+    }
+    fix_table_crc(&mut out);
+    out
+}
