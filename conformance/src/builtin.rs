@@ -125,9 +125,12 @@ fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(),
     let table = LevelTable::parse(stream, &header)?;
     let layout = layout_for(&header, &table, header.level_count - 1);
     if layout.total != header.workspace_bytes {
-        return Err(Error::InvalidHeader("declared workspace size differs from SPEC §9"));
+        return Err(Error::InvalidHeader(
+            "declared workspace size differs from SPEC §9",
+        ));
     }
-    let mut workspace = vec![0u8; layout.bytes_unaligned() as usize];
+    let len = usize::try_from(layout.bytes_unaligned()).map_err(|_| Error::CapacityExceeded)?;
+    let mut workspace = vec![0u8; len];
     let (memory, mut buffers) = layout.carve(&mut workspace)?;
     let mut state = MeshState::new(memory, header.bits);
     let mut inflater = Box::new(Inflater::new());
@@ -162,10 +165,17 @@ fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(),
         } else {
             substream::FLAGS
         };
+        // SPEC §7.6: no split may take the level past its triangle count.
+        state.set_triangle_limit(info.triangle_count);
         let slots = buffers.each_mut().map(|b| &mut **b);
         let mut subs = Substreams::open(bytes, level_header, first_id, slots, &mut inflater);
         if is_base {
-            read_base(&mut state, &mut subs, info.vertex_count, info.triangle_count)?;
+            read_base(
+                &mut state,
+                &mut subs,
+                info.vertex_count,
+                info.triangle_count,
+            )?;
         } else {
             for r in 0..level_header.round_count {
                 let declared = level_header.split_count(r);
@@ -185,7 +195,8 @@ fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(),
         }
         // SPEC §7.6: end of level.
         subs.finish()?;
-        if state.vertex_count() != info.vertex_count || state.triangle_count() != info.triangle_count
+        if state.vertex_count() != info.vertex_count
+            || state.triangle_count() != info.triangle_count
         {
             return Err(Error::LevelCountMismatch);
         }

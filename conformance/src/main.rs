@@ -63,6 +63,20 @@ enum Command {
     },
 }
 
+/// `println!` that ignores a closed standard output (`run ... | head`).
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        let mut line = format!($($arg)*);
+        line.push('\n');
+        let _ = std::io::stdout().lock().write_all(line.as_bytes());
+    }};
+}
+
+/// `print!` of text that already ends in a newline, ignoring a closed stdout.
+fn put(text: &str) {
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+}
+
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(code) => code,
@@ -84,7 +98,7 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
         } => {
             let dir = vectors.unwrap_or_else(default_vector_dir);
             let manifest = Manifest::load(&dir.join("manifest.json"))?;
-            println!(
+            say!(
                 "splitstream conformance vectors {} ({} vectors) in {}",
                 manifest.format_version,
                 manifest.vectors.len(),
@@ -95,11 +109,10 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
                     return Err("--timeout must be positive".into());
                 }
                 let limit = Duration::from_secs_f64(timeout);
-                let report =
-                    run_vectors(&manifest, &dir, |s| run_external(&command, s, limit))?;
-                println!("decoder: {command}");
-                print!("{}", report.table());
-                println!("{}", report.summary());
+                let report = run_vectors(&manifest, &dir, |s| run_external(&command, s, limit))?;
+                say!("decoder: {command}");
+                put(&report.table());
+                say!("{}", report.summary());
                 return Ok(exit(report.failed() == 0));
             }
             let chosen: Vec<_> = match builtin {
@@ -115,23 +128,23 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
             for b in chosen {
                 let report = run_vectors(&manifest, &dir, |s| run_builtin(b, s))?;
                 if verbose || single {
-                    println!("decoder: {} (built-in)", b.name);
-                    print!("{}", report.table());
+                    say!("decoder: {} (built-in)", b.name);
+                    put(&report.table());
                 } else if report.failed() > 0 {
                     let mut failures = report.clone();
                     failures.rows.retain(|r| !r.passed);
-                    println!("decoder: {} (built-in), failures:", b.name);
-                    print!("{}", failures.table());
+                    say!("decoder: {} (built-in), failures:", b.name);
+                    put(&failures.table());
                 }
                 passed += report.passed();
                 failed += report.failed();
                 rows.push((b.name, report.passed(), report.failed()));
             }
-            println!("\n{:<16}  {:>6}  {:>6}", "built-in", "passed", "failed");
+            say!("\n{:<16}  {:>6}  {:>6}", "built-in", "passed", "failed");
             for (name, p, f) in rows {
-                println!("{name:<16}  {p:>6}  {f:>6}");
+                say!("{name:<16}  {p:>6}  {f:>6}");
             }
-            println!("{passed} passed, {failed} failed");
+            say!("{passed} passed, {failed} failed");
             Ok(exit(failed == 0))
         }
         Command::Decode => {
@@ -149,7 +162,7 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
         Command::List => {
             for b in BUILTINS {
                 let hidden = if b.hidden { " (hidden)" } else { "" };
-                println!("{:<16} {}{hidden}", b.name, b.summary);
+                say!("{:<16} {}{hidden}", b.name, b.summary);
             }
             Ok(ExitCode::SUCCESS)
         }
@@ -160,7 +173,7 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
             let generated = generate::generate(&real)?;
             generate::write(&generated, &out)?;
             let bytes: usize = generated.files.values().map(Vec::len).sum();
-            println!(
+            say!(
                 "wrote {} vectors ({} bytes with the manifest) to {}",
                 generated.manifest.vectors.len(),
                 bytes,
@@ -172,5 +185,9 @@ fn run(cli: Cli) -> Result<ExitCode, String> {
 }
 
 fn exit(ok: bool) -> ExitCode {
-    if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+    if ok {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
 }

@@ -71,8 +71,7 @@ pub struct FinalMesh {
 
 impl Manifest {
     pub fn load(path: &Path) -> Result<Manifest, String> {
-        let text =
-            std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
         serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))
     }
 

@@ -147,9 +147,19 @@ pub fn judge(v: &Vector, o: &Outcome) -> (bool, String) {
                 return (false, format!("{text}, hash {i} differs ({})", got[i]));
             }
             if got.len() > want.len() {
-                return (false, format!("{text}, {} hashes (at most {} expected)", got.len(), want.len()));
+                return (
+                    false,
+                    format!(
+                        "{text}, {} hashes (at most {} expected)",
+                        got.len(),
+                        want.len()
+                    ),
+                );
             }
-            (v.error_class.as_deref() == Some(class.as_str()), describe(&text))
+            (
+                v.error_class.as_deref() == Some(class.as_str()),
+                describe(&text),
+            )
         }
     }
 }
@@ -166,9 +176,18 @@ mod tests {
         let o = parse_output(b"error truncated\n");
         assert_eq!(o.verdict, Verdict::Error("truncated".into()));
         assert!(matches!(parse_output(b"").verdict, Verdict::Broken(_)));
-        assert!(matches!(parse_output(b"0123\nok\n").verdict, Verdict::Broken(_)));
-        assert!(matches!(parse_output(b"ok\nok\n").verdict, Verdict::Broken(_)));
-        assert!(matches!(parse_output(b"ABCDEF0123456789\nok\n").verdict, Verdict::Broken(_)));
+        assert!(matches!(
+            parse_output(b"0123\nok\n").verdict,
+            Verdict::Broken(_)
+        ));
+        assert!(matches!(
+            parse_output(b"ok\nok\n").verdict,
+            Verdict::Broken(_)
+        ));
+        assert!(matches!(
+            parse_output(b"ABCDEF0123456789\nok\n").verdict,
+            Verdict::Broken(_)
+        ));
     }
 
     #[test]

@@ -1,9 +1,9 @@
 //! Runs decoders against the vector set and reports a pass/fail table.
 
 use std::io::{Read, Write};
-use std::os::unix::process::CommandExt;
 use std::path::Path;
 use std::process::{Command, Stdio};
+use std::sync::mpsc;
 use std::time::{Duration, Instant};
 
 use crate::manifest::Manifest;
@@ -38,8 +38,20 @@ impl Report {
 
     /// The pass/fail table, one vector a line.
     pub fn table(&self) -> String {
-        let w0 = self.rows.iter().map(|r| r.vector.len()).max().unwrap_or(6).max(6);
-        let w1 = self.rows.iter().map(|r| r.expected.len()).max().unwrap_or(8).max(8);
+        let w0 = self
+            .rows
+            .iter()
+            .map(|r| r.vector.len())
+            .max()
+            .unwrap_or(6)
+            .max(6);
+        let w1 = self
+            .rows
+            .iter()
+            .map(|r| r.expected.len())
+            .max()
+            .unwrap_or(8)
+            .max(8);
         let mut s = format!("{:<4}  {:<w0$}  {:<w1$}  got\n", "", "vector", "expected");
         for r in &self.rows {
             let mark = if r.passed { "pass" } else { "FAIL" };
@@ -80,8 +92,10 @@ pub fn run_vectors(
 }
 
 /// Runs `command` through `sh -c`, writes `stream` to its standard input and
-/// parses its standard output (the protocol of conformance/README.md). The
-/// command and everything it starts are killed after `timeout`.
+/// parses its standard output (the protocol of conformance/README.md). After
+/// `timeout` the shell is killed (SIGKILL); processes it started that keep
+/// the output open are abandoned after a short grace period, so a decoder
+/// wrapped in a script should `exec` it.
 pub fn run_external(command: &str, stream: &[u8], timeout: Duration) -> Outcome {
     let mut child = match Command::new("sh")
         .arg("-c")
@@ -89,7 +103,6 @@ pub fn run_external(command: &str, stream: &[u8], timeout: Duration) -> Outcome 
         .stdin(Stdio::piped())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
-        .process_group(0)
         .spawn()
     {
         Ok(c) => c,
@@ -98,20 +111,22 @@ pub fn run_external(command: &str, stream: &[u8], timeout: Duration) -> Outcome 
     let mut stdin = child.stdin.take().expect("piped");
     let input = stream.to_vec();
     // The decoder may stop reading early (a bad header): a broken pipe is fine.
-    let writer = std::thread::spawn(move || {
+    std::thread::spawn(move || {
         let _ = stdin.write_all(&input);
     });
+    let (out_tx, out_rx) = mpsc::channel();
     let mut stdout = child.stdout.take().expect("piped");
-    let reader = std::thread::spawn(move || {
+    std::thread::spawn(move || {
         let mut out = Vec::new();
         let _ = stdout.read_to_end(&mut out);
-        out
+        let _ = out_tx.send(out);
     });
+    let (err_tx, err_rx) = mpsc::channel();
     let mut stderr = child.stderr.take().expect("piped");
-    let err_reader = std::thread::spawn(move || {
+    std::thread::spawn(move || {
         let mut out = Vec::new();
         let _ = stderr.read_to_end(&mut out);
-        out
+        let _ = err_tx.send(out);
     });
     let started = Instant::now();
     let status = loop {
@@ -123,20 +138,21 @@ pub fn run_external(command: &str, stream: &[u8], timeout: Duration) -> Outcome 
         }
     };
     if status.is_none() {
-        // Kill the whole process group (sh and what it started).
-        let _ = Command::new("kill")
-            .arg("-KILL")
-            .arg(format!("-{}", child.id()))
-            .stderr(Stdio::null())
-            .status();
         let _ = child.kill();
         let _ = child.wait();
     }
-    let _ = writer.join();
-    let out = reader.join().unwrap_or_default();
-    let err = err_reader.join().unwrap_or_default();
+    // Output still open after the shell ended belongs to a process it left
+    // behind; wait a little, then judge what arrived.
+    let grace = Duration::from_secs(2);
+    let out = out_rx.recv_timeout(grace);
+    let err = err_rx
+        .recv_timeout(Duration::from_millis(100))
+        .unwrap_or_default();
     let Some(status) = status else {
         return Outcome::broken(format!("timed out after {} s", timeout.as_secs_f64()));
+    };
+    let Ok(out) = out else {
+        return Outcome::broken("the decoder exited but its output stayed open");
     };
     let mut outcome = parse_output(&out);
     if status.code().is_none() {

@@ -8,7 +8,8 @@
 //! Writes `<dir>/decode_bytes/*.sps` (complete valid streams: the hand-made
 //! ones of tests/handmade.rs and generated deep ones), `<dir>/decode_mutated/*`
 //! (one byte per seed stream: no mutation), `<dir>/round_records/*` (choice
-//! strings of the generator) and `<dir>/tetrahedron.sps`.
+//! strings of the generator) and `<dir>/tetrahedron.sps` (the stream of
+//! `embedded-size/`, deflate chunks).
 
 #[path = "../fuzz/src/streams.rs"]
 mod streams;
@@ -103,26 +104,33 @@ fn main() {
     }
     let mut n = 0;
     for (name, bytes) in handmade() {
-        streams::decode_full(&bytes)
-            .error
-            .map(|e| panic!("{name}: {e}"));
+        if let Some(e) = streams::decode_full(&bytes).error {
+            panic!("{name}: {e}");
+        }
         std::fs::write(dir.join("decode_bytes").join(format!("{name}.sps")), &bytes).unwrap();
         n += 1;
     }
-    std::fs::write(dir.join("tetrahedron.sps"), &handmade()[0].1).unwrap();
+    // The embedded-size demo stream (deflate chunks).
+    std::fs::write(dir.join("tetrahedron.sps"), &handmade()[1].1).unwrap();
     for (i, g) in streams::seed_generated().iter().enumerate() {
         streams::check_against(g, &streams::decode_full(&g.stream)).unwrap();
         std::fs::write(
-            dir.join("decode_bytes").join(format!("gen_{i:02}_{}.sps", g.base)),
+            dir.join("decode_bytes")
+                .join(format!("gen_{i:02}_{}.sps", g.base)),
             &g.stream,
         )
         .unwrap();
-        std::fs::write(dir.join("decode_mutated").join(format!("seed_{i:02}")), [i as u8]).unwrap();
+        std::fs::write(
+            dir.join("decode_mutated").join(format!("seed_{i:02}")),
+            [i as u8],
+        )
+        .unwrap();
         println!(
-            "seed {i:2}: {:<12} {:>5} bytes, {} levels, {} rounds, {} splits",
+            "seed {i:2}: {:<12} {:>5} bytes, {} levels{}, {} rounds, {} splits",
             g.base,
             g.stream.len(),
-            g.levels.len(),
+            g.levels.len() - g.seeded as usize,
+            if g.seeded { " (rounds in level 0)" } else { "" },
             g.hashes.len() - 1,
             g.splits
         );
@@ -136,8 +144,11 @@ fn main() {
         let bytes = streams::pseudo_random_bytes(seed, 512);
         let g = streams::generate(&mut Choices::new(&bytes), false);
         assert!(g.error.is_none());
-        std::fs::write(dir.join("round_records").join(format!("random_{seed:02}")), &bytes)
-            .unwrap();
+        std::fs::write(
+            dir.join("round_records").join(format!("random_{seed:02}")),
+            &bytes,
+        )
+        .unwrap();
         n += 1;
     }
     println!("wrote {n} files under {}", dir.display());

@@ -68,7 +68,8 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
             fit -= 1;
             if fit == 0 {
                 return Err(Error::WorkspaceTooSmall {
-                    needed: usize::try_from(layout_for(&header, &table, 0).total).unwrap_or(usize::MAX),
+                    needed: usize::try_from(layout_for(&header, &table, 0).total)
+                        .unwrap_or(usize::MAX),
                     available: workspace.len(),
                 });
             }
@@ -167,16 +168,25 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
             }
         };
         self.state.set_triangle_limit(info.triangle_count);
-        let mut ld = open_level(self, level, info, header, bytes);
         if level == 0 {
-            let result = read_base(
-                ld.state,
-                &mut ld.subs,
-                info.vertex_count,
-                info.triangle_count,
-            )
-            .and_then(|_| ld.complete());
-            if let Err(e) = result {
+            // The seed mesh first (ids 9..=11), then the level's rounds.
+            let buffers = self.buffers.each_mut().map(|b| &mut **b);
+            let mut subs = Substreams::open(
+                bytes,
+                header,
+                substream::BASE_POSITIONS,
+                buffers,
+                self.inflater,
+            );
+            let seed = (header.seed_vertices, header.seed_triangles);
+            if let Err(e) = read_base(&mut self.state, &mut subs, seed.0, seed.1) {
+                self.poisoned = true;
+                return Err(e);
+            }
+        }
+        let mut ld = open_level(self, level, info, header, bytes);
+        if ld.header.round_count == 0 {
+            if let Err(e) = ld.complete() {
                 *ld.poisoned = true;
                 return Err(e);
             }
@@ -227,8 +237,12 @@ fn prepare_level<'l>(
     if header.round_count != info.round_count {
         return Err(Error::LevelCountMismatch);
     }
-    if !is_base {
-        let before = decoder.table.get(level - 1).vertex_count as u64;
+    {
+        let before = if is_base {
+            header.seed_vertices as u64
+        } else {
+            decoder.table.get(level - 1).vertex_count as u64
+        };
         let mut added = 0u64;
         for r in 0..header.round_count {
             let s = header.split_count(r);
@@ -251,14 +265,8 @@ fn open_level<'d, 'l, 'ws>(
     header: LevelHeader<'l>,
     bytes: &'l [u8],
 ) -> LevelDecoder<'d, 'l, 'ws> {
-    let is_base = level == 0;
-    let first_id = if is_base {
-        substream::BASE_POSITIONS
-    } else {
-        substream::FLAGS
-    };
     let buffers = decoder.buffers.each_mut().map(|b| &mut **b);
-    let subs = Substreams::open(bytes, header, first_id, buffers, decoder.inflater);
+    let subs = Substreams::open(bytes, header, substream::FLAGS, buffers, decoder.inflater);
     LevelDecoder {
         level,
         info,
@@ -270,7 +278,7 @@ fn open_level<'d, 'l, 'ws>(
         ring: &mut decoder.ring,
         next_level: &mut decoder.next_level,
         poisoned: &mut decoder.poisoned,
-        done: is_base,
+        done: false,
     }
 }
 

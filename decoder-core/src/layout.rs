@@ -40,7 +40,10 @@ impl Layout {
     ) -> Layout {
         let v = vertex_capacity as u64;
         let t = triangle_capacity as u64;
-        let opposite_len = (3 * t).max(6 * base_triangles as u64 + base_vertices as u64 + 1);
+        let opposite_len = (3 * t).max(
+            3 * base_triangles as u64
+                + MeshState::base_scratch_len(base_vertices, base_triangles) as u64,
+        );
         let chunk_buffer_len = round_up(max_chunk_len as u64);
         let sizes = [
             12 * v,
@@ -85,7 +88,9 @@ impl Layout {
     ) -> Result<(StateMemory<'ws>, [&'ws mut [u8]; SLOTS]), Error> {
         let skip = buffer.as_ptr().align_offset(ALIGN).min(ALIGN);
         let too_small = Error::WorkspaceTooSmall {
-            needed: usize::try_from(self.total).unwrap_or(usize::MAX).saturating_add(skip),
+            needed: usize::try_from(self.total)
+                .unwrap_or(usize::MAX)
+                .saturating_add(skip),
             available: buffer.len(),
         };
         if !self.fits(buffer) {

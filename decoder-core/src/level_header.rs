@@ -18,6 +18,10 @@ pub struct ChunkEntry {
 #[derive(Clone, Copy, Debug)]
 pub struct LevelHeader<'l> {
     pub round_count: u32,
+    /// Level 0 only: vertex and triangle counts of the seed mesh its rounds
+    /// start from (SPEC §5.1, §6.3); `(0, 0)` for other levels.
+    pub seed_vertices: u32,
+    pub seed_triangles: u32,
     split_counts: &'l [u8],
     directory: &'l [u8],
     pub chunk_count: u32,
@@ -31,13 +35,18 @@ impl<'l> LevelHeader<'l> {
     pub fn parse(level: &'l [u8], is_base: bool, max_chunk_len: u32) -> Result<Self, Error> {
         let round_count = u32_at(level, 0)?;
         let chunk_count = u32_at(level, 4)?;
+        let (seed_vertices, seed_triangles, counts_at) = if is_base {
+            (u32_at(level, 8)?, u32_at(level, 12)?, 16usize)
+        } else {
+            (0, 0, 8usize)
+        };
         let splits_len = (round_count as usize)
             .checked_mul(4)
             .ok_or(Error::Truncated)?;
         let dir_len = (chunk_count as usize)
             .checked_mul(CHUNK_ENTRY_LEN)
             .ok_or(Error::Truncated)?;
-        let dir_start = 8usize.checked_add(splits_len).ok_or(Error::Truncated)?;
+        let dir_start = counts_at.checked_add(splits_len).ok_or(Error::Truncated)?;
         let crc_at = dir_start.checked_add(dir_len).ok_or(Error::Truncated)?;
         let payload_start = crc_at.checked_add(4).ok_or(Error::Truncated)?;
         if level.len() < payload_start {
@@ -48,7 +57,9 @@ impl<'l> LevelHeader<'l> {
         }
         let header = LevelHeader {
             round_count,
-            split_counts: &level[8..dir_start],
+            seed_vertices,
+            seed_triangles,
+            split_counts: &level[counts_at..dir_start],
             directory: &level[dir_start..crc_at],
             chunk_count,
             payload_start,
@@ -58,8 +69,11 @@ impl<'l> LevelHeader<'l> {
     }
 
     fn validate(&self, level_len: usize, is_base: bool, max_chunk_len: u32) -> Result<(), Error> {
+        if is_base && (self.seed_vertices == 0 || self.seed_triangles == 0) {
+            return Err(Error::InvalidLevelHeader("empty seed mesh"));
+        }
         let allowed = if is_base {
-            substream::BASE_POSITIONS..=substream::BASE_DEFICITS
+            substream::FLAGS..=substream::BASE_DEFICITS
         } else {
             substream::FLAGS..=substream::PLACEMENT
         };

@@ -75,7 +75,10 @@ impl<'h> LevelTable<'h> {
             }
             match previous {
                 None => {
-                    if e.round_count != 0 || e.vertex_count == 0 || e.triangle_count == 0 {
+                    if e.vertex_count == 0
+                        || e.triangle_count == 0
+                        || e.round_count > e.vertex_count
+                    {
                         return Err(Error::InvalidLevelTable("base level counts"));
                     }
                 }

@@ -76,12 +76,16 @@ pub enum ChunkCodec {
 }
 
 /// One level's content before framing.
+///
+/// A base level given to [`write_stream`] holds just the seed mesh: its
+/// `substreams` are ids 9..=11 and it has no rounds. [`write_stream_seeded`]
+/// takes the seed separately, so that level 0 can also carry rounds.
 #[derive(Clone, Debug, Default)]
 pub struct LevelPayload {
-    /// Declared split count of each round (empty for the base level).
+    /// Declared split count of each round.
     pub round_splits: Vec<u32>,
-    /// Substreams in id order: ids 1..=8 for a refinement level, 9..=11 for
-    /// the base (index 0 is the first id).
+    /// Substreams in id order: ids 1..=8 for rounds (index 0 is id 1), or
+    /// ids 9..=11 for a base level given to [`write_stream`].
     pub substreams: Vec<SubstreamWriter>,
     pub vertex_count: u32,
     pub triangle_count: u32,
@@ -100,17 +104,39 @@ pub struct StreamParams {
     pub chunk_limit: u32,
 }
 
-/// Frames a base level and refinement levels into a complete stream.
+/// The seed mesh of level 0 (SPEC §6.3): counts and substreams 9..=11.
+#[derive(Clone, Debug, Default)]
+pub struct SeedPayload {
+    pub vertices: u32,
+    pub triangles: u32,
+    pub substreams: Vec<SubstreamWriter>,
+}
+
+/// Frames a base level (seed mesh only) and refinement levels.
 pub fn write_stream(params: &StreamParams, levels: &[LevelPayload]) -> Vec<u8> {
+    let base = &levels[0];
+    let seed = SeedPayload {
+        vertices: base.vertex_count,
+        triangles: base.triangle_count,
+        substreams: base.substreams.clone(),
+    };
+    let mut rounds = levels.to_vec();
+    rounds[0].substreams = Vec::new();
+    rounds[0].round_splits = Vec::new();
+    write_stream_seeded(params, &seed, &rounds)
+}
+
+/// Frames a stream whose level 0 is `seed` followed by the rounds of
+/// `levels[0]`; `levels[1..]` are the refinement levels.
+pub fn write_stream_seeded(
+    params: &StreamParams,
+    seed: &SeedPayload,
+    levels: &[LevelPayload],
+) -> Vec<u8> {
     let mut framed: Vec<Vec<u8>> = Vec::with_capacity(levels.len());
     let mut max_chunk = 0u32;
     for (k, level) in levels.iter().enumerate() {
-        let first_id = if k == 0 {
-            substream::BASE_POSITIONS
-        } else {
-            substream::FLAGS
-        };
-        let (bytes, largest) = frame_level(level, first_id, params);
+        let (bytes, largest) = frame_level(level, (k == 0).then_some(seed), params);
         max_chunk = max_chunk.max(largest);
         framed.push(bytes);
     }
@@ -161,12 +187,26 @@ pub fn write_stream(params: &StreamParams, levels: &[LevelPayload]) -> Vec<u8> {
 }
 
 /// Frames one level (SPEC §5.1); returns its bytes and its largest raw chunk.
-pub fn frame_level(level: &LevelPayload, first_id: u8, params: &StreamParams) -> (Vec<u8>, u32) {
+/// `seed` is given for level 0 only.
+pub fn frame_level(
+    level: &LevelPayload,
+    seed: Option<&SeedPayload>,
+    params: &StreamParams,
+) -> (Vec<u8>, u32) {
     let limit = params.chunk_limit.max(1) as usize;
     let mut directory = Vec::new();
     let mut payload = Vec::new();
     let mut largest = 0u32;
-    for (i, sub) in level.substreams.iter().enumerate() {
+    let rounds = level
+        .substreams
+        .iter()
+        .enumerate()
+        .map(|(i, s)| (substream::FLAGS + i as u8, s));
+    let base = seed
+        .into_iter()
+        .flat_map(|s| s.substreams.iter().enumerate())
+        .map(|(i, s)| (substream::BASE_POSITIONS + i as u8, s));
+    for (id, sub) in rounds.chain(base) {
         for raw in sub.as_bytes().chunks(limit) {
             let (codec_id, stored) = match params.codec {
                 ChunkCodec::Stored => (codec::STORED, raw.to_vec()),
@@ -180,7 +220,7 @@ pub fn frame_level(level: &LevelPayload, first_id: u8, params: &StreamParams) ->
                 }
             };
             let mut entry = [0u8; CHUNK_ENTRY_LEN];
-            entry[0] = first_id + i as u8;
+            entry[0] = id;
             entry[1] = codec_id;
             entry[4..8].copy_from_slice(&(raw.len() as u32).to_le_bytes());
             entry[8..12].copy_from_slice(&(stored.len() as u32).to_le_bytes());
@@ -193,6 +233,10 @@ pub fn frame_level(level: &LevelPayload, first_id: u8, params: &StreamParams) ->
     let mut out = Vec::new();
     out.extend_from_slice(&(level.round_splits.len() as u32).to_le_bytes());
     out.extend_from_slice(&(directory.len() as u32).to_le_bytes());
+    if let Some(seed) = seed {
+        out.extend_from_slice(&seed.vertices.to_le_bytes());
+        out.extend_from_slice(&seed.triangles.to_le_bytes());
+    }
     for s in &level.round_splits {
         out.extend_from_slice(&s.to_le_bytes());
     }

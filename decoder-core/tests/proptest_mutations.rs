@@ -4,10 +4,10 @@
 //! decoding paths run: the owned `decode_all` and the no-alloc `Decoder`
 //! over an exactly sized workspace; they must agree.
 
-#[path = "../fuzz/src/streams.rs"]
-mod streams;
 #[path = "../fuzz/src/mesh_check.rs"]
 mod mesh_check;
+#[path = "../fuzz/src/streams.rs"]
+mod streams;
 
 use std::sync::OnceLock;
 

@@ -11,17 +11,19 @@
 //! * Completely random record substreams and split counts on a fixed base
 //!   give either a valid mesh (same invariants) or a typed error.
 
-#[path = "../fuzz/src/streams.rs"]
-mod streams;
 #[path = "../fuzz/src/mesh_check.rs"]
 mod mesh_check;
+#[path = "../fuzz/src/streams.rs"]
+mod streams;
 
 use mesh_check::check_oriented_manifold;
 use proptest::prelude::*;
 use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::decode_all;
-use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream};
+use splitstream_decoder_core::writer::{
+    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+};
 use streams::{Choices, bases};
 
 fn base_euler(base: &str) -> i64 {

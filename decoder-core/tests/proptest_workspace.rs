@@ -50,7 +50,10 @@ fn every_size(stream: &[u8]) {
         let fit = Decoder::new(stream, &mut bytes[..size], &mut inflater)
             .map(|d| d.levels_that_fit())
             .unwrap_or(0);
-        assert!(fit >= last_fit, "size {size}: {fit} levels fit, {last_fit} before");
+        assert!(
+            fit >= last_fit,
+            "size {size}: {fit} levels fit, {last_fit} before"
+        );
         last_fit = fit;
     }
     // The advertised size always suffices, at any alignment.

@@ -131,13 +131,20 @@ pub fn tetra_split() -> Rec {
 pub fn tetra_stream(codec: ChunkCodec) -> Vec<u8> {
     write_stream(
         &params(codec),
-        &[tetrahedron(), level(&[true], vec![1], &[tetra_split()], 5, 6)],
+        &[
+            tetrahedron(),
+            level(&[true], vec![1], &[tetra_split()], 5, 6),
+        ],
     )
 }
 
 /// One triangle; vertex 0 (ring: ghost, 1, 2) splits with the ghost as a wing.
 pub fn boundary_ghost_wing_stream() -> Vec<u8> {
-    let b = base(&[[0, 0, 0], [10, 0, 0], [0, 10, 0]], &[[0, 1, 2]], &[0, LEAF, LEAF]);
+    let b = base(
+        &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
+        &[[0, 1, 2]],
+        &[0, LEAF, LEAF],
+    );
     let rec = Rec {
         o: 0,
         d: 1,
@@ -157,7 +164,11 @@ pub fn boundary_ghost_wing_stream() -> Vec<u8> {
 pub fn single_triangle_stream() -> Vec<u8> {
     write_stream(
         &params(ChunkCodec::Stored),
-        &[base(&[[0, 0, 0], [10, 0, 0], [0, 10, 0]], &[[0, 1, 2]], &[LEAF; 3])],
+        &[base(
+            &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
+            &[[0, 1, 2]],
+            &[LEAF; 3],
+        )],
     )
 }
 

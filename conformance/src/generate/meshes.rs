@@ -5,6 +5,29 @@ use std::path::Path;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
 
+/// sin(x) from +, -, *, / only (Taylor series after reduction to
+/// [-pi, pi]), so that generated meshes, and therefore the vectors, do not
+/// depend on the platform's libm.
+fn sin(x: f64) -> f64 {
+    let tau = std::f64::consts::TAU;
+    let mut x = x - tau * (x / tau).round();
+    if x > std::f64::consts::FRAC_PI_2 {
+        x = std::f64::consts::PI - x;
+    } else if x < -std::f64::consts::FRAC_PI_2 {
+        x = -std::f64::consts::PI - x;
+    }
+    let (mut term, mut sum) = (x, x);
+    for k in 1..12 {
+        term *= -x * x / ((2 * k) as f64 * (2 * k + 1) as f64);
+        sum += term;
+    }
+    sum
+}
+
+fn cos(x: f64) -> f64 {
+    sin(x + std::f64::consts::FRAC_PI_2)
+}
+
 /// An icosphere: `subdivisions` rounds of 4-to-1 splits of an icosahedron,
 /// projected to the unit sphere. Closed, genus 0.
 pub fn icosphere(subdivisions: usize) -> Mesh {
@@ -81,9 +104,8 @@ pub fn grid(w: usize, h: usize, seed: u64, hole: Option<[usize; 4]>) -> Mesh {
     for y in 0..h {
         for x in 0..w {
             let (fx, fy) = (x as f64, y as f64);
-            let z = (fx * 0.7 + seed as f64).sin() * 2.0
-                + (fy * 0.45).cos() * 3.0
-                + ((fx * fy) * 0.05).sin();
+            let z =
+                sin(fx * 0.7 + seed as f64) * 2.0 + cos(fy * 0.45) * 3.0 + sin((fx * fy) * 0.05);
             positions.push([fx * 10.0, fy * 10.0, z]);
         }
     }
@@ -124,7 +146,7 @@ pub fn cone(n: usize, rings: usize) -> Mesh {
         let z = 10.0 - 2.5 * (j + 1) as f64;
         for i in 0..n {
             let a = std::f64::consts::TAU * i as f64 / n as f64 + 0.1 * j as f64;
-            positions.push([radius * a.cos(), radius * a.sin(), z]);
+            positions.push([radius * cos(a), radius * sin(a), z]);
         }
     }
     positions.push([0.0, 0.0, 10.0 - 2.5 * (rings + 1) as f64]);
@@ -202,4 +224,16 @@ pub fn checked(mesh: Mesh, what: &str) -> Mesh {
         panic!("generator mesh {what} is not encodable: {e}");
     }
     mesh
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn portable_sine_matches_libm() {
+        for i in -2000..2000 {
+            let x = i as f64 * 0.01234;
+            assert!((super::sin(x) - x.sin()).abs() < 1e-13, "{x}");
+            assert!((super::cos(x) - x.cos()).abs() < 1e-13, "{x}");
+        }
+    }
 }

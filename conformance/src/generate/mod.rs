@@ -97,7 +97,11 @@ pub fn generate(real_data: &Path) -> Result<Generated, String> {
     let mut files = BTreeMap::new();
     let mut vectors = Vec::new();
     for spec in specs.0 {
-        let dir = if spec.error_class.is_none() { "valid" } else { "invalid" };
+        let dir = if spec.error_class.is_none() {
+            "valid"
+        } else {
+            "invalid"
+        };
         let file = format!("{dir}/{}.sps", spec.name);
         vectors.push(describe(&spec, &file));
         files.insert(file, spec.stream);
@@ -121,7 +125,10 @@ pub fn write(generated: &Generated, dir: &Path) -> Result<(), String> {
         std::fs::create_dir_all(&d).map_err(|e| err(&d, e))?;
         for entry in std::fs::read_dir(&d).map_err(|e| err(&d, e))? {
             let path = entry.map_err(|e| err(&d, e))?.path();
-            let rel = format!("{sub}/{}", path.file_name().unwrap_or_default().to_string_lossy());
+            let rel = format!(
+                "{sub}/{}",
+                path.file_name().unwrap_or_default().to_string_lossy()
+            );
             if !generated.files.contains_key(&rel) {
                 std::fs::remove_file(&path).map_err(|e| err(&path, e))?;
             }
@@ -200,7 +207,14 @@ fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
         let mut per_substream = BTreeMap::new();
         for c in 0..lh.chunk_count {
             let e = lh.chunk(c).expect("valid");
-            tags.push(if e.codec == 0 { "stored-chunks" } else { "deflate-chunks" }.to_string());
+            tags.push(
+                if e.codec == 0 {
+                    "stored-chunks"
+                } else {
+                    "deflate-chunks"
+                }
+                .to_string(),
+            );
             *per_substream.entry(e.substream).or_insert(0) += 1;
         }
         if per_substream.values().any(|&n| n > 1) {
@@ -225,10 +239,16 @@ fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
         let mut level = decoder
             .begin_level(k, &stream[range.start as usize..range.end as usize])
             .expect("valid");
-        track(level.state().triangles(), level.state().vertex_count() as usize);
+        track(
+            level.state().triangles(),
+            level.state().vertex_count() as usize,
+        );
         while level.next_round().expect("valid").is_some() {
             rounds += 1;
-            track(level.state().triangles(), level.state().vertex_count() as usize);
+            track(
+                level.state().triangles(),
+                level.state().vertex_count() as usize,
+            );
         }
     }
     let triangles = decoder.triangles();
@@ -241,7 +261,14 @@ fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
         .iter()
         .filter(|&&(a, b)| directed.binary_search(&(b, a)).is_err())
         .count();
-    tags.push(if boundary_edges == 0 { "closed" } else { "boundary" }.to_string());
+    tags.push(
+        if boundary_edges == 0 {
+            "closed"
+        } else {
+            "boundary"
+        }
+        .to_string(),
+    );
     if max_vertex_triangles >= 32 {
         tags.push("high-valence".to_string());
     }
@@ -305,8 +332,14 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
     // Encoded meshes.
     let sphere3 = meshes::checked(meshes::icosphere(3), "icosphere(3)");
     let sphere2 = meshes::checked(meshes::icosphere(2), "icosphere(2)");
-    let holed = meshes::checked(meshes::grid(24, 20, 1, Some([8, 15, 6, 12])), "grid with hole");
-    let small_holed = meshes::checked(meshes::grid(14, 12, 4, Some([4, 9, 4, 8])), "small grid with hole");
+    let holed = meshes::checked(
+        meshes::grid(24, 20, 1, Some([8, 15, 6, 12])),
+        "grid with hole",
+    );
+    let small_holed = meshes::checked(
+        meshes::grid(14, 12, 4, Some([4, 9, 4, 8])),
+        "small grid with hole",
+    );
     let bumpy = meshes::checked(meshes::grid(30, 30, 2, None), "grid");
     let locked = meshes::checked(meshes::grid(16, 16, 3, None), "grid for lock_boundary");
     let cone = meshes::checked(meshes::cone(96, 4), "cone");
@@ -362,18 +395,16 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             },
         ),
     );
-    for (levels, mesh, what) in [(1, &sphere2, "icosphere"), (2, &sphere2, "icosphere"), (8, &bumpy, "grid")] {
+    for (levels, mesh, what) in [
+        (1, &sphere2, "icosphere"),
+        (2, &sphere2, "icosphere"),
+        (8, &bumpy, "grid"),
+    ] {
         s.valid(
             &format!("{what}-levels-{levels}"),
             &format!("{what} encoded with levels = {levels}."),
             &["encoded"],
-            encoded(
-                mesh,
-                EncodeOptions {
-                    levels,
-                    ..opts()
-                },
-            ),
+            encoded(mesh, EncodeOptions { levels, ..opts() }),
         );
     }
     s.valid(
@@ -409,7 +440,10 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             },
         ),
     );
-    let terrain = meshes::checked(splitstream_encoder::input::fractal_terrain(33, 7), "terrain");
+    let terrain = meshes::checked(
+        splitstream_encoder::input::fractal_terrain(33, 7),
+        "terrain",
+    );
     s.valid(
         "terrain-constrained-deflate",
         "33x33 fractal terrain (the demo's generator), constrained positions, deflate, 6 levels.",
@@ -468,9 +502,21 @@ fn invalid_vectors(s: &mut Specs) {
         ("truncated-signature", 5, "inside the 8-byte signature"),
         ("truncated-header", 60, "inside the 96-byte header"),
         ("truncated-level-table", head - 10, "inside the level table"),
-        ("truncated-base-level", level0.start + level0.len() / 2, "in the middle of the base level"),
-        ("truncated-mid-level", level2.start + level2.len() / 2, "in the middle of level 2 (levels 0 and 1 decode first)"),
-        ("truncated-last-byte", subject.len() - 1, "one byte before the end"),
+        (
+            "truncated-base-level",
+            level0.start + level0.len() / 2,
+            "in the middle of the base level",
+        ),
+        (
+            "truncated-mid-level",
+            level2.start + level2.len() / 2,
+            "in the middle of level 2 (levels 0 and 1 decode first)",
+        ),
+        (
+            "truncated-last-byte",
+            subject.len() - 1,
+            "one byte before the end",
+        ),
     ] {
         s.invalid(
             name,
@@ -545,6 +591,31 @@ fn invalid_vectors(s: &mut Specs) {
             let mut b = handmade::tetra_stream(ChunkCodec::Stored);
             b[9] = 1;
             fix_header_crc(&mut b);
+            b
+        },
+    );
+
+    s.valid(
+        "trailing-bytes-ignored",
+        "The icosphere stream followed by 16 bytes past the end of its last level, which decoders ignore (SPEC §10.3).",
+        &["framing"],
+        {
+            let mut b = subject.clone();
+            b.extend_from_slice(b"not splitstream!");
+            b
+        },
+    );
+    s.invalid(
+        "round-count-mismatch",
+        "count-mismatch",
+        "Level-table entry 1 declares one round more than level 1's header (table CRC recomputed).",
+        &["framing", "level-count"],
+        {
+            let mut b = subject.clone();
+            let at = table_entry(1) + 20;
+            let rounds = u32::from_le_bytes(b[at..at + 4].try_into().expect("4 bytes"));
+            b[at..at + 4].copy_from_slice(&(rounds + 1).to_le_bytes());
+            fix_table_crc(&mut b);
             b
         },
     );
@@ -689,6 +760,17 @@ fn invalid_vectors(s: &mut Specs) {
         },
     );
     s.invalid(
+        "level-triangles-low",
+        "count-mismatch",
+        "The last level's table entry (and so the header capacity) one triangle short of what its splits make.",
+        &["records", "level-count"],
+        {
+            let mut p = parts.clone();
+            p.levels[last as usize].triangle_count -= 1;
+            reframe(&p)
+        },
+    );
+    s.invalid(
         "record-trailing-data",
         "count-mismatch",
         "One byte appended to the edge substream of the last level: data after the level's last record.",
@@ -713,15 +795,17 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "flags-padding-not-zero",
         "count-mismatch",
-        "A padding bit after the last flag of level 1 set (SPEC §5.4).",
+        "The top padding bit after the last flag of a refinement level set (SPEC §5.4).",
         &["records", "record-count"],
         {
             let mut p = parts.clone();
-            // Find a flag substream whose last byte has free high bits.
-            let flags = &mut p.levels[1].substreams[0];
-            let lastb = flags.last_mut().expect("flags");
-            assert!(*lastb & 0x80 == 0, "the last flag byte has padding");
-            *lastb |= 0x80;
+            // The first level whose flag count is not a multiple of 8 (its
+            // last flag byte has padding bits; unused bits are zero).
+            let level = p.levels[1..]
+                .iter_mut()
+                .find(|l| l.substreams[0].last().is_some_and(|&b| b & 0x80 == 0))
+                .expect("a flag substream with padding");
+            *level.substreams[0].last_mut().expect("flags") |= 0x80;
             reframe(&p)
         },
     );
@@ -810,7 +894,15 @@ fn invalid_vectors(s: &mut Specs) {
         "Base mesh of two tetrahedra sharing one vertex (two fans at a vertex).",
         &["handmade", "base-only", "manifold"],
         hand(&[base(
-            &[[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [9, 0, 0], [0, 9, 0], [0, 0, 9]],
+            &[
+                [0, 0, 0],
+                [1, 0, 0],
+                [0, 1, 0],
+                [0, 0, 1],
+                [9, 0, 0],
+                [0, 9, 0],
+                [0, 0, 9],
+            ],
             &[
                 [0, 2, 1],
                 [0, 1, 3],
@@ -840,7 +932,11 @@ fn invalid_vectors(s: &mut Specs) {
         "position-out-of-range",
         "Base vertex x = 256 with 8 bits per axis.",
         &["handmade", "base-only", "positions"],
-        hand(&[base(&[[0, 0, 0], [256, 0, 0], [0, 10, 0]], &[[0, 1, 2]], &[255; 3])]),
+        hand(&[base(
+            &[[0, 0, 0], [256, 0, 0], [0, 10, 0]],
+            &[[0, 1, 2]],
+            &[255; 3],
+        )]),
     );
     s.invalid(
         "position-out-of-range-split",
@@ -856,11 +952,29 @@ fn invalid_vectors(s: &mut Specs) {
             hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
         },
     );
-    let triangle = || base(&[[0, 0, 0], [10, 0, 0], [0, 10, 0]], &[[0, 1, 2]], &[255; 3]);
+    let triangle = || {
+        base(
+            &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
+            &[[0, 1, 2]],
+            &[255; 3],
+        )
+    };
     for (name, bytes, what) in [
-        ("varint-not-minimal", &[0x80u8, 0x00, 0x01, 0x02][..], "index 0 written as 0x80 0x00 (not minimal)"),
-        ("varint-too-long", &[0x80, 0x80, 0x80, 0x80, 0x80, 0x00, 0x01, 0x02][..], "a 6-byte varint"),
-        ("varint-over-32-bits", &[0xFF, 0xFF, 0xFF, 0xFF, 0x1F, 0x01, 0x02][..], "a 5-byte varint above 2^32 - 1"),
+        (
+            "varint-not-minimal",
+            &[0x80u8, 0x00, 0x01, 0x02][..],
+            "index 0 written as 0x80 0x00 (not minimal)",
+        ),
+        (
+            "varint-too-long",
+            &[0x80, 0x80, 0x80, 0x80, 0x80, 0x00, 0x01, 0x02][..],
+            "a 6-byte varint",
+        ),
+        (
+            "varint-over-32-bits",
+            &[0xFF, 0xFF, 0xFF, 0xFF, 0x1F, 0x01, 0x02][..],
+            "a 5-byte varint above 2^32 - 1",
+        ),
     ] {
         s.invalid(
             name,

@@ -50,7 +50,9 @@ pub fn unframe(stream: &[u8]) -> Unframed {
                 raw.copy_from_slice(stored);
             } else {
                 any_deflate = true;
-                inflater.inflate_exact(stored, &mut raw).expect("a valid chunk");
+                inflater
+                    .inflate_exact(stored, &mut raw)
+                    .expect("a valid chunk");
             }
             substreams[(e.substream - first_id) as usize].extend_from_slice(&raw);
             at += e.stored_len as usize;

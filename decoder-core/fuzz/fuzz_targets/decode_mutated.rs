@@ -10,7 +10,6 @@
 use std::sync::OnceLock;
 
 use libfuzzer_sys::fuzz_target;
-use splitstream_decoder_core::writer::write_stream;
 use splitstream_decoder_core_fuzz::streams::{self, Choices, Generated};
 
 static SEEDS: OnceLock<Vec<Generated>> = OnceLock::new();
@@ -22,7 +21,7 @@ fuzz_target!(|data: &[u8]| {
     };
     let seed = &seeds[pick as usize % seeds.len()];
     let (params, levels) = streams::mutate_levels(seed, &mut Choices::new(ops));
-    let stream = write_stream(&params, &levels);
+    let stream = streams::frame(&params, &levels, seed.seeded);
     let decoded = streams::decode_full(&stream);
     if ops.is_empty() {
         streams::check_against(seed, &decoded).unwrap();

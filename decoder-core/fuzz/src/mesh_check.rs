@@ -43,7 +43,12 @@ pub fn check_oriented_manifold(vertex_count: usize, triangles: &[[u32; 3]]) -> R
         let (start, is_path) = match starts.as_slice() {
             [] => (*l.keys().next().unwrap(), false),
             [s] => (*s, true),
-            _ => return Err(format!("vertex {v}: more than one fan ({} open)", starts.len())),
+            _ => {
+                return Err(format!(
+                    "vertex {v}: more than one fan ({} open)",
+                    starts.len()
+                ));
+            }
         };
         let mut steps = 0;
         let mut x = start;
@@ -58,7 +63,10 @@ pub fn check_oriented_manifold(vertex_count: usize, triangles: &[[u32; 3]]) -> R
             }
         }
         if steps != l.len() {
-            return Err(format!("vertex {v}: link has {} edges, one fan holds {steps}", l.len()));
+            return Err(format!(
+                "vertex {v}: link has {} edges, one fan holds {steps}",
+                l.len()
+            ));
         }
         if !is_path && l.len() < 3 {
             return Err(format!("vertex {v}: interior with valence {}", l.len()));

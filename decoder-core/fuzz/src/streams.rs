@@ -18,7 +18,8 @@
 
 use splitstream_decoder_core::limits::{LEAF, NONE};
 use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+    ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
+    write_stream_seeded,
 };
 use splitstream_decoder_core::{
     Decoder, Error, Inflater, Layout, MeshState, PositionMode, RecordSource, Ring, SplitRecord,
@@ -97,7 +98,11 @@ pub fn octahedron() -> BaseMesh {
                 let x = if sx > 0 { 0 } else { 1 };
                 let y = if sy > 0 { 2 } else { 3 };
                 let z = if sz > 0 { 4 } else { 5 };
-                triangles.push(if sx * sy * sz > 0 { [x, y, z] } else { [x, z, y] });
+                triangles.push(if sx * sy * sz > 0 {
+                    [x, y, z]
+                } else {
+                    [x, z, y]
+                });
             }
         }
     }
@@ -179,6 +184,9 @@ pub struct Generated {
     pub params: StreamParams,
     /// Levels before framing (base first), for structured mutation.
     pub levels: Vec<LevelPayload>,
+    /// Whether level 0 carries the rounds of `levels[1]` after its seed mesh
+    /// (SPEC §5.1, §6.3): framed by [`frame`].
+    pub seeded: bool,
     pub stream: Vec<u8>,
     /// State hash after the base and after every round that succeeded.
     pub hashes: Vec<u64>,
@@ -236,7 +244,9 @@ fn has_robust_pair(state: &MeshState<'_>, ring: &Ring, earlier: usize) -> bool {
     };
     let v = ring.vertices();
     let k = v.len();
-    (0..k).any(|o| robust(v[o]) && (o + 1..k).any(|j| robust(v[j]) && !(v[o] == NONE && v[j] == NONE)))
+    (0..k).any(|o| {
+        robust(v[o]) && (o + 1..k).any(|j| robust(v[j]) && !(v[o] == NONE && v[j] == NONE))
+    })
 }
 
 fn pick_deficit(b: u8, valence: usize) -> u8 {
@@ -332,7 +342,11 @@ impl RecordSource for GenSource<'_, '_> {
                     (p, q)
                 };
                 let (mut pp, mut qq) = place(&edge);
-                if pp.iter().chain(qq.iter()).any(|&v| !(0..limit).contains(&v)) {
+                if pp
+                    .iter()
+                    .chain(qq.iter())
+                    .any(|&v| !(0..limit).contains(&v))
+                {
                     edge = [0; 3];
                     (pp, qq) = place(&edge);
                 }
@@ -371,12 +385,18 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         PositionMode::Constrained
     };
     let bits = [8u8, 10, 16, 24][choices.below(4)];
-    let codec = match choices.byte() % 4 {
-        0 | 1 => ChunkCodec::Stored,
-        2 => ChunkCodec::Deflate(1),
-        _ => ChunkCodec::Deflate(6),
+    // Deflate is rare: miniz_oxide's compressor state is large and is set
+    // up per chunk, which would dominate the fuzzers' time.
+    let codec = match choices.byte() % 8 {
+        6 => ChunkCodec::Deflate(1),
+        7 => ChunkCodec::Deflate(6),
+        _ => ChunkCodec::Stored,
     };
-    let chunk_limit = [64u32, 1, 3, 7, 16, 255][choices.below(6)];
+    let mut chunk_limit = [64u32, 1, 3, 7, 16, 255][choices.below(6)];
+    if codec != ChunkCodec::Stored {
+        // Deflating thousands of one-byte chunks only slows the fuzzer down.
+        chunk_limit = chunk_limit.max(64);
+    }
     let params = StreamParams {
         position_mode,
         bits,
@@ -411,7 +431,9 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         }
         defs[..bv as usize].copy_from_slice(&deficits);
     }
-    state.finish_base(bv, bt).expect("seed base meshes are manifold");
+    state
+        .finish_base(bv, bt)
+        .expect("seed base meshes are manifold");
     let mut hashes = vec![state.state_hash()];
     let mut levels = vec![base_level(&base, &deficits)];
     let mut ring = Ring::default();
@@ -505,11 +527,14 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
             geometric_error: 0.0,
         });
     }
-    let stream = write_stream(&params, &levels);
+    // Level 0 may carry the first refinement level's rounds itself.
+    let seeded = levels.len() >= 2 && choices.byte() & 1 == 1;
+    let stream = frame(&params, &levels, seeded);
     Generated {
         base: base.name,
         params,
         levels,
+        seeded,
         stream,
         hashes,
         error,
@@ -517,6 +542,21 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         splits: state.vertex_count() - bv,
         triangles: state.triangles().to_vec(),
         positions: state.positions().to_vec(),
+    }
+}
+
+/// Frames `levels` (`levels[0]` the seed mesh, substreams 9..=11): with
+/// `seeded`, level 0 is the seed followed by the rounds of `levels[1]`.
+pub fn frame(params: &StreamParams, levels: &[LevelPayload], seeded: bool) -> Vec<u8> {
+    if seeded && levels.len() >= 2 {
+        let seed = SeedPayload {
+            vertices: levels[0].vertex_count,
+            triangles: levels[0].triangle_count,
+            substreams: levels[0].substreams.clone(),
+        };
+        write_stream_seeded(params, &seed, &levels[1..])
+    } else {
+        write_stream(params, levels)
     }
 }
 
@@ -617,6 +657,9 @@ pub fn check_against(g: &Generated, d: &Decoded) -> Result<(), String> {
 /// operations until exhausted (at most 32).
 pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec<LevelPayload>) {
     let mut params = g.params;
+    // Framing is redone per input: stored chunks keep it cheap (an op below
+    // can still select deflate).
+    params.codec = ChunkCodec::Stored;
     let mut subs: Vec<Vec<Vec<u8>>> = g
         .levels
         .iter()
@@ -710,6 +753,9 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                         0 => ChunkCodec::Stored,
                         1 => ChunkCodec::Deflate(1),
                         _ => ChunkCodec::Deflate(9),
+                    };
+                    if params.codec != ChunkCodec::Stored {
+                        params.chunk_limit = params.chunk_limit.max(16);
                     }
                 }
             },
@@ -731,22 +777,24 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
     let levels = subs
         .into_iter()
         .zip(meta)
-        .map(|(s, (round_splits, vertex_count, triangle_count))| LevelPayload {
-            round_splits,
-            substreams: s
-                .into_iter()
-                .map(|b| {
-                    let mut w = SubstreamWriter::default();
-                    for x in b {
-                        w.byte(x);
-                    }
-                    w
-                })
-                .collect(),
-            vertex_count,
-            triangle_count,
-            geometric_error: 0.0,
-        })
+        .map(
+            |(s, (round_splits, vertex_count, triangle_count))| LevelPayload {
+                round_splits,
+                substreams: s
+                    .into_iter()
+                    .map(|b| {
+                        let mut w = SubstreamWriter::default();
+                        for x in b {
+                            w.byte(x);
+                        }
+                        w
+                    })
+                    .collect(),
+                vertex_count,
+                triangle_count,
+                geometric_error: 0.0,
+            },
+        )
         .collect();
     (params, levels)
 }

@@ -219,3 +219,67 @@ impl Simplifier<'_> {
         removed
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::baseline::BaselineOptions;
+
+    /// A flat disc with `rim` border vertices and two centres, 0 and 1, that
+    /// share the top and bottom rim vertices: merging them gives an interior
+    /// vertex with exactly `rim` neighbours.
+    fn two_fans(rim: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let mut positions = vec![[-0.01, 0.0, 0.0], [0.01, 0.0, 0.0]];
+        for k in 0..rim {
+            let a = std::f64::consts::TAU * f64::from(k) / f64::from(rim);
+            positions.push([a.cos(), a.sin(), 0.0]);
+        }
+        let r = |k: u32| 2 + k % rim;
+        let (top, bottom) = (rim / 4, rim / 4 + rim / 2);
+        let mut triangles: Vec<[u32; 3]> = (top..bottom).map(|k| [0, r(k), r(k + 1)]).collect();
+        triangles.extend((bottom..top + rim).map(|k| [1, r(k), r(k + 1)]));
+        triangles.push([0, r(bottom), 1]);
+        triangles.push([1, r(top), 0]);
+        (positions, triangles)
+    }
+
+    fn try_merge(rim: u32) -> Result<(), Refusal> {
+        let (positions, triangles) = two_fans(rim);
+        let options = BaselineOptions::default();
+        let mut s = Simplifier::new(&positions, &triangles, &options);
+        s.plan(0, 1, [0.0; 3]).map(|_| ())
+    }
+
+    #[test]
+    fn valence_limit_is_enforced_exactly() {
+        assert_eq!(try_merge(MAX_VALENCE as u32), Ok(()));
+        assert_eq!(try_merge(MAX_VALENCE as u32 + 1), Err(Refusal::Illegal));
+    }
+
+    #[test]
+    fn flips_are_refused() {
+        let (positions, triangles) = two_fans(12);
+        let options = BaselineOptions::default();
+        let mut s = Simplifier::new(&positions, &triangles, &options);
+        assert!(s.plan(0, 1, [0.0; 3]).is_ok());
+        // Far outside the disc, the fans would fold over.
+        assert_eq!(s.plan(0, 1, [3.0, 0.0, 0.0]).err(), Some(Refusal::Illegal));
+        // Not an edge: two rim vertices far apart.
+        assert_eq!(s.plan(2, 8, [0.0; 3]).err(), Some(Refusal::NotAnEdge));
+    }
+
+    #[test]
+    fn chords_between_border_vertices_are_refused() {
+        // Square split by diagonal 0-2: both ends on the border.
+        let positions = vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ];
+        let triangles = vec![[0, 1, 2], [0, 2, 3]];
+        let options = BaselineOptions::default();
+        let mut s = Simplifier::new(&positions, &triangles, &options);
+        assert_eq!(s.plan(0, 2, [0.0; 3]).err(), Some(Refusal::Illegal));
+    }
+}

@@ -3,60 +3,53 @@
 
 use crate::simplify::Simplification;
 
-/// Levels in decoding order: for each refinement level, the simplification
-/// steps it reverses (latest step first), and each level's error estimate.
+/// Levels in decoding order: for each level, the simplification steps it
+/// reverses (latest step first), and each level's error estimate.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LevelPlan {
-    /// `rounds[l]` lists step indices for refinement level `l + 1`.
+    /// `rounds[l]` lists the step indices whose reversal forms level `l`;
+    /// level 0 starts from the seed mesh (what the simplification left).
     pub rounds: Vec<Vec<usize>>,
-    /// Geometric error after each level, base first (model units).
+    /// Geometric error after each level (metric units).
     pub errors: Vec<f32>,
 }
 
-/// Splits the steps into at most `levels - 1` refinement levels whose vertex
-/// counts are as close as possible to a geometric sequence from the base
-/// size to the full size. Errors are in the simplifier's metric units.
-pub fn plan_levels(s: &Simplification, levels: usize) -> LevelPlan {
+/// Picks `levels` level boundaries (as numbers of rounds undone): level 0
+/// ends closest to `base_vertices`, the others are as close as possible to
+/// a geometric sequence from there to the full mesh.
+pub fn plan_levels(s: &Simplification, levels: usize, base_vertices: usize) -> LevelPlan {
     let steps = s.steps.len();
-    // Vertex count after undoing the last i steps (i = 0: the base).
+    // Vertex count after undoing the last i steps (i = 0: the seed).
     let mut counts = vec![s.alive_count as f64];
     for k in (0..steps).rev() {
         counts.push(counts.last().copied().unwrap_or(0.0) + s.steps[k].len() as f64);
     }
-    let base = counts[0].max(1.0);
-    let full = counts[steps].max(1.0);
-    let wanted = (levels.max(1) - 1).min(steps);
-    // Boundaries b_1 < ... < b_wanted = steps (numbers of rounds undone).
-    let mut bounds = Vec::with_capacity(wanted);
-    let mut previous = 0usize;
-    for i in 1..=wanted {
-        let remaining = wanted - i;
-        let target = base * (full / base).powf(i as f64 / wanted as f64);
-        let lo = previous + 1;
-        let hi = steps - remaining;
-        let best = (lo..=hi)
-            .min_by(|&a, &b| {
-                let da = (counts[a].ln() - target.ln()).abs();
-                let db = (counts[b].ln() - target.ln()).abs();
-                da.total_cmp(&db)
-            })
-            .unwrap_or(hi);
-        bounds.push(if i == wanted { steps } else { best });
-        previous = *bounds.last().unwrap_or(&0);
+    let log_distance = |i: usize, target: f64| (counts[i].max(1.0).ln() - target.max(1.0).ln()).abs();
+    let closest = |lo: usize, hi: usize, target: f64| {
+        (lo..=hi)
+            .min_by(|&a, &b| log_distance(a, target).total_cmp(&log_distance(b, target)))
+            .unwrap_or(hi)
+    };
+    let refinement = (levels.max(1) - 1).min(steps);
+    let base_end = closest(0, steps - refinement, base_vertices as f64);
+    let mut bounds = vec![base_end];
+    let (base, full) = (counts[base_end].max(1.0), counts[steps].max(1.0));
+    for i in 1..=refinement {
+        let previous = bounds[bounds.len() - 1];
+        let target = base * (full / base).powf(i as f64 / refinement as f64);
+        let hi = steps - (refinement - i);
+        bounds.push(if i == refinement { steps } else { closest(previous + 1, hi, target) });
     }
-    // Error estimate still present after undoing i rounds: the largest
-    // distance of a collapse not undone yet (steps 0 .. steps - i).
+    // Error still present after undoing i rounds: the largest distance of a
+    // collapse not undone yet (steps 0 .. steps - i).
     let mut prefix_max = vec![0.0f64; steps + 1];
     for k in 0..steps {
-        let step_max = s.steps[k]
-            .iter()
-            .map(|c| c.distance)
-            .fold(0.0f64, f64::max);
+        let step_max = s.steps[k].iter().map(|c| c.distance).fold(0.0f64, f64::max);
         prefix_max[k + 1] = prefix_max[k].max(step_max);
     }
     let error_after = |undone: usize| prefix_max[steps - undone] as f32;
     let mut rounds = Vec::with_capacity(bounds.len());
-    let mut errors = vec![error_after(0)];
+    let mut errors = Vec::with_capacity(bounds.len());
     let mut start = 0;
     for &b in &bounds {
         rounds.push((start..b).map(|i| steps - 1 - i).collect());

@@ -6,13 +6,17 @@ mod levels;
 mod replay;
 
 use splitstream_decoder_core::PositionMode;
-use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, write_stream};
+use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, write_stream_seeded};
 
 use crate::mesh::Mesh;
 use crate::quantize::{QuantizedMesh, Units, quantize};
 use crate::simplify::{SimplifyOptions, simplify};
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
+
+/// Vertices the simplification aims for below the base mesh: a seed just
+/// large enough that closed shapes keep a valid manifold.
+pub const SEED_VERTICES: usize = 16;
 
 /// Everything `splitstream encode` can set.
 #[derive(Clone, Debug)]
@@ -109,12 +113,12 @@ pub fn encode_quantized(
 ) -> Result<Encoded, EncodeError> {
     let n = mesh.positions.len();
     let shift = (options.levels - 1).min(40) as u32;
-    let target = options
-        .base_vertices
-        .unwrap_or(n >> shift)
-        .clamp(4.min(n), n);
+    let base = options.base_vertices.unwrap_or(n >> shift).clamp(4.min(n), n);
+    // Simplify on to a small seed: level 0 codes the rounds from the seed
+    // up to the base mesh, far more compactly than a plain base mesh.
+    let seed_target = SEED_VERTICES.min(base);
     let simplify_options = SimplifyOptions {
-        target_vertices: target,
+        target_vertices: seed_target,
         max_error: options.max_error,
         constrained: options.position_mode == PositionMode::Constrained,
         lock_boundary: options.lock_boundary,
@@ -125,7 +129,7 @@ pub fn encode_quantized(
     let simplification = simplify(mesh, &simplify_options, progress);
     let simplify_seconds = started.elapsed().as_secs_f64();
     let started = std::time::Instant::now();
-    let plan = plan_levels(&simplification, options.levels);
+    let plan = plan_levels(&simplification, options.levels, base);
     let replayed = replay(mesh, &simplification, &plan, options.position_mode)
         .map_err(EncodeError::Replay)?;
     let params = StreamParams {
@@ -138,7 +142,7 @@ pub fn encode_quantized(
     };
     let level_vertex_counts = replayed.levels.iter().map(|l: &LevelPayload| l.vertex_count).collect();
     let rounds = replayed.levels.iter().map(|l| l.round_splits.len()).sum();
-    let stream = write_stream(&params, &replayed.levels);
+    let stream = write_stream_seeded(&params, &replayed.seed, &replayed.levels);
     Ok(Encoded {
         stream,
         permutation: replayed.permutation,

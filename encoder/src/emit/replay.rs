@@ -2,7 +2,7 @@
 //! flag and split record as the decoder will read it (SPEC §7).
 
 use splitstream_decoder_core::limits::{LEAF, NONE, substream};
-use splitstream_decoder_core::writer::{LevelPayload, SubstreamWriter};
+use splitstream_decoder_core::writer::{LevelPayload, SeedPayload, SubstreamWriter};
 use splitstream_decoder_core::{
     Error, MeshState, PositionMode, RecordSource, Ring, SplitOutcome, SplitRecord, StateMemory,
 };
@@ -27,6 +27,9 @@ impl std::error::Error for ReplayError {}
 
 /// Output of the replay: framed-ready levels and the vertex permutation.
 pub struct Replayed {
+    /// The seed mesh level 0 starts from.
+    pub seed: SeedPayload,
+    /// Level 0's rounds, then the refinement levels.
     pub levels: Vec<LevelPayload>,
     /// Input vertex id of each decoded vertex.
     pub permutation: Vec<u32>,
@@ -251,13 +254,12 @@ pub fn replay(
     state
         .finish_base(v0 as u32, t0 as u32)
         .map_err(|e| ReplayError(format!("base mesh rejected by the decoder: {e}")))?;
-    let mut levels = vec![LevelPayload {
-        round_splits: vec![],
+    let seed = SeedPayload {
+        vertices: v0 as u32,
+        triangles: t0 as u32,
         substreams: base_subs,
-        vertex_count: v0 as u32,
-        triangle_count: t0 as u32,
-        geometric_error: plan.errors[0],
-    }];
+    };
+    let mut levels = Vec::with_capacity(plan.rounds.len());
     let mut current = vec![NONE; n];
     let mut ring = Ring::default();
     for (l, steps) in plan.rounds.iter().enumerate() {
@@ -293,12 +295,13 @@ pub fn replay(
             substreams: subs,
             vertex_count: state.vertex_count(),
             triangle_count: state.triangle_count(),
-            geometric_error: plan.errors[l + 1],
+            geometric_error: plan.errors[l],
         });
     }
     check_exact(mesh, &state, &dec2enc)?;
     let final_hash = state.state_hash();
     Ok(Replayed {
+        seed,
         levels,
         permutation: dec2enc,
         final_hash,

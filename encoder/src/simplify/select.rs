@@ -106,6 +106,18 @@ fn cell_of(p: [f64; 3], cell: f64) -> [i64; 3] {
 
 /// The best valid collapse of `v` (§2 step a), from the cached edge slots.
 pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) -> Best {
+    best_edge_avoiding(s, v, scale, scratch, &[])
+}
+
+/// [`best_edge`] among the neighbours `u` with `blocked[u] == false`
+/// (`blocked` empty: all of them).
+pub fn best_edge_avoiding(
+    s: &State,
+    v: u32,
+    scale: Scale,
+    scratch: &mut CheckScratch,
+    blocked: &[bool],
+) -> Best {
     if !s.alive[v as usize] {
         return Best::NONE;
     }
@@ -117,7 +129,9 @@ pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) ->
     for &c in &fan.corners {
         // Edge (v, next c) faces prev c; edge (v, prev c) faces next c.
         for (u, facing) in [(s.table.v(next(c)), prev(c)), (s.table.v(prev(c)), next(c))] {
-            if candidates.iter().any(|x: &Candidate| x.other == u) {
+            if candidates.iter().any(|x: &Candidate| x.other == u)
+                || blocked.get(u as usize).copied().unwrap_or(false)
+            {
                 continue;
             }
             let slot = s.edges[facing as usize];

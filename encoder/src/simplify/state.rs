@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use super::check::{CheckScratch, check_collapse};
-use super::select::{Best, EdgeSlot, Scale, best_edge, edge_slot, pair_key};
+use super::select::{Best, EdgeSlot, Scale, best_edge, best_edge_avoiding, edge_slot, pair_key};
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
@@ -155,6 +155,8 @@ pub fn simplify(
     let mut steps = Vec::new();
     let mut step_errors = Vec::new();
     let mut threshold = 0.0f64;
+    let mut best = vec![Best::NONE; n];
+    let mut dirty = vec![true; n];
     let limit = options.max_error.unwrap_or(f64::INFINITY);
     while alive_count > options.target_vertices {
         let edge = mean_edge_length(&s);
@@ -162,9 +164,18 @@ pub fn simplify(
             cell: options.subgrid_cells * edge,
             flat: 1e-6 * edge * edge,
         };
-        let best: Vec<Best> = (0..n as u32)
+        // Only vertices whose 2-ring changed can have a new best edge.
+        best = (0..n as u32)
             .into_par_iter()
-            .map_init(CheckScratch::default, |scratch, v| best_edge(&s, v, scale, scratch))
+            .map_init(CheckScratch::default, |scratch, v| {
+                if !s.alive[v as usize] {
+                    Best::NONE
+                } else if dirty[v as usize] {
+                    best_edge(&s, v, scale, scratch)
+                } else {
+                    best[v as usize]
+                }
+            })
             .collect();
         // Raise S to the admitted quantile of the current candidate errors.
         let mut errors: Vec<f64> = best.iter().filter(|b| b.other != NONE).map(|b| b.error).collect();
@@ -174,7 +185,7 @@ pub fn simplify(
         let q = ((errors.len() - 1) as f64 * options.admit_quantile.clamp(0.0, 1.0)) as usize;
         let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
         threshold = threshold.max(*quantile).min(limit);
-        let mut winners = step_winners(&s, &best, threshold);
+        let mut winners = step_winners(&s, &mut best, threshold, scale);
         if winners.is_empty() {
             // Nothing under S: raise it to the smallest candidate error (the
             // paper's "S is increased"), unless that passes the maximum.
@@ -183,7 +194,7 @@ pub fn simplify(
                 break;
             }
             threshold = threshold.max(smallest).min(limit);
-            winners = step_winners(&s, &best, threshold);
+            winners = step_winners(&s, &mut best, threshold, scale);
             if winners.is_empty() {
                 break;
             }
@@ -204,7 +215,16 @@ pub fn simplify(
             step_error = step_error.max(b.error);
             collapses.push(collapse);
         }
+        if std::env::var_os("SPLITSTREAM_DEBUG").is_some() {
+            eprintln!(
+                "step {}: alive {alive_count}, candidates {}, threshold {threshold:.3e}, collapses {}",
+                steps.len(),
+                errors.len(),
+                winners.len()
+            );
+        }
         refresh_edges(&mut s, &winners);
+        mark_two_rings(&s, &winners, &mut dirty);
         alive_count -= collapses.len();
         steps.push(collapses);
         step_errors.push(step_error);
@@ -223,33 +243,83 @@ pub fn simplify(
 
 /// Steps b and c: reciprocal pairs under the threshold that are local minima
 /// among the requests of their 1-rings. Returns the survivors (lower ids).
-fn step_winners(s: &State, best: &[Best], threshold: f64) -> Vec<u32> {
+///
+/// Steps a to c are then repeated on what they left undecided: a vertex
+/// whose partner was taken by a cheaper collapse chooses again among its free
+/// neighbours, and a pair blocked only by a pair that itself lost gets its
+/// turn. The passes grow the step towards a maximal set of independent
+/// collapses in error order, still in parallel; more collapses per step mean
+/// fewer rounds and fewer flags in the stream. Vertices changed here are all
+/// within the 2-ring of a collapse, so they are recomputed next step.
+fn step_winners(s: &State, best: &mut [Best], threshold: f64, scale: Scale) -> Vec<u32> {
+    const PASSES: usize = 4;
     let n = best.len();
-    let admitted = |v: usize| {
-        let b = &best[v];
-        b.other != NONE && b.error <= threshold && best[b.other as usize].other == v as u32
-    };
-    // Key of the reciprocal request each vertex takes part in (u64::MAX: none).
-    let keys: Vec<u64> = (0..n)
-        .into_par_iter()
-        .map(|v| {
-            if admitted(v) {
-                pair_key(&best[v], v as u32)
-            } else {
-                u64::MAX
+    let mut blocked = vec![false; n];
+    let mut winners = Vec::new();
+    for pass in 0..PASSES {
+        if pass > 0 {
+            let updates: Vec<(u32, Best)> = (0..n as u32)
+                .into_par_iter()
+                .filter(|&v| {
+                    let b = &best[v as usize];
+                    s.alive[v as usize]
+                        && !blocked[v as usize]
+                        && b.other != NONE
+                        && blocked[b.other as usize]
+                })
+                .map_init(CheckScratch::default, |scratch, v| {
+                    (v, best_edge_avoiding(s, v, scale, scratch, &blocked))
+                })
+                .collect();
+            for (v, b) in updates {
+                best[v as usize] = b;
             }
-        })
-        .collect();
-    (0..n as u32)
-        .into_par_iter()
-        .filter(|&v| {
-            let b = &best[v as usize];
-            admitted(v as usize) && v < b.other && {
+        }
+        let best_now: &[Best] = best;
+        let admitted = |v: usize| {
+            let b = &best_now[v];
+            !blocked[v]
+                && b.other != NONE
+                && b.error <= threshold
+                && best_now[b.other as usize].other == v as u32
+        };
+        let keys: Vec<u64> = (0..n)
+            .into_par_iter()
+            .map(|v| if admitted(v) { pair_key(&best_now[v], v as u32) } else { u64::MAX })
+            .collect();
+        let chosen: Vec<u32> = (0..n as u32)
+            .into_par_iter()
+            .filter(|&v| {
                 let key = keys[v as usize];
-                is_local_minimum(s, v, b.other, key, &keys)
-            }
-        })
-        .collect()
+                let c = best_now[v as usize].other;
+                key != u64::MAX && v < c && is_local_minimum(s, v, c, key, &keys)
+            })
+            .collect();
+        if chosen.is_empty() {
+            break;
+        }
+        // The chosen pairs' endpoints and neighbours leave the game.
+        let touched: Vec<u32> = chosen
+            .par_iter()
+            .flat_map_iter(|&v| {
+                let mut fan = Fan::default();
+                let mut out = Vec::new();
+                for x in [v, best_now[v as usize].other] {
+                    out.push(x);
+                    s.table.fan(x, &mut fan);
+                    out.extend(fan.corners.iter().map(|&k| s.table.v(next(k))));
+                    out.extend(fan.corners.iter().map(|&k| s.table.v(prev(k))));
+                }
+                out
+            })
+            .collect();
+        for x in touched {
+            blocked[x as usize] = true;
+        }
+        winners.extend_from_slice(&chosen);
+    }
+    winners.sort_unstable();
+    winners
 }
 
 fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64]) -> bool {
@@ -319,6 +389,34 @@ fn refresh_edges(s: &mut State, merged: &[u32]) {
         .collect();
     for (c, slot) in updates {
         s.edges[c as usize] = slot;
+    }
+}
+
+/// Marks the vertices within two edges of each merged vertex: the only
+/// ones whose best collapse can have changed (errors, links, fold-overs and
+/// wing valences all live in the 2-ring).
+fn mark_two_rings(s: &State, merged: &[u32], dirty: &mut [bool]) {
+    dirty.fill(false);
+    let touched: Vec<u32> = merged
+        .par_iter()
+        .flat_map_iter(|&r| {
+            let mut fan = Fan::default();
+            let mut inner = Fan::default();
+            let mut out = vec![r];
+            s.table.fan(r, &mut fan);
+            for &c in &fan.corners {
+                for x in [s.table.v(next(c)), s.table.v(prev(c))] {
+                    out.push(x);
+                    s.table.fan(x, &mut inner);
+                    out.extend(inner.corners.iter().map(|&k| s.table.v(next(k))));
+                    out.extend(inner.corners.iter().map(|&k| s.table.v(prev(k))));
+                }
+            }
+            out
+        })
+        .collect();
+    for v in touched {
+        dirty[v as usize] = true;
     }
 }
 
