@@ -35,6 +35,7 @@ mod level_table;
 pub mod limits;
 #[cfg(feature = "alloc")]
 pub mod owned;
+mod predict;
 pub mod record;
 mod ring;
 mod round;
@@ -53,6 +54,7 @@ pub use inflate::Inflater;
 pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader};
 pub use level_table::{LevelInfo, LevelTable, head_len, write_level_table};
+pub use predict::predict_split;
 pub use ring::Ring;
 pub use round::{RecordSource, RoundStats};
 pub use split::{SplitOutcome, SplitRecord};

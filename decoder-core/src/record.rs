@@ -3,6 +3,7 @@
 use crate::Error;
 use crate::header::PositionMode;
 use crate::limits::substream::{self, SLOTS};
+use crate::predict::predict_split;
 use crate::ring::Ring;
 use crate::round::RecordSource;
 use crate::split::SplitRecord;
@@ -35,55 +36,57 @@ impl RecordSource for StreamSource<'_, '_, '_> {
         self.subs.bit(slot(substream::FLAGS))
     }
 
-    fn record(
-        &mut self,
-        state: &MeshState<'_>,
-        r: u32,
-        _ring: &Ring,
-    ) -> Result<SplitRecord, Error> {
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let s = &mut *self.subs;
         let wing_offset = s.byte(slot(substream::WING_OFFSET))?;
         let wing_distance = s.byte(slot(substream::WING_DISTANCE))?;
         let config = s.bit(slot(substream::CONFIG))?;
+        let (o, d) = (wing_offset as usize, wing_distance as usize);
+        if d == 0 || o + d >= ring.len() {
+            return Err(Error::RingOffsetOutOfRange);
+        }
         let deficit_p = s.byte(slot(substream::DEFICIT_P))?;
         let deficit_c = s.byte(slot(substream::DEFICIT_C))?;
-        let mut edge = [0i64; 3];
-        for e in &mut edge {
-            *e = s.signed(slot(substream::EDGE))? as i64;
-        }
         let parent = state.positions()[r as usize];
-        let mut p = [0i64; 3];
-        match self.mode {
+        let (p_hat, c_hat) = predict_split(state.positions(), parent, ring, o, d, config);
+        let mut first = [0i64; 3];
+        for x in &mut first {
+            *x = s.signed(slot(substream::EDGE))? as i64;
+        }
+        let (p, c) = match self.mode {
             PositionMode::Optimal => {
+                let mut c = [0i64; 3];
                 for k in 0..3 {
-                    let m = s.signed(slot(substream::PLACEMENT))? as i64;
-                    p[k] = parent[k] as i64 - m - (edge[k] >> 1);
+                    c[k] = c_hat[k] + s.signed(slot(substream::PLACEMENT))? as i64;
                 }
+                (core::array::from_fn(|k| p_hat[k] + first[k]), c)
             }
             PositionMode::Constrained => {
-                let code = s.byte(slot(substream::PLACEMENT))?;
-                for k in 0..3 {
-                    p[k] = parent[k] as i64
-                        - match code {
-                            0 => 0,
-                            1 => edge[k],
-                            2 => edge[k] >> 1,
-                            _ => return Err(Error::InvalidPlacement),
-                        };
+                let parent = parent.map(|x| x as i64);
+                match s.byte(slot(substream::PLACEMENT))? {
+                    // R sits on P: C is coded.
+                    0 => (parent, core::array::from_fn(|k| c_hat[k] + first[k])),
+                    // R sits on C: P is coded.
+                    1 => (core::array::from_fn(|k| p_hat[k] + first[k]), parent),
+                    // R is the midpoint P + (e >> 1): the edge e is coded.
+                    2 => {
+                        let e: [i64; 3] = core::array::from_fn(|k| c_hat[k] - p_hat[k] + first[k]);
+                        let p: [i64; 3] = core::array::from_fn(|k| parent[k] - (e[k] >> 1));
+                        (p, core::array::from_fn(|k| p[k] + e[k]))
+                    }
+                    _ => return Err(Error::InvalidPlacement),
                 }
             }
-        }
+        };
         let bits = state.bits();
-        let position_p = to_grid(p, bits)?;
-        let position_c = to_grid([p[0] + edge[0], p[1] + edge[1], p[2] + edge[2]], bits)?;
         Ok(SplitRecord {
             wing_offset,
             wing_distance,
             config,
             deficit_p,
             deficit_c,
-            position_p,
-            position_c,
+            position_p: to_grid(p, bits)?,
+            position_c: to_grid(c, bits)?,
         })
     }
 }

@@ -91,15 +91,16 @@ fn tetrahedron() -> LevelPayload {
 
 /// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge (0,1,3).
 fn tetra_split() -> Rec {
-    // P = (0,0,0), C = (2,2,2): e = 2, m = R - P - (e >> 1) = -1.
+    // Predictions (SPEC §7.4): P̂ = mean(R, 1, 3) = (3, 0, 3),
+    // Ĉ = mean(R, 3, 2, 1) = (2, 2, 2). P = (0, 0, 0), C = (2, 2, 2).
     Rec {
         o: 0,
         d: 1,
         q: false,
         dp: LEAF,
         dc: LEAF,
-        e: [2; 3],
-        m: [-1; 3],
+        e: [-3, 0, -3],
+        m: [0; 3],
     }
 }
 
@@ -162,8 +163,10 @@ fn boundary_split_with_a_ghost_wing() {
         q: false,
         dp: LEAF,
         dc: LEAF,
-        e: [0, 4, 0],
-        m: [0, -2, 0],
+        // P̂ = mean(R, 1) = (5, 0, 0); Ĉ = mean(R, 1, 2) = (3, 3, 0):
+        // P = (0, 0, 0), C = (0, 4, 0).
+        e: [-5, 0, 0],
+        m: [-3, 1, 0],
     };
     let stream = write_stream(
         &params(ChunkCodec::Stored),
@@ -172,6 +175,7 @@ fn boundary_split_with_a_ghost_wing() {
     let mesh = decode_all(&stream, false).unwrap();
     assert_eq!(mesh.triangles, vec![[3, 1, 2], [3, 0, 1]]);
     assert_eq!(mesh.positions[3], [0, 4, 0]);
+    assert_eq!(mesh.positions[0], [0, 0, 0]);
     assert_oriented_manifold(&mesh.triangles);
 }
 

@@ -52,9 +52,11 @@ fn tetra_stream() -> Vec<u8> {
     s[3].bit(false); // q
     s[4].byte(LEAF); // deficit P
     s[5].byte(LEAF); // deficit C
+    for x in [-3, 0, -3] {
+        s[6].signed(x); // residual of P against P̂ = (3, 0, 3)
+    }
     for _ in 0..3 {
-        s[6].signed(2); // e
-        s[7].signed(-1); // m
+        s[7].signed(0); // residual of C against Ĉ = (2, 2, 2)
     }
     let l1 = LevelPayload {
         round_splits: vec![1],

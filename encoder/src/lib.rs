@@ -1,9 +1,9 @@
 //! The splitstream encoder.
 
 pub mod baseline;
-pub mod input;
 pub mod corner_table;
 pub mod emit;
+pub mod input;
 pub mod mesh;
 pub mod metrics;
 pub mod quadric;

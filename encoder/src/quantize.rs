@@ -71,7 +71,9 @@ pub fn quantize(mesh: &Mesh, bits: u8, units: Units) -> QuantizedMesh {
     let positions = mesh
         .positions
         .iter()
-        .map(|p| std::array::from_fn(|k| ((p[k] - lo[k]) / scale[k]).round().clamp(0.0, top) as u32))
+        .map(|p| {
+            std::array::from_fn(|k| ((p[k] - lo[k]) / scale[k]).round().clamp(0.0, top) as u32)
+        })
         .collect();
     let metres = units.metres_per_unit(lo, hi);
     QuantizedMesh {

@@ -8,15 +8,40 @@ use splitstream_encoder::Mesh;
 pub fn icosphere(subdivisions: usize) -> Mesh {
     let t = (1.0 + 5f64.sqrt()) / 2.0;
     let mut positions: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0], [1.0, t, 0.0], [-1.0, -t, 0.0], [1.0, -t, 0.0],
-        [0.0, -1.0, t], [0.0, 1.0, t], [0.0, -1.0, -t], [0.0, 1.0, -t],
-        [t, 0.0, -1.0], [t, 0.0, 1.0], [-t, 0.0, -1.0], [-t, 0.0, 1.0],
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
     ];
     let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11],
-        [1, 5, 9], [5, 11, 4], [11, 10, 2], [10, 7, 6], [7, 1, 8],
-        [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9],
-        [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
     ];
     for _ in 0..subdivisions {
         let mut midpoints = std::collections::HashMap::new();
@@ -40,7 +65,10 @@ pub fn icosphere(subdivisions: usize) -> Mesh {
         let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
         *p = p.map(|x| x / l);
     }
-    Mesh { positions, triangles }
+    Mesh {
+        positions,
+        triangles,
+    }
 }
 
 /// A `w` x `h` height-field grid with a bumpy surface and a boundary.
@@ -49,7 +77,9 @@ pub fn bumpy_grid(w: usize, h: usize, seed: u64) -> Mesh {
     for y in 0..h {
         for x in 0..w {
             let (fx, fy) = (x as f64, y as f64);
-            let z = (fx * 0.7 + seed as f64).sin() * 2.0 + (fy * 0.45).cos() * 3.0 + ((fx * fy) * 0.05).sin();
+            let z = (fx * 0.7 + seed as f64).sin() * 2.0
+                + (fy * 0.45).cos() * 3.0
+                + ((fx * fy) * 0.05).sin();
             positions.push([fx * 10.0, fy * 10.0, z]);
         }
     }
@@ -62,5 +92,8 @@ pub fn bumpy_grid(w: usize, h: usize, seed: u64) -> Mesh {
             triangles.push([i, ru, u]);
         }
     }
-    Mesh { positions, triangles }
+    Mesh {
+        positions,
+        triangles,
+    }
 }

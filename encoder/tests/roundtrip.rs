@@ -3,11 +3,11 @@
 
 mod common;
 
-use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::PositionMode;
+use splitstream_decoder_core::owned::decode_all;
+use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::quantize::quantize;
-use splitstream_encoder::Mesh;
 
 fn canonical(t: [u32; 3]) -> [u32; 3] {
     let r = (0..3).min_by_key(|&i| t[i]).unwrap();

@@ -23,7 +23,7 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Decoder, Error, Inflater, Layout, MeshState, PositionMode, RecordSource, Ring, SplitRecord,
-    workspace_len,
+    predict_split, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -301,59 +301,64 @@ impl RecordSource for GenSource<'_, '_> {
             deficit_c = c.byte();
         }
         let limit = 1i64 << self.bits;
+        let in_grid = |v: &[i64; 3]| v.iter().all(|&x| (0..limit).contains(&x));
         let clamp = |v: i64| v.clamp(0, limit - 1);
         let parent = state.positions()[r as usize];
-        let parent = [parent[0] as i64, parent[1] as i64, parent[2] as i64];
+        let parent64 = parent.map(|x| x as i64);
+        // Positions are coded as residuals from the SPEC §7.4 prediction,
+        // which needs a valid ring partition; an invalid (o, d) is rejected
+        // before any position is read, so anything may follow it.
+        let (p_hat, c_hat) = if d >= 1 && o + d < k {
+            predict_split(state.positions(), parent, ring, o, d, config)
+        } else {
+            (parent64, parent64)
+        };
         let mut p = [0i64; 3];
         let mut q = [0i64; 3];
-        let mut edge = [0i64; 3];
         match self.mode {
             PositionMode::Optimal => {
                 for k in 0..3 {
-                    p[k] = clamp(parent[k] + small(c.byte()));
+                    p[k] = clamp(parent64[k] + small(c.byte()));
                     q[k] = clamp(p[k] + small(c.byte()));
-                    edge[k] = q[k] - p[k];
-                }
-                for e in edge {
-                    self.subs[6].signed(e as i32);
                 }
                 for k in 0..3 {
-                    let m = parent[k] - p[k] - (edge[k] >> 1);
-                    self.subs[7].signed(m as i32);
+                    self.subs[6].signed((p[k] - p_hat[k]) as i32);
+                }
+                for k in 0..3 {
+                    self.subs[7].signed((q[k] - c_hat[k]) as i32);
                 }
             }
             PositionMode::Constrained => {
                 let code = c.byte() % 3;
+                let mut edge = [0i64; 3];
                 for e in &mut edge {
                     *e = small(c.byte());
                 }
-                let place = |edge: &[i64; 3]| {
-                    let mut p = [0i64; 3];
-                    let mut q = [0i64; 3];
-                    for k in 0..3 {
-                        p[k] = parent[k]
-                            - match code {
-                                0 => 0,
-                                1 => edge[k],
-                                _ => edge[k] >> 1,
-                            };
-                        q[k] = p[k] + edge[k];
+                let place = |e: &[i64; 3]| -> ([i64; 3], [i64; 3]) {
+                    match code {
+                        // R sits on P.
+                        0 => (parent64, core::array::from_fn(|k| parent64[k] + e[k])),
+                        // R sits on C.
+                        1 => (core::array::from_fn(|k| parent64[k] - e[k]), parent64),
+                        // R is the midpoint P + (e >> 1).
+                        _ => {
+                            let p: [i64; 3] = core::array::from_fn(|k| parent64[k] - (e[k] >> 1));
+                            (p, core::array::from_fn(|k| p[k] + e[k]))
+                        }
                     }
-                    (p, q)
                 };
-                let (mut pp, mut qq) = place(&edge);
-                if pp
-                    .iter()
-                    .chain(qq.iter())
-                    .any(|&v| !(0..limit).contains(&v))
-                {
+                (p, q) = place(&edge);
+                if !in_grid(&p) || !in_grid(&q) {
                     edge = [0; 3];
-                    (pp, qq) = place(&edge);
+                    (p, q) = place(&edge);
                 }
-                p = pp;
-                q = qq;
-                for e in edge {
-                    self.subs[6].signed(e as i32);
+                for k in 0..3 {
+                    let residual = match code {
+                        0 => q[k] - c_hat[k],
+                        1 => p[k] - p_hat[k],
+                        _ => (q[k] - p[k]) - (c_hat[k] - p_hat[k]),
+                    };
+                    self.subs[6].signed(residual as i32);
                 }
                 self.subs[7].byte(code);
             }

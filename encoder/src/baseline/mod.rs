@@ -7,8 +7,15 @@
 //! [`collapse_target`](crate::quadric::collapse_target), and compare vertex
 //! counts, errors and time (Cellier et al. 2012 report the parallel version
 //! keeps 10–15 % more points for about a tenth of the time). It always takes
-//! the globally cheapest collapse from a binary heap, which is what makes it
-//! sequential. It is not used by the encoder itself.
+//! the globally cheapest legal collapse from one priority queue, which is
+//! what makes it sequential. It is not used by the encoder itself.
+//!
+//! Connectivity is a flat corner table edited in place; the queue holds one
+//! lazily deleted entry per scored edge. A collapse is refused if it would
+//! break the link condition, pinch two border vertices together, fold a
+//! closed component below a tetrahedron, flip or flatten a surviving
+//! triangle, or give a vertex more than [`MAX_VALENCE`] neighbours. A refused
+//! edge is scored again once a neighbouring collapse may have made it legal.
 
 mod collapse;
 mod corner_table;

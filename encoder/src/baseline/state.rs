@@ -34,6 +34,16 @@ impl<'o> Simplifier<'o> {
         options: &'o BaselineOptions,
     ) -> Self {
         let n = positions.len();
+        // The input checker rejects out-of-range indices; skip them here
+        // rather than panic, as `vertex_quadrics` does.
+        let valid = |t: &[u32; 3]| t.iter().all(|&v| (v as usize) < n);
+        let owned: Vec<[u32; 3]>;
+        let triangles = if triangles.iter().all(valid) {
+            triangles
+        } else {
+            owned = triangles.iter().copied().filter(valid).collect();
+            &owned
+        };
         let table = CornerTable::new(n, triangles);
         let mut on_boundary = vec![false; n];
         for (c, &o) in table.opposite.iter().enumerate() {

@@ -314,6 +314,10 @@ fn empty_and_tiny_inputs() {
     let r = simplify_sequential(&tri, &options(0));
     assert_eq!(r.mesh.triangle_count(), 1, "a lone triangle cannot shrink");
     assert_eq!(r.mesh.vertex_count(), 3, "unused vertex dropped");
+    let mut bad = tri.clone();
+    bad.triangles.push([0, 2, 99]);
+    let r = simplify_sequential(&bad, &options(0));
+    assert_eq!(r.mesh.triangle_count(), 1, "out-of-range triangle skipped");
 }
 
 /// A rough synthetic terrain: a few octaves of sines plus hashed jitter.

@@ -21,7 +21,11 @@ pub fn run(input: &Path, output: &Path, level: Option<u16>) -> CliResult {
         let bytes = decoder.level_bytes(k, &stream).map_err(fail)?;
         decoder.decode_level(k, bytes).map_err(fail)?;
     }
-    let positions: Vec<[f64; 3]> = decoder.positions().iter().map(|&q| decoder.dequantize(q)).collect();
+    let positions: Vec<[f64; 3]> = decoder
+        .positions()
+        .iter()
+        .map(|&q| decoder.dequantize(q))
+        .collect();
     write_mesh(output, &positions, decoder.triangles())?;
     println!(
         "{}: level {stop}, {} vertices, {} triangles, state hash {:016x}",

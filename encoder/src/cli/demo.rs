@@ -57,6 +57,9 @@ pub fn run(side: usize) -> CliResult {
             ms
         );
     }
-    println!("final state hash {:016x}: decoded exactly (checked against the input during encoding)", decoder.state_hash());
+    println!(
+        "final state hash {:016x}: decoded exactly (checked against the input during encoding)",
+        decoder.state_hash()
+    );
     Ok(())
 }

@@ -6,10 +6,10 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::Units;
-use splitstream_encoder::Mesh;
 
 use super::{CliResult, Codec, Position};
 
@@ -75,7 +75,11 @@ pub fn run(a: Args) -> CliResult {
         chunk_limit: a.chunk_size,
         lock_boundary: a.lock_boundary,
         admit_quantile: a.admit,
-        units: if a.geographic { Units::Geographic } else { Units::Linear },
+        units: if a.geographic {
+            Units::Geographic
+        } else {
+            Units::Linear
+        },
     };
     if !a.geographic && looks_geographic(&mesh) {
         eprintln!(
@@ -89,12 +93,17 @@ pub fn run(a: Args) -> CliResult {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_message("simplifying");
-    let encoded = encode(&mesh, &options, |done| bar.set_position(done as u64))
-        .map_err(|e| e.to_string())?;
+    let encoded =
+        encode(&mesh, &options, |done| bar.set_position(done as u64)).map_err(|e| e.to_string())?;
     bar.finish_and_clear();
-    std::fs::write(&a.output, &encoded.stream).map_err(|e| format!("{}: {e}", a.output.display()))?;
+    std::fs::write(&a.output, &encoded.stream)
+        .map_err(|e| format!("{}: {e}", a.output.display()))?;
     if let Some(path) = &a.permutation {
-        let text: String = encoded.permutation.iter().map(|v| format!("{v}\n")).collect();
+        let text: String = encoded
+            .permutation
+            .iter()
+            .map(|v| format!("{v}\n"))
+            .collect();
         std::fs::write(path, text).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     let bytes = encoded.stream.len();
@@ -124,5 +133,10 @@ fn looks_geographic(mesh: &Mesh) -> bool {
         return false;
     };
     let xy = (hi[0] - lo[0]).max(hi[1] - lo[1]);
-    lo[0] >= -180.0 && hi[0] <= 180.0 && lo[1] >= -90.0 && hi[1] <= 90.0 && xy < 5.0 && hi[2] - lo[2] > 50.0 * xy
+    lo[0] >= -180.0
+        && hi[0] <= 180.0
+        && lo[1] >= -90.0
+        && hi[1] <= 90.0
+        && xy < 5.0
+        && hi[2] - lo[2] > 50.0 * xy
 }

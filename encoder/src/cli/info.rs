@@ -16,7 +16,11 @@ pub struct FieldSizes {
 }
 
 /// Sums chunk sizes per substream over every level of `stream`.
-pub fn field_sizes(stream: &[u8], header: &Header, table: &LevelTable<'_>) -> Result<FieldSizes, String> {
+pub fn field_sizes(
+    stream: &[u8],
+    header: &Header,
+    table: &LevelTable<'_>,
+) -> Result<FieldSizes, String> {
     let mut sizes = FieldSizes {
         framing: splitstream_decoder_core::head_len(header.level_count) as u64,
         ..FieldSizes::default()
@@ -26,7 +30,8 @@ pub fn field_sizes(stream: &[u8], header: &Header, table: &LevelTable<'_>) -> Re
         let bytes = stream
             .get(e.offset as usize..(e.offset + e.length as u64) as usize)
             .ok_or("stream truncated")?;
-        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len).map_err(|e| e.to_string())?;
+        let lh =
+            LevelHeader::parse(bytes, k == 0, header.max_chunk_len).map_err(|e| e.to_string())?;
         sizes.framing += lh.payload_start as u64;
         for c in 0..lh.chunk_count {
             let chunk = lh.chunk(c).map_err(|e| e.to_string())?;
@@ -52,8 +57,14 @@ pub fn run(input: &Path, json: bool) -> CliResult {
     let sizes = field_sizes(&stream, &header, &table)?;
     let n = header.vertex_capacity as f64;
     let bpv = |bytes: u64| 8.0 * bytes as f64 / n;
-    let connectivity: u64 = (1..12).filter(|&i| !is_geometry(i)).map(|i| sizes.stored[i]).sum();
-    let geometry: u64 = (1..12).filter(|&i| is_geometry(i)).map(|i| sizes.stored[i]).sum();
+    let connectivity: u64 = (1..12)
+        .filter(|&i| !is_geometry(i))
+        .map(|i| sizes.stored[i])
+        .sum();
+    let geometry: u64 = (1..12)
+        .filter(|&i| is_geometry(i))
+        .map(|i| sizes.stored[i])
+        .sum();
     let mode = match header.position_mode {
         PositionMode::Optimal => "optimal",
         PositionMode::Constrained => "constrained",
@@ -96,10 +107,17 @@ pub fn run(input: &Path, json: bool) -> CliResult {
             "levels": levels,
             "fields": fields,
         });
-        println!("{}", serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())?);
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&doc).map_err(|e| e.to_string())?
+        );
         return Ok(());
     }
-    println!("{}: splitstream format 1.{}", input.display(), header.version_minor);
+    println!(
+        "{}: splitstream format 1.{}",
+        input.display(),
+        header.version_minor
+    );
     println!(
         "  {} vertices, {} triangles, {} bytes ({:.2} bits/vertex: connectivity {:.2}, geometry {:.2}, framing {:.2})",
         header.vertex_capacity,
@@ -125,7 +143,13 @@ pub fn run(input: &Path, json: bool) -> CliResult {
         let e = table.get(k);
         println!(
             "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:.6}",
-            k, e.offset, e.length, e.vertex_count, e.triangle_count, e.round_count, e.geometric_error
+            k,
+            e.offset,
+            e.length,
+            e.vertex_count,
+            e.triangle_count,
+            e.round_count,
+            e.geometric_error
         );
     }
     println!("  field            bytes   raw bytes  bits/vertex");

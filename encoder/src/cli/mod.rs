@@ -15,7 +15,11 @@ use clap::{Parser, Subcommand, ValueEnum};
 pub type CliResult = Result<(), String>;
 
 #[derive(Parser)]
-#[command(name = "splitstream", version, about = "Progressive streaming of terrain and 3D meshes")]
+#[command(
+    name = "splitstream",
+    version,
+    about = "Progressive streaming of terrain and 3D meshes"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,

@@ -4,7 +4,11 @@ use std::io::{BufWriter, Write};
 use std::path::Path;
 
 /// Writes `positions` and `triangles` to `path`, format chosen by extension.
-pub fn write_mesh(path: &Path, positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<(), String> {
+pub fn write_mesh(
+    path: &Path,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+) -> Result<(), String> {
     let name = path.display();
     let ext = path
         .extension()

@@ -24,7 +24,8 @@ pub fn plan_levels(s: &Simplification, levels: usize, base_vertices: usize) -> L
     for k in (0..steps).rev() {
         counts.push(counts.last().copied().unwrap_or(0.0) + s.steps[k].len() as f64);
     }
-    let log_distance = |i: usize, target: f64| (counts[i].max(1.0).ln() - target.max(1.0).ln()).abs();
+    let log_distance =
+        |i: usize, target: f64| (counts[i].max(1.0).ln() - target.max(1.0).ln()).abs();
     let closest = |lo: usize, hi: usize, target: f64| {
         (lo..=hi)
             .min_by(|&a, &b| log_distance(a, target).total_cmp(&log_distance(b, target)))
@@ -38,7 +39,11 @@ pub fn plan_levels(s: &Simplification, levels: usize, base_vertices: usize) -> L
         let previous = bounds[bounds.len() - 1];
         let target = base * (full / base).powf(i as f64 / refinement as f64);
         let hi = steps - (refinement - i);
-        bounds.push(if i == refinement { steps } else { closest(previous + 1, hi, target) });
+        bounds.push(if i == refinement {
+            steps
+        } else {
+            closest(previous + 1, hi, target)
+        });
     }
     // Error still present after undoing i rounds: the largest distance of a
     // collapse not undone yet (steps 0 .. steps - i).

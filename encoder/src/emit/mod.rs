@@ -6,7 +6,9 @@ mod levels;
 mod replay;
 
 use splitstream_decoder_core::PositionMode;
-use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, write_stream_seeded};
+use splitstream_decoder_core::writer::{
+    ChunkCodec, LevelPayload, StreamParams, write_stream_seeded,
+};
 
 use crate::mesh::Mesh;
 use crate::quantize::{QuantizedMesh, Units, quantize};
@@ -113,7 +115,10 @@ pub fn encode_quantized(
 ) -> Result<Encoded, EncodeError> {
     let n = mesh.positions.len();
     let shift = (options.levels - 1).min(40) as u32;
-    let base = options.base_vertices.unwrap_or(n >> shift).clamp(4.min(n), n);
+    let base = options
+        .base_vertices
+        .unwrap_or(n >> shift)
+        .clamp(4.min(n), n);
     // Simplify on to a small seed: level 0 codes the rounds from the seed
     // up to the base mesh, far more compactly than a plain base mesh.
     let seed_target = SEED_VERTICES.min(base);
@@ -130,8 +135,8 @@ pub fn encode_quantized(
     let simplify_seconds = started.elapsed().as_secs_f64();
     let started = std::time::Instant::now();
     let plan = plan_levels(&simplification, options.levels, base);
-    let replayed = replay(mesh, &simplification, &plan, options.position_mode)
-        .map_err(EncodeError::Replay)?;
+    let replayed =
+        replay(mesh, &simplification, &plan, options.position_mode).map_err(EncodeError::Replay)?;
     let params = StreamParams {
         position_mode: options.position_mode,
         bits: mesh.bits,
@@ -140,7 +145,11 @@ pub fn encode_quantized(
         codec: options.codec,
         chunk_limit: options.chunk_limit,
     };
-    let level_vertex_counts = replayed.levels.iter().map(|l: &LevelPayload| l.vertex_count).collect();
+    let level_vertex_counts = replayed
+        .levels
+        .iter()
+        .map(|l: &LevelPayload| l.vertex_count)
+        .collect();
     let rounds = replayed.levels.iter().map(|l| l.round_splits.len()).sum();
     let stream = write_stream_seeded(&params, &replayed.seed, &replayed.levels);
     Ok(Encoded {

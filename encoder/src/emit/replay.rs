@@ -5,6 +5,7 @@ use splitstream_decoder_core::limits::{LEAF, NONE, substream};
 use splitstream_decoder_core::writer::{LevelPayload, SeedPayload, SubstreamWriter};
 use splitstream_decoder_core::{
     Error, MeshState, PositionMode, RecordSource, Ring, SplitOutcome, SplitRecord, StateMemory,
+    predict_split,
 };
 
 use super::levels::LevelPlan;
@@ -118,14 +119,20 @@ impl RecordSource for StepSource<'_> {
             return Err(self.fail(format!("wings of the collapse of {id} not in the ring")));
         };
         // P's arc runs counter-clockwise from wing A to wing B.
-        let (o, d, config) = if ia < ib { (ia, ib - ia, false) } else { (ib, ia - ib, true) };
+        let (o, d, config) = if ia < ib {
+            (ia, ib - ia, false)
+        } else {
+            (ib, ia - ib, true)
+        };
         let k = ring.len();
         let len_p = if config { k - d } else { d };
         let deficit = |split_valence: u8, valence: usize| -> Option<u8> {
             if split_valence == LEAF {
                 Some(LEAF)
             } else {
-                (split_valence as usize).checked_sub(valence).map(|x| x as u8)
+                (split_valence as usize)
+                    .checked_sub(valence)
+                    .map(|x| x as u8)
             }
         };
         let (Some(dp), Some(dc)) = (
@@ -139,35 +146,47 @@ impl RecordSource for StepSource<'_> {
             return Err(self.fail(format!("position of {id} differs from its collapse")));
         }
         let (p, c) = (col.position_p, col.position_c);
-        let e: [i64; 3] = std::array::from_fn(|i| c[i] as i64 - p[i] as i64);
+        let (p_hat, c_hat) = predict_split(state.positions(), parent, ring, o, d, config);
+        let residual = |x: [u32; 3], hat: [i64; 3]| -> [i64; 3] {
+            std::array::from_fn(|i| x[i] as i64 - hat[i])
+        };
         let s = &mut *self.subs;
         s[slot(substream::WING_OFFSET)].byte(o as u8);
         s[slot(substream::WING_DISTANCE)].byte(d as u8);
         s[slot(substream::CONFIG)].bit(config);
         s[slot(substream::DEFICIT_P)].byte(dp);
         s[slot(substream::DEFICIT_C)].byte(dc);
-        for &ek in &e {
-            s[slot(substream::EDGE)].signed(ek as i32);
-        }
-        match self.mode {
-            PositionMode::Optimal => {
-                for i in 0..3 {
-                    let m = parent[i] as i64 - p[i] as i64 - (e[i] >> 1);
-                    s[slot(substream::PLACEMENT)].signed(m as i32);
-                }
-            }
+        let (first, second): ([i64; 3], Option<[i64; 3]>) = match self.mode {
+            PositionMode::Optimal => (residual(p, p_hat), Some(residual(c, c_hat))),
             PositionMode::Constrained => {
+                let e: [i64; 3] = std::array::from_fn(|i| c[i] as i64 - p[i] as i64);
                 let mid: [u32; 3] = std::array::from_fn(|i| (p[i] as i64 + (e[i] >> 1)) as u32);
-                let code = if parent == p {
-                    0
+                let (code, first) = if parent == p {
+                    (0, residual(c, c_hat))
                 } else if parent == c {
-                    1
+                    (1, residual(p, p_hat))
                 } else if parent == mid {
-                    2
+                    (2, std::array::from_fn(|i| e[i] - (c_hat[i] - p_hat[i])))
                 } else {
-                    return Err(self.fail(format!("constrained position of {id} off P, C and midpoint")));
+                    return Err(self.fail(format!(
+                        "constrained position of {id} off P, C and midpoint"
+                    )));
                 };
                 s[slot(substream::PLACEMENT)].byte(code);
+                (first, None)
+            }
+        };
+        let fits = |v: &[i64; 3]| v.iter().all(|&x| i32::try_from(x).is_ok());
+        if !fits(&first) || second.as_ref().is_some_and(|v| !fits(v)) {
+            return Err(self.fail(format!("position residual of {id} beyond 32 bits")));
+        }
+        let s = &mut *self.subs;
+        for x in first {
+            s[slot(substream::EDGE)].signed(x as i32);
+        }
+        if let Some(second) = second {
+            for x in second {
+                s[slot(substream::PLACEMENT)].signed(x as i32);
             }
         }
         Ok(SplitRecord {
@@ -210,7 +229,13 @@ pub fn replay(
         .vertex
         .chunks_exact(3)
         .filter(|t| t[0] != NONE)
-        .map(|t| [enc2dec[t[0] as usize], enc2dec[t[1] as usize], enc2dec[t[2] as usize]])
+        .map(|t| {
+            [
+                enc2dec[t[0] as usize],
+                enc2dec[t[1] as usize],
+                enc2dec[t[2] as usize],
+            ]
+        })
         .collect();
     let mut fan = Fan::default();
     let base_deficits: Vec<u8> = dec2enc
@@ -310,7 +335,11 @@ pub fn replay(
 
 /// decode(encode(M)) == M: the refined state, mapped back to input ids, has
 /// exactly the input's oriented triangles and quantized positions.
-fn check_exact(mesh: &QuantizedMesh, state: &MeshState<'_>, dec2enc: &[u32]) -> Result<(), ReplayError> {
+fn check_exact(
+    mesh: &QuantizedMesh,
+    state: &MeshState<'_>,
+    dec2enc: &[u32],
+) -> Result<(), ReplayError> {
     if state.vertex_count() as usize != mesh.positions.len() {
         return Err(ReplayError(format!(
             "replay ended with {} vertices, the input has {}",
@@ -320,7 +349,9 @@ fn check_exact(mesh: &QuantizedMesh, state: &MeshState<'_>, dec2enc: &[u32]) -> 
     }
     for (d, &e) in dec2enc.iter().enumerate() {
         if state.positions()[d] != mesh.positions[e as usize] {
-            return Err(ReplayError(format!("vertex {e} decodes to another position")));
+            return Err(ReplayError(format!(
+                "vertex {e} decodes to another position"
+            )));
         }
     }
     let canonical = |t: [u32; 3]| {
@@ -336,7 +367,9 @@ fn check_exact(mesh: &QuantizedMesh, state: &MeshState<'_>, dec2enc: &[u32]) -> 
     decoded.sort_unstable();
     input.sort_unstable();
     if decoded != input {
-        return Err(ReplayError("decoded triangles differ from the input".into()));
+        return Err(ReplayError(
+            "decoded triangles differ from the input".into(),
+        ));
     }
     Ok(())
 }

@@ -58,13 +58,29 @@ pub fn check_collapse(
     let t = &s.table;
     t.fan(p, &mut k.fan_p);
     t.fan(c, &mut k.fan_c);
-    let left = k.fan_p.corners.iter().copied().find(|&x| t.v(next(x)) == c).unwrap_or(NONE);
-    let right = k.fan_p.corners.iter().copied().find(|&x| t.v(prev(x)) == c).unwrap_or(NONE);
+    let left = k
+        .fan_p
+        .corners
+        .iter()
+        .copied()
+        .find(|&x| t.v(next(x)) == c)
+        .unwrap_or(NONE);
+    let right = k
+        .fan_p
+        .corners
+        .iter()
+        .copied()
+        .find(|&x| t.v(prev(x)) == c)
+        .unwrap_or(NONE);
     if left == NONE && right == NONE {
         return Err(());
     }
     let wing_a = if left != NONE { t.v(prev(left)) } else { NONE };
-    let wing_b = if right != NONE { t.v(next(right)) } else { NONE };
+    let wing_b = if right != NONE {
+        t.v(next(right))
+    } else {
+        NONE
+    };
     neighbours(s, &k.fan_p, &mut k.np);
     neighbours(s, &k.fan_c, &mut k.nc);
     // Link condition on the ghost-closed mesh: the common neighbours are
@@ -110,7 +126,9 @@ pub fn check_collapse(
             return Err(());
         }
     }
-    if !keeps_orientation(s, p, c, target, &k.fan_p) || !keeps_orientation(s, c, p, target, &k.fan_c) {
+    if !keeps_orientation(s, p, c, target, &k.fan_p)
+        || !keeps_orientation(s, c, p, target, &k.fan_c)
+    {
         return Err(());
     }
     Ok(Plan {

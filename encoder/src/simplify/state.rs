@@ -178,7 +178,11 @@ pub fn simplify(
             })
             .collect();
         // Raise S to the admitted quantile of the current candidate errors.
-        let mut errors: Vec<f64> = best.iter().filter(|b| b.other != NONE).map(|b| b.error).collect();
+        let mut errors: Vec<f64> = best
+            .iter()
+            .filter(|b| b.other != NONE)
+            .map(|b| b.error)
+            .collect();
         if errors.is_empty() {
             break;
         }
@@ -285,7 +289,13 @@ fn step_winners(s: &State, best: &mut [Best], threshold: f64, scale: Scale) -> V
         };
         let keys: Vec<u64> = (0..n)
             .into_par_iter()
-            .map(|v| if admitted(v) { pair_key(&best_now[v], v as u32) } else { u64::MAX })
+            .map(|v| {
+                if admitted(v) {
+                    pair_key(&best_now[v], v as u32)
+                } else {
+                    u64::MAX
+                }
+            })
             .collect();
         let chosen: Vec<u32> = (0..n as u32)
             .into_par_iter()
@@ -345,7 +355,11 @@ fn apply_collapse(s: &mut State, p: u32, b: Best, fans: &mut [Fan; 2]) -> Collap
         .expect("the winner was checked in this step and its neighbourhood is untouched");
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
     let weight = q.c[0] + q.c[4] + q.c[7];
-    let distance = if weight > 0.0 { (b.error / weight).sqrt() } else { 0.0 };
+    let distance = if weight > 0.0 {
+        (b.error / weight).sqrt()
+    } else {
+        0.0
+    };
     let record = Collapse {
         p,
         c,

@@ -1,0 +1,53 @@
+//! Position prediction for a split (SPEC §7.4).
+//!
+//! Once the ring partition is known, P's neighbours are C and the vertices
+//! of P's arc; on a smooth surface P lies near the centroid of its
+//! neighbours. C is not decoded yet, so R stands in for it. The stream then
+//! codes only the residuals, which are much smaller than the edge vector.
+
+use crate::limits::NONE;
+use crate::ring::Ring;
+
+/// Predicted positions of P and C: for each, the floor of the mean of R and
+/// the real vertices of its arc (wings included), per axis, in i64.
+pub fn predict_split(
+    positions: &[[u32; 3]],
+    parent: [u32; 3],
+    ring: &Ring,
+    offset: usize,
+    distance: usize,
+    config: bool,
+) -> ([i64; 3], [i64; 3]) {
+    let k = ring.len();
+    let arc_1 = centroid(positions, parent, ring, offset, distance);
+    let arc_2 = centroid(positions, parent, ring, offset + distance, k - distance);
+    if config {
+        (arc_2, arc_1)
+    } else {
+        (arc_1, arc_2)
+    }
+}
+
+/// Mean of `parent` and the real ring vertices `start ..= start + len` (mod k).
+fn centroid(
+    positions: &[[u32; 3]],
+    parent: [u32; 3],
+    ring: &Ring,
+    start: usize,
+    len: usize,
+) -> [i64; 3] {
+    let k = ring.len();
+    let mut sum = parent.map(|x| x as i64);
+    let mut count = 1i64;
+    for i in start..=start + len {
+        let v = ring.vertices()[i % k];
+        if v != NONE {
+            let p = positions[v as usize];
+            for a in 0..3 {
+                sum[a] += p[a] as i64;
+            }
+            count += 1;
+        }
+    }
+    sum.map(|s| s.div_euclid(count))
+}
