@@ -2,7 +2,7 @@
 //!
 //! To add one (a C ABI, WebAssembly, wgpu or OpenCL decoder), write a
 //! `fn(&[u8]) -> Outcome` that decodes through that implementation and
-//! reports the state hash after the base level and after every round, then
+//! reports the state hash after the seed mesh and after every round, then
 //! add a [`Builtin`] entry to [`BUILTINS`] (behind a cargo feature if it
 //! needs a toolchain or device that CI machines may lack). A decoder that
 //! lives in another process needs nothing here: see `run --decoder`.
@@ -113,7 +113,10 @@ impl<S: RecordSource> RecordSource for FlipConfig<S> {
 /// Decodes with decoder-core's public pieces, in the order of SPEC §10.3
 /// (the order `Decoder` uses); with `flip_config`, every split record's
 /// configuration bit is inverted. Without it this must agree with
-/// [`decoder_core`] on every vector (a test checks it).
+/// [`decoder_core`] on every vector (a test checks it), except that it
+/// reports the seed mesh's hash right after the seed as SPEC §8 says, also
+/// when level 0 has no rounds and then fails its end-of-level checks, where
+/// `Decoder` (which completes such a level inside `begin_level`) reports none.
 pub fn decode_by_pieces(stream: &[u8], flip_config: bool) -> Outcome {
     let mut hashes = Vec::new();
     let result = pieces(stream, flip_config, &mut hashes);
@@ -147,51 +150,58 @@ fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(),
         if level_header.round_count != info.round_count {
             return Err(Error::LevelCountMismatch);
         }
-        if !is_base {
-            let mut added = 0u64;
-            for r in 0..level_header.round_count {
-                let s = level_header.split_count(r);
-                if s == 0 {
-                    return Err(Error::InvalidLevelHeader("a round without splits"));
-                }
-                added += s as u64;
-            }
-            if table.get(k - 1).vertex_count as u64 + added != info.vertex_count as u64 {
-                return Err(Error::LevelCountMismatch);
-            }
-        }
-        let first_id = if is_base {
-            substream::BASE_POSITIONS
+        let before = if is_base {
+            level_header.seed_vertices
         } else {
-            substream::FLAGS
+            table.get(k - 1).vertex_count
         };
+        let mut added = 0u64;
+        for r in 0..level_header.round_count {
+            let s = level_header.split_count(r);
+            if s == 0 {
+                return Err(Error::InvalidLevelHeader("a round without splits"));
+            }
+            added += s as u64;
+        }
+        if before as u64 + added != info.vertex_count as u64 {
+            return Err(Error::LevelCountMismatch);
+        }
         // SPEC §7.6: no split may take the level past its triangle count.
         state.set_triangle_limit(info.triangle_count);
-        let slots = buffers.each_mut().map(|b| &mut **b);
-        let mut subs = Substreams::open(bytes, level_header, first_id, slots, &mut inflater);
+        let rounds = level_header.round_count;
         if is_base {
-            read_base(
-                &mut state,
-                &mut subs,
-                info.vertex_count,
-                info.triangle_count,
-            )?;
-        } else {
-            for r in 0..level_header.round_count {
-                let declared = level_header.split_count(r);
-                let source = StreamSource {
-                    subs: &mut subs,
-                    mode: header.position_mode,
-                };
-                let result = if flip_config {
-                    state.run_round(declared, &mut FlipConfig(source), &mut ring)
-                } else {
-                    let mut source = source;
-                    state.run_round(declared, &mut source, &mut ring)
-                };
-                result?;
-                hashes.push(state.state_hash());
-            }
+            // SPEC §6.3: the seed mesh (substreams 9..=11) comes first.
+            let slots = buffers.each_mut().map(|b| &mut **b);
+            let mut seed = Substreams::open(
+                bytes,
+                level_header,
+                substream::BASE_POSITIONS,
+                slots,
+                &mut inflater,
+            );
+            let (v, t) = (level_header.seed_vertices, level_header.seed_triangles);
+            read_base(&mut state, &mut seed, v, t)?;
+            // SPEC §8, §10.3: the seed's hash comes before the rounds and
+            // before the end-of-level checks.
+            hashes.push(state.state_hash());
+        }
+        let slots = buffers.each_mut().map(|b| &mut **b);
+        let mut subs =
+            Substreams::open(bytes, level_header, substream::FLAGS, slots, &mut inflater);
+        for r in 0..rounds {
+            let declared = level_header.split_count(r);
+            let source = StreamSource {
+                subs: &mut subs,
+                mode: header.position_mode,
+            };
+            let result = if flip_config {
+                state.run_round(declared, &mut FlipConfig(source), &mut ring)
+            } else {
+                let mut source = source;
+                state.run_round(declared, &mut source, &mut ring)
+            };
+            result?;
+            hashes.push(state.state_hash());
         }
         // SPEC §7.6: end of level.
         subs.finish()?;
@@ -199,9 +209,6 @@ fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(),
             || state.triangle_count() != info.triangle_count
         {
             return Err(Error::LevelCountMismatch);
-        }
-        if is_base {
-            hashes.push(state.state_hash());
         }
     }
     Ok(())

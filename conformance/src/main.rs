@@ -47,7 +47,7 @@ enum Command {
         verbose: bool,
     },
     /// The reference decoder speaking the protocol: reads a stream on stdin,
-    /// prints the state hash after the base level and after every round, then
+    /// prints the state hash after the seed mesh and after every round, then
     /// `ok` or `error <class>`.
     Decode,
     /// List the built-in decoders.

@@ -40,10 +40,10 @@ pub struct Vector {
     /// SPEC §10.1 error class of an invalid vector.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error_class: Option<String>,
-    /// Valid vector: the state hash (SPEC §8) after the base level and after
-    /// every round, in order. Invalid vector: the hashes the reference decoder
-    /// reports before it meets the fault; a decoder may report any prefix of
-    /// them (e.g. one that checks every chunk up front reports fewer).
+    /// Valid vector: the state hash (SPEC §8) after the seed mesh and after
+    /// every round, in order. Invalid vector: the hashes SPEC §10.3 reports
+    /// before the fault is met; a decoder may report any prefix of them (e.g.
+    /// one that checks every chunk up front reports fewer).
     pub round_hashes: Vec<String>,
     /// Valid vectors only: the decoded mesh after the last level.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -59,8 +59,8 @@ pub struct FinalMesh {
     pub triangles: usize,
     /// Edges with one triangle (0: closed mesh).
     pub boundary_edges: usize,
-    /// Largest number of triangles around one vertex in any state (base and
-    /// after every round).
+    /// Largest number of triangles around one vertex in any state (the seed
+    /// and after every round).
     pub max_vertex_triangles: usize,
     /// The last entry of `round_hashes`: positions, deficits and triangles.
     pub state_hash: String,

@@ -57,7 +57,9 @@ fn one_split(o: u8, d: u8, e: [i32; 3], m: [i32; 3], v: u32, t: u32) -> LevelPay
 }
 
 /// The hand-made streams: tetrahedron with one split (stored and deflate),
-/// triangle with a boundary split, and a base-only octahedron.
+/// triangle with a boundary split (the record bytes of tests/handmade.rs,
+/// read as residuals from the SPEC §7.4 prediction), and a base-only
+/// octahedron.
 pub fn handmade() -> Vec<(&'static str, Vec<u8>)> {
     let tetra = streams::base_level(&streams::tetrahedron(), &[0, LEAF, LEAF, LEAF]);
     let tri = streams::base_level(&streams::triangle(), &[0, LEAF, LEAF]);

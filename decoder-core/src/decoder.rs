@@ -184,14 +184,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
                 return Err(e);
             }
         }
-        let mut ld = open_level(self, level, info, header, bytes);
-        if ld.header.round_count == 0 {
-            if let Err(e) = ld.complete() {
-                *ld.poisoned = true;
-                return Err(e);
-            }
-        }
-        Ok(ld)
+        Ok(open_level(self, level, info, header, bytes))
     }
 
     /// Decodes a whole level (see [`Decoder::begin_level`]).

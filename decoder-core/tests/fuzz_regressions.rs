@@ -81,3 +81,13 @@ fn seed_streams_still_decode() {
         assert_eq!(decode_like_the_fuzzer(&g.stream).map(|_| ()), Ok(()));
     }
 }
+
+/// `fix_checksums` leaves valid streams unchanged (it follows the format).
+#[test]
+fn fix_checksums_is_the_identity_on_valid_streams() {
+    for g in streams::seed_generated() {
+        let mut s = g.stream.clone();
+        fix_checksums(&mut s);
+        assert!(s == g.stream, "{} (seeded: {})", g.base, g.seeded);
+    }
+}

@@ -1,6 +1,6 @@
-//! Flat corner table (Rossignac's "Corner Table"): the connectivity the
-//! sequential baseline edits in place. Three flat `u32` arrays and no
-//! per-vertex lists, so a 2M-triangle terrain costs about 50 MB and every
+//! Flat corner table (Rossignac's "Corner Table"): the connectivity both
+//! simplifiers (parallel and sequential baseline) edit in place. Three flat
+//! `u32` arrays and no per-vertex lists, so a 2M-triangle terrain costs about 50 MB and every
 //! traversal is a few indexed loads.
 
 /// Marks a missing opposite corner (a boundary edge), a dead triangle's
@@ -23,7 +23,7 @@ pub fn next(c: u32) -> u32 {
 }
 
 pub fn prev(c: u32) -> u32 {
-    if c % 3 == 0 { c + 2 } else { c - 1 }
+    if c.is_multiple_of(3) { c + 2 } else { c - 1 }
 }
 
 /// The corners around one vertex, in fan order, and whether the fan is open.
@@ -75,6 +75,11 @@ impl CornerTable {
 
     pub fn o(&self, c: u32) -> u32 {
         self.opposite[c as usize]
+    }
+
+    /// Whether corner `c`'s triangle is still part of the mesh.
+    pub fn corner_alive(&self, c: u32) -> bool {
+        self.vertex.get(c as usize).is_some_and(|&v| v != NONE)
     }
 
     /// Collects the corners around vertex `v` into `fan`: first turning one

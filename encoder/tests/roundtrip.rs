@@ -2,39 +2,12 @@
 //! mapping decoded vertices to input ids, and the quantized positions.
 
 mod common;
+mod roundtrip_check;
+
+use roundtrip_check::assert_roundtrip;
 
 use splitstream_decoder_core::PositionMode;
-use splitstream_decoder_core::owned::decode_all;
-use splitstream_encoder::Mesh;
-use splitstream_encoder::emit::{EncodeOptions, encode};
-use splitstream_encoder::quantize::quantize;
-
-fn canonical(t: [u32; 3]) -> [u32; 3] {
-    let r = (0..3).min_by_key(|&i| t[i]).unwrap();
-    [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
-}
-
-/// Encodes, decodes with decoder-core from the bytes alone, and compares.
-pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {
-    let encoded = encode(mesh, options, |_| {}).expect("encode");
-    let decoded = decode_all(&encoded.stream, false).expect("decode");
-    let q = quantize(mesh, options.bits, options.units);
-    assert_eq!(decoded.positions.len(), mesh.positions.len());
-    for (d, &e) in encoded.permutation.iter().enumerate() {
-        assert_eq!(decoded.positions[d], q.positions[e as usize], "vertex {e}");
-    }
-    let mut got: Vec<[u32; 3]> = decoded
-        .triangles
-        .iter()
-        .map(|t| canonical(t.map(|v| encoded.permutation[v as usize])))
-        .collect();
-    let mut want: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
-    got.sort_unstable();
-    want.sort_unstable();
-    assert_eq!(got, want);
-    assert_eq!(decoded.levels as usize, encoded.level_vertex_counts.len());
-    encoded.stream.len()
-}
+use splitstream_encoder::emit::EncodeOptions;
 
 #[test]
 fn closed_sphere_roundtrips() {

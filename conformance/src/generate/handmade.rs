@@ -4,6 +4,7 @@
 
 use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::limits::LEAF;
+use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
@@ -20,7 +21,8 @@ pub fn params(codec: ChunkCodec) -> StreamParams {
     }
 }
 
-/// A base level (ids 9..=11): delta-coded positions, triangles, deficits.
+/// A base level holding only a seed mesh (ids 9..=11): delta-coded
+/// positions, triangles, deficits; `write_stream` frames it as level 0.
 pub fn base(positions: &[[i32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
     let mut subs = vec![SubstreamWriter::default(); 3];
     let mut prev = [0i32; 3];
@@ -57,7 +59,11 @@ pub fn with_raw_substream(mut level: LevelPayload, index: usize, bytes: &[u8]) -
     level
 }
 
-/// One optimal-mode split record: o, d, q, deficits, edge vector, midpoint offset.
+/// One optimal-mode split record: o, d, q, deficits, and the two position
+/// residuals as coded: `e` in the edge substream (P minus its prediction)
+/// and `m` in the placement substream (C minus its prediction), SPEC §7.4.
+/// Records built here start with zero residuals; [`solve`] sets them for
+/// wanted positions of P and C.
 #[derive(Clone, Copy)]
 pub struct Rec {
     pub o: u8,
@@ -67,6 +73,41 @@ pub struct Rec {
     pub dc: u8,
     pub e: [i32; 3],
     pub m: [i32; 3],
+}
+
+/// Sets the residuals of `rec` so that its split (of vertex `r`, creating
+/// vertex `c`) places P at `p` and C at `cpos`: the stream `build` makes is
+/// first decoded with zero residuals, which yields the predictions, whatever
+/// predictor SPEC §7.4 uses, as long as residuals are added to it.
+pub fn solve(
+    rec: Rec,
+    r: usize,
+    c: usize,
+    p: [i32; 3],
+    cpos: [i32; 3],
+    build: &dyn Fn(Rec) -> Vec<u8>,
+) -> Rec {
+    let zero = Rec {
+        e: [0; 3],
+        m: [0; 3],
+        ..rec
+    };
+    let probe = decode_all(&build(zero), false).expect("the zero-residual probe decodes");
+    let (ph, ch) = (probe.positions[r], probe.positions[c]);
+    let solved = Rec {
+        e: std::array::from_fn(|k| p[k] - ph[k] as i32),
+        m: std::array::from_fn(|k| cpos[k] - ch[k] as i32),
+        ..rec
+    };
+    if let Ok(mesh) = decode_all(&build(solved), false) {
+        let want = (p.map(|x| x as u32), cpos.map(|x| x as u32));
+        assert_eq!(
+            (mesh.positions[r], mesh.positions[c]),
+            want,
+            "residuals do not add to the prediction (SPEC §7.4 changed?)"
+        );
+    }
+    solved
 }
 
 /// A refinement level (ids 1..=8) in optimal mode.
@@ -113,8 +154,8 @@ pub fn tetrahedron_two_candidates() -> LevelPayload {
     base(&TETRA_POSITIONS, &TETRA_TRIANGLES, &[0, 0, LEAF, LEAF])
 }
 
-/// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge (0,1,3):
-/// P = (0,0,0), C = (2,2,2).
+/// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge
+/// (0,1,3); zero residuals (P and C at their predictions).
 pub fn tetra_split() -> Rec {
     Rec {
         o: 0,
@@ -122,42 +163,38 @@ pub fn tetra_split() -> Rec {
         q: false,
         dp: LEAF,
         dc: LEAF,
-        e: [2; 3],
-        m: [-1; 3],
+        e: [0; 3],
+        m: [0; 3],
     }
 }
 
-/// The one-split tetrahedron stream (5 vertices, 6 triangles).
+/// The one-split tetrahedron of SPEC Appendix A (5 vertices, 6 triangles):
+/// P = (0,0,0), C = (2,2,2).
 pub fn tetra_stream(codec: ChunkCodec) -> Vec<u8> {
-    write_stream(
-        &params(codec),
-        &[
-            tetrahedron(),
-            level(&[true], vec![1], &[tetra_split()], 5, 6),
-        ],
-    )
+    let build = |rec: Rec| {
+        write_stream(
+            &params(codec),
+            &[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)],
+        )
+    };
+    build(solve(tetra_split(), 0, 4, [0, 0, 0], [2, 2, 2], &build))
 }
 
-/// One triangle; vertex 0 (ring: ghost, 1, 2) splits with the ghost as a wing.
+/// One triangle; vertex 0 (ring: ghost, 1, 2) splits with the ghost as a
+/// wing: P = (0,0,0), C = (0,4,0).
 pub fn boundary_ghost_wing_stream() -> Vec<u8> {
     let b = base(
         &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
         &[[0, 1, 2]],
         &[0, LEAF, LEAF],
     );
-    let rec = Rec {
-        o: 0,
-        d: 1,
-        q: false,
-        dp: LEAF,
-        dc: LEAF,
-        e: [0, 4, 0],
-        m: [0, -2, 0],
+    let build = |rec: Rec| {
+        write_stream(
+            &params(ChunkCodec::Stored),
+            &[b.clone(), level(&[true], vec![1], &[rec], 4, 2)],
+        )
     };
-    write_stream(
-        &params(ChunkCodec::Stored),
-        &[b, level(&[true], vec![1], &[rec], 4, 2)],
-    )
+    build(solve(tetra_split(), 0, 3, [0, 0, 0], [0, 4, 0], &build))
 }
 
 /// A single triangle, base only: the smallest legal stream.

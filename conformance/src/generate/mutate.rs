@@ -7,14 +7,18 @@ use std::ops::Range;
 
 use splitstream_decoder_core::limits::{CHUNK_ENTRY_LEN, HEADER_LEN, LEVEL_ENTRY_LEN, codec};
 use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+    ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream_seeded,
 };
 use splitstream_decoder_core::{Header, Inflater, LevelHeader, LevelTable, crc32, head_len};
 
 /// One level's content, substreams as raw bytes.
 #[derive(Clone, Debug)]
 pub struct Level {
+    /// Level 0 only: the seed mesh's vertex and triangle counts and its
+    /// substreams (ids 9..=11).
+    pub seed: Option<(u32, u32, Vec<Vec<u8>>)>,
     pub round_splits: Vec<u32>,
+    /// The rounds' substreams, ids 1..=8.
     pub substreams: Vec<Vec<u8>>,
     pub vertex_count: u32,
     pub triangle_count: u32,
@@ -39,8 +43,8 @@ pub fn unframe(stream: &[u8]) -> Unframed {
         let info = table.get(k);
         let bytes = &stream[level_range(stream, k)];
         let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len).expect("a valid level");
-        let (count, first_id) = if k == 0 { (3, 9u8) } else { (8, 1u8) };
-        let mut substreams = vec![Vec::new(); count];
+        // Slots 0..8: ids 1..=8 (rounds); 8..11: ids 9..=11 (seed).
+        let mut substreams = vec![Vec::new(); 11];
         let mut at = lh.payload_start;
         for c in 0..lh.chunk_count {
             let e = lh.chunk(c).expect("a valid chunk");
@@ -54,10 +58,13 @@ pub fn unframe(stream: &[u8]) -> Unframed {
                     .inflate_exact(stored, &mut raw)
                     .expect("a valid chunk");
             }
-            substreams[(e.substream - first_id) as usize].extend_from_slice(&raw);
+            substreams[(e.substream - 1) as usize].extend_from_slice(&raw);
             at += e.stored_len as usize;
         }
+        let seed_substreams = substreams.split_off(8);
+        let seed = (k == 0).then_some((lh.seed_vertices, lh.seed_triangles, seed_substreams));
         levels.push(Level {
+            seed,
             round_splits: (0..lh.round_count).map(|r| lh.split_count(r)).collect(),
             substreams,
             vertex_count: info.vertex_count,
@@ -82,6 +89,19 @@ pub fn unframe(stream: &[u8]) -> Unframed {
     }
 }
 
+fn writers(substreams: &[Vec<u8>]) -> Vec<SubstreamWriter> {
+    substreams
+        .iter()
+        .map(|bytes| {
+            let mut w = SubstreamWriter::default();
+            for &b in bytes {
+                w.byte(b);
+            }
+            w
+        })
+        .collect()
+}
+
 /// Frames the levels again (all checksums, counts and sizes recomputed).
 pub fn reframe(u: &Unframed) -> Vec<u8> {
     let payloads: Vec<LevelPayload> = u
@@ -89,23 +109,19 @@ pub fn reframe(u: &Unframed) -> Vec<u8> {
         .iter()
         .map(|l| LevelPayload {
             round_splits: l.round_splits.clone(),
-            substreams: l
-                .substreams
-                .iter()
-                .map(|bytes| {
-                    let mut w = SubstreamWriter::default();
-                    for &b in bytes {
-                        w.byte(b);
-                    }
-                    w
-                })
-                .collect(),
+            substreams: writers(&l.substreams),
             vertex_count: l.vertex_count,
             triangle_count: l.triangle_count,
             geometric_error: l.geometric_error,
         })
         .collect();
-    write_stream(&u.params, &payloads)
+    let (vertices, triangles, seed) = u.levels[0].seed.as_ref().expect("level 0 has a seed");
+    let seed = SeedPayload {
+        vertices: *vertices,
+        triangles: *triangles,
+        substreams: writers(seed),
+    };
+    write_stream_seeded(&u.params, &seed, &payloads)
 }
 
 fn u32_at(s: &[u8], at: usize) -> u32 {
@@ -141,12 +157,18 @@ pub fn level_range(s: &[u8], k: u16) -> Range<usize> {
     offset..offset + u32_at(s, at + 8) as usize
 }
 
+/// Offset of the split counts of level `k` (level 0 first holds the seed
+/// mesh's vertex and triangle counts, SPEC §5.1).
+fn split_counts_at(s: &[u8], k: u16) -> usize {
+    level_range(s, k).start + if k == 0 { 16 } else { 8 }
+}
+
 /// Where the level header of level `k` keeps its CRC.
 fn level_crc_at(s: &[u8], k: u16) -> usize {
     let start = level_range(s, k).start;
     let rounds = u32_at(s, start) as usize;
     let chunks = u32_at(s, start + 4) as usize;
-    start + 8 + 4 * rounds + CHUNK_ENTRY_LEN * chunks
+    split_counts_at(s, k) + 4 * rounds + CHUNK_ENTRY_LEN * chunks
 }
 
 /// Recomputes the level header CRC of level `k` (SPEC §5.1).
@@ -159,14 +181,13 @@ pub fn fix_level_header_crc(s: &mut [u8], k: u16) {
 
 /// Offset of the split count of round `r` of level `k`.
 pub fn split_count_at(s: &[u8], k: u16, r: usize) -> usize {
-    level_range(s, k).start + 8 + 4 * r
+    split_counts_at(s, k) + 4 * r
 }
 
 /// Offset of chunk-directory entry `c` of level `k`.
 pub fn chunk_entry_at(s: &[u8], k: u16, c: usize) -> usize {
-    let start = level_range(s, k).start;
-    let rounds = u32_at(s, start) as usize;
-    start + 8 + 4 * rounds + CHUNK_ENTRY_LEN * c
+    let rounds = u32_at(s, level_range(s, k).start) as usize;
+    split_counts_at(s, k) + 4 * rounds + CHUNK_ENTRY_LEN * c
 }
 
 /// Number of chunks of level `k`.

@@ -1,8 +1,8 @@
 //! One edge collapse: the checks that keep the mesh a valid oriented
 //! manifold, then the in-place edit of the corner table.
 
-use super::corner_table::{NONE, next, prev};
 use super::state::Simplifier;
+use crate::corner_table::{NONE, next, prev};
 use crate::quadric::{Quadric, cross, dot, sub};
 
 /// Most neighbours a vertex may end up with (boundary vertices count one
@@ -164,49 +164,13 @@ impl Simplifier<'_> {
     /// Performs a planned collapse of `b` into `a`, moving `a` to `p` with
     /// summed quadric `q`. Returns the number of triangles removed.
     pub fn apply(&mut self, a: u32, b: u32, p: [f64; 3], q: Quadric, plan: &Plan) -> usize {
-        let fa = std::mem::take(&mut self.fans[0]);
-        let fb = std::mem::take(&mut self.fans[1]);
-        let t = &mut self.table;
-        let doomed = |c: u32| c != NONE && (c / 3 == plan.left / 3 || c / 3 == plan.right / 3);
-
-        // Re-anchor the opposite vertices on triangles that survive: the
-        // neighbours across their two folded edges.
-        for (c, left) in [(plan.left, true), (plan.right, false)] {
-            if c == NONE {
-                continue;
-            }
-            let x = t.v(if left { prev(c) } else { next(c) });
-            let anchor = [c, next(c), prev(c)]
-                .into_iter()
-                .map(|k| t.o(k))
-                .find(|&o| o != NONE && !doomed(o))
-                .map(|o| t.corner_at(o, x))
-                .unwrap_or(NONE);
-            t.corner_of[x as usize] = anchor;
-        }
-        for &c in &fb.corners {
-            if !doomed(c) {
-                t.vertex[c as usize] = a;
-            }
-        }
-        let mut removed = 0;
-        // Remove by the corner facing the collapsing edge.
-        if plan.left != NONE {
-            t.remove_triangle(prev(plan.left));
-            removed += 1;
-        }
-        if plan.right != NONE {
-            t.remove_triangle(next(plan.right));
-            removed += 1;
-        }
-        t.corner_of[a as usize] = fa
-            .corners
-            .iter()
-            .chain(&fb.corners)
-            .copied()
-            .find(|&c| !doomed(c))
-            .unwrap_or(NONE);
-        t.corner_of[b as usize] = NONE;
+        let mut fans = [
+            std::mem::take(&mut self.fans[0]),
+            std::mem::take(&mut self.fans[1]),
+        ];
+        self.table.collapse(a, b, plan.left, plan.right, &mut fans);
+        let [fa, fb] = fans;
+        let removed = usize::from(plan.left != NONE) + usize::from(plan.right != NONE);
 
         let (ai, bi) = (a as usize, b as usize);
         self.positions[ai] = p;

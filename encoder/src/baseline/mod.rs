@@ -18,7 +18,6 @@
 //! edge is scored again once a neighbouring collapse may have made it legal.
 
 mod collapse;
-mod corner_table;
 mod queue;
 mod state;
 #[cfg(test)]
@@ -143,7 +142,7 @@ fn compact(s: &Simplifier) -> Mesh {
         .table
         .vertex
         .chunks_exact(3)
-        .filter(|t| t[0] != corner_table::NONE)
+        .filter(|t| t[0] != crate::corner_table::NONE)
         .map(|t| {
             [
                 remap[t[0] as usize],

@@ -2,8 +2,8 @@
 //! bookkeeping that keeps lazily deleted queue entries honest.
 
 use super::BaselineOptions;
-use super::corner_table::{CornerTable, Fan, NONE, next, prev};
 use super::queue::{Entry, Queue};
+use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, collapse_target, vertex_quadrics};
 
 pub struct Simplifier<'o> {

@@ -8,7 +8,7 @@ use splitstream_encoder::input::fractal_terrain;
 
 use super::CliResult;
 
-pub fn run(side: usize) -> CliResult {
+pub fn run(side: usize, output: Option<&std::path::Path>) -> CliResult {
     if !(2..=4096).contains(&side) {
         return Err(format!("--side {side} is outside 2..=4096"));
     }
@@ -25,6 +25,9 @@ pub fn run(side: usize) -> CliResult {
     let encoded = encode(&mesh, &options, |_| {}).map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     let stream = &encoded.stream;
+    if let Some(path) = output {
+        std::fs::write(path, stream).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
     println!(
         "encoded: {} bytes ({:.2} bits/vertex), {} levels, {} rounds, in {:.2} s ({:.2} M triangles/s)",
         stream.len(),

@@ -1,5 +1,6 @@
 //! Command-line definitions and dispatch.
 
+mod bench;
 mod decode;
 mod demo;
 mod encode;
@@ -106,12 +107,28 @@ pub enum Command {
     },
     /// Decode fully, checking every checksum and rule; print the state hash.
     Verify { input: PathBuf },
+    /// Measure the encoder's goals: bits per vertex, quality and speed
+    /// against the sequential baseline, throughput (see encoder/BENCHMARKS.md).
+    Bench {
+        /// Folder with the real inputs (encoder/data/fetch.sh).
+        #[arg(long, default_value = "encoder/data/real")]
+        data: PathBuf,
+        /// Side of the synthetic terrain for the throughput figures.
+        #[arg(long, default_value_t = 1000)]
+        terrain_side: usize,
+        /// Only sizes and throughput.
+        #[arg(long)]
+        skip_quality: bool,
+    },
     /// The main job on a built-in default: generate a terrain, encode it,
     /// decode it level by level and print the level table.
     Demo {
         /// Side of the generated square terrain, in samples.
         #[arg(long, default_value_t = 512)]
         side: usize,
+        /// Also write the stream here.
+        #[arg(short, long)]
+        output: Option<PathBuf>,
     },
 }
 
@@ -159,7 +176,12 @@ pub fn run(cli: Cli) -> CliResult {
         } => decode::run(&input, &output, level),
         Command::Info { input, json } => info::run(&input, json),
         Command::Verify { input } => verify::run(&input),
-        Command::Demo { side } => demo::run(side),
+        Command::Bench {
+            data,
+            terrain_side,
+            skip_quality,
+        } => bench::run(&data, terrain_side, skip_quality),
+        Command::Demo { side, output } => demo::run(side, output.as_deref()),
     }
 }
 

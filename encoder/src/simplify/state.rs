@@ -287,11 +287,15 @@ fn step_winners(s: &State, best: &mut [Best], threshold: f64, scale: Scale) -> V
                 && b.error <= threshold
                 && best_now[b.other as usize].other == v as u32
         };
+        // One key per pair, taken from its lower endpoint, so that both
+        // endpoints compare alike (their cached errors may come from
+        // different steps).
         let keys: Vec<u64> = (0..n)
             .into_par_iter()
             .map(|v| {
                 if admitted(v) {
-                    pair_key(&best_now[v], v as u32)
+                    let low = v.min(best_now[v].other as usize);
+                    pair_key(&best_now[low], low as u32)
                 } else {
                     u64::MAX
                 }
@@ -448,4 +452,41 @@ fn mean_edge_length(s: &State) -> f64 {
         })
         .reduce(|| (0.0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
     if count == 0 { 1.0 } else { sum / count as f64 }
+}
+
+impl Simplification {
+    /// The simplified mesh in real coordinates, compacted (surviving
+    /// vertices in ascending id, live triangles in order).
+    pub fn to_mesh(&self, mesh: &QuantizedMesh) -> crate::Mesh {
+        let mut index = vec![NONE; self.alive.len()];
+        let mut positions = Vec::with_capacity(self.alive_count);
+        for (v, &alive) in self.alive.iter().enumerate() {
+            if alive {
+                index[v] = positions.len() as u32;
+                positions.push(mesh.dequantize(self.positions[v]));
+            }
+        }
+        let triangles = self
+            .table
+            .vertex
+            .chunks_exact(3)
+            .filter(|t| t[0] != NONE)
+            .map(|t| {
+                [
+                    index[t[0] as usize],
+                    index[t[1] as usize],
+                    index[t[2] as usize],
+                ]
+            })
+            .collect();
+        crate::Mesh {
+            positions,
+            triangles,
+        }
+    }
+
+    /// Largest quadric error of any collapse.
+    pub fn max_error(&self) -> f64 {
+        self.step_errors.iter().copied().fold(0.0, f64::max)
+    }
 }

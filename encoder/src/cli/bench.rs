@@ -1,0 +1,279 @@
+//! `splitstream bench`: the encoder's measured goals in one run — bits per
+//! vertex, quality and speed against the sequential baseline, throughput.
+//! Figures go to BENCHMARKS.md with the machine and date.
+
+use std::path::Path;
+use std::time::Instant;
+
+use splitstream_decoder_core::PositionMode;
+use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_encoder::Mesh;
+use splitstream_encoder::baseline::{BaselineOptions, simplify_sequential};
+use splitstream_encoder::emit::{EncodeOptions, encode};
+use splitstream_encoder::input::{ReadOptions, check_mesh, fractal_terrain, read_mesh};
+use splitstream_encoder::metrics::surface_distance;
+use splitstream_encoder::quantize::{QuantizedMesh, Units, quantize};
+use splitstream_encoder::simplify::{SimplifyOptions, simplify};
+
+use super::CliResult;
+use super::info::{field_sizes, is_geometry};
+
+const SAMPLES: usize = 200_000;
+
+struct Input {
+    name: &'static str,
+    file: &'static str,
+    units: Units,
+}
+
+const INPUTS: [Input; 4] = [
+    Input {
+        name: "armadillo",
+        file: "armadillo.off",
+        units: Units::Linear,
+    },
+    Input {
+        name: "bunny00",
+        file: "bunny00.off",
+        units: Units::Linear,
+    },
+    Input {
+        name: "refined_elephant",
+        file: "refined_elephant.off",
+        units: Units::Linear,
+    },
+    Input {
+        name: "jacksboro DEM",
+        file: "jacksboro_fault_dem.npz",
+        units: Units::Geographic,
+    },
+];
+
+pub fn run(data: &Path, terrain_side: usize, skip_quality: bool) -> CliResult {
+    println!("# splitstream encoder benchmark\n");
+    println!("## Stream size (5 levels, 14-bit positions), bits per vertex\n");
+    println!("| input | vertices | mode | total | connectivity | geometry | rounds | encode s |");
+    println!("|---|---|---|---|---|---|---|---|");
+    let mut loaded = Vec::new();
+    for input in &INPUTS {
+        let path = data.join(input.file);
+        if !path.exists() {
+            println!(
+                "| {} | skipped: run encoder/data/fetch.sh | | | | | | |",
+                input.name
+            );
+            continue;
+        }
+        let mesh = read_mesh(&path, &ReadOptions::default()).map_err(|e| e.to_string())?;
+        check_mesh(&mesh).map_err(|e| format!("{}: {e}", path.display()))?;
+        for mode in [PositionMode::Optimal, PositionMode::Constrained] {
+            size_row(input.name, &mesh, input.units, mode)?;
+        }
+        loaded.push((input, mesh));
+    }
+    if !skip_quality {
+        println!(
+            "\n## Quality against the sequential baseline (same quadrics), symmetric distances in % of the bounding-box diagonal\n"
+        );
+        println!(
+            "| input | target | parallel Hausdorff | sequential Hausdorff | ratio | parallel RMS | sequential RMS | ratio | parallel s | sequential s | speed-up |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|---|---|");
+        for (input, mesh) in &loaded {
+            for fraction in [0.25, 0.0625] {
+                quality_row(input, mesh, fraction)?;
+            }
+        }
+        println!("\n## Vertices kept at the same maximum quadric error\n");
+        println!(
+            "| input | max error (from the parallel run to 6.25 %) | parallel vertices | sequential vertices | extra |"
+        );
+        println!("|---|---|---|---|---|");
+        for (input, mesh) in &loaded {
+            equal_error_row(input, mesh)?;
+        }
+    }
+    println!("\n## Throughput on the synthetic {terrain_side}x{terrain_side} terrain\n");
+    throughput(terrain_side)?;
+    Ok(())
+}
+
+fn size_row(name: &str, mesh: &Mesh, units: Units, mode: PositionMode) -> CliResult {
+    let options = EncodeOptions {
+        position_mode: mode,
+        units,
+        ..EncodeOptions::default()
+    };
+    let t = Instant::now();
+    let encoded = encode(mesh, &options, |_| {}).map_err(|e| e.to_string())?;
+    let seconds = t.elapsed().as_secs_f64();
+    let stream = &encoded.stream;
+    let header = splitstream_decoder_core::Header::parse(stream).map_err(|e| e.to_string())?;
+    let table =
+        splitstream_decoder_core::LevelTable::parse(stream, &header).map_err(|e| e.to_string())?;
+    let sizes = field_sizes(stream, &header, &table)?;
+    let n = mesh.positions.len() as f64;
+    let bpv = |b: u64| 8.0 * b as f64 / n;
+    let connectivity: u64 = (1..12)
+        .filter(|&i| !is_geometry(i))
+        .map(|i| sizes.stored[i])
+        .sum();
+    let geometry: u64 = (1..12)
+        .filter(|&i| is_geometry(i))
+        .map(|i| sizes.stored[i])
+        .sum();
+    println!(
+        "| {name} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} |",
+        mesh.positions.len(),
+        if mode == PositionMode::Optimal {
+            "optimal"
+        } else {
+            "constrained"
+        },
+        bpv(stream.len() as u64),
+        bpv(connectivity),
+        bpv(geometry),
+        encoded.rounds,
+        seconds
+    );
+    Ok(())
+}
+
+fn quantized(input: &Input, mesh: &Mesh) -> QuantizedMesh {
+    quantize(mesh, 14, input.units)
+}
+
+/// The quantized input in metric units, the geometry both simplifiers see.
+fn metric_mesh(q: &QuantizedMesh) -> Mesh {
+    Mesh {
+        positions: q
+            .positions
+            .iter()
+            .map(|p| std::array::from_fn(|k| p[k] as f64 * q.metric[k]))
+            .collect(),
+        triangles: q.triangles.clone(),
+    }
+}
+
+fn quality_row(input: &Input, mesh: &Mesh, fraction: f64) -> CliResult {
+    let q = quantized(input, mesh);
+    let metric = QuantizedMesh {
+        origin: [0.0; 3],
+        scale: q.metric,
+        ..q.clone()
+    };
+    let reference = metric_mesh(&q);
+    let target = ((mesh.positions.len() as f64) * fraction).round() as usize;
+    let t = Instant::now();
+    let s = simplify(
+        &q,
+        &SimplifyOptions {
+            target_vertices: target,
+            ..SimplifyOptions::default()
+        },
+        |_| {},
+    );
+    let parallel_seconds = t.elapsed().as_secs_f64();
+    let parallel = s.to_mesh(&metric);
+    let sequential = simplify_sequential(
+        &reference,
+        &BaselineOptions {
+            target_vertices: target,
+            ..BaselineOptions::default()
+        },
+    );
+    let dp = surface_distance(&reference, &parallel, SAMPLES, 7);
+    let ds = surface_distance(&reference, &sequential.mesh, SAMPLES, 7);
+    let pct = |x: f64, d: f64| 100.0 * x / d;
+    println!(
+        "| {} | {:.2} % ({} v) | {:.4} | {:.4} | {:.2} | {:.5} | {:.5} | {:.2} | {:.2} | {:.2} | {:.1}x |",
+        input.name,
+        100.0 * fraction,
+        parallel.positions.len(),
+        pct(dp.hausdorff, dp.diagonal),
+        pct(ds.hausdorff, ds.diagonal),
+        dp.hausdorff / ds.hausdorff,
+        pct(dp.rms, dp.diagonal),
+        pct(ds.rms, ds.diagonal),
+        dp.rms / ds.rms,
+        parallel_seconds,
+        sequential.seconds,
+        sequential.seconds / parallel_seconds
+    );
+    Ok(())
+}
+
+fn equal_error_row(input: &Input, mesh: &Mesh) -> CliResult {
+    let q = quantized(input, mesh);
+    let reference = metric_mesh(&q);
+    let target = mesh.positions.len() / 16;
+    let first = simplify(
+        &q,
+        &SimplifyOptions {
+            target_vertices: target,
+            ..SimplifyOptions::default()
+        },
+        |_| {},
+    );
+    let limit = first.max_error();
+    let parallel = simplify(
+        &q,
+        &SimplifyOptions {
+            target_vertices: 0,
+            max_error: Some(limit),
+            ..SimplifyOptions::default()
+        },
+        |_| {},
+    );
+    let sequential = simplify_sequential(
+        &reference,
+        &BaselineOptions {
+            target_vertices: 0,
+            max_error: Some(limit),
+            ..BaselineOptions::default()
+        },
+    );
+    let np = parallel.alive_count;
+    let ns = sequential.mesh.positions.len();
+    println!(
+        "| {} | {:.4e} | {} | {} | {:+.1} % |",
+        input.name,
+        limit,
+        np,
+        ns,
+        100.0 * (np as f64 / ns as f64 - 1.0)
+    );
+    Ok(())
+}
+
+fn throughput(side: usize) -> CliResult {
+    let mesh = fractal_terrain(side, 2012);
+    let triangles = mesh.triangles.len() as f64;
+    let t = Instant::now();
+    let encoded = encode(&mesh, &EncodeOptions::default(), |_| {}).map_err(|e| e.to_string())?;
+    let seconds = t.elapsed().as_secs_f64();
+    println!(
+        "- encode end to end: {:.2} s for {} triangles = {:.3} M triangles/s ({} rounds; simplify {:.2} s, emit {:.2} s; {} threads)",
+        seconds,
+        mesh.triangles.len(),
+        triangles / seconds / 1e6,
+        encoded.rounds,
+        encoded.simplify_seconds,
+        encoded.emit_seconds,
+        rayon::current_num_threads()
+    );
+    let stream = &encoded.stream;
+    let fail = |e: splitstream_decoder_core::Error| e.to_string();
+    let mut ws = OwnedWorkspace::for_stream(stream).map_err(fail)?;
+    let mut decoder = ws.decoder(stream).map_err(fail)?;
+    let t = Instant::now();
+    decoder.decode_available(stream).map_err(fail)?;
+    let seconds = t.elapsed().as_secs_f64();
+    let splits = decoder.positions().len() as f64;
+    println!(
+        "- decode (decoder-core, one thread, all levels): {:.1} ms = {:.2} M splits/s",
+        seconds * 1e3,
+        splits / seconds / 1e6
+    );
+    Ok(())
+}
