@@ -49,13 +49,36 @@ const INPUTS: [Input; 4] = [
     },
 ];
 
-pub fn run(data: &Path, terrain_side: usize, skip_quality: bool) -> CliResult {
+/// What `splitstream bench` measures.
+pub struct Settings {
+    pub data: std::path::PathBuf,
+    pub terrain_side: usize,
+    pub skip_quality: bool,
+    pub admit: f64,
+    pub only: Option<String>,
+    pub skip_throughput: bool,
+}
+
+pub fn run(settings: &Settings) -> CliResult {
+    let data: &Path = &settings.data;
+    let admit = settings.admit;
+    let simplify_options = |target: usize, max_error: Option<f64>| SimplifyOptions {
+        target_vertices: target,
+        max_error,
+        admit_quantile: admit,
+        ..SimplifyOptions::default()
+    };
     println!("# splitstream encoder benchmark\n");
     println!("## Stream size (5 levels, 14-bit positions), bits per vertex\n");
     println!("| input | vertices | mode | total | connectivity | geometry | rounds | encode s |");
     println!("|---|---|---|---|---|---|---|---|");
     let mut loaded = Vec::new();
-    for input in &INPUTS {
+    for input in INPUTS.iter().filter(|i| {
+        settings
+            .only
+            .as_ref()
+            .is_none_or(|o| i.name.contains(o.as_str()))
+    }) {
         let path = data.join(input.file);
         if !path.exists() {
             println!(
@@ -67,11 +90,11 @@ pub fn run(data: &Path, terrain_side: usize, skip_quality: bool) -> CliResult {
         let mesh = read_mesh(&path, &ReadOptions::default()).map_err(|e| e.to_string())?;
         check_mesh(&mesh).map_err(|e| format!("{}: {e}", path.display()))?;
         for mode in [PositionMode::Optimal, PositionMode::Constrained] {
-            size_row(input.name, &mesh, input.units, mode)?;
+            size_row(input.name, &mesh, input.units, mode, admit)?;
         }
         loaded.push((input, mesh));
     }
-    if !skip_quality {
+    if !settings.skip_quality {
         println!(
             "\n## Quality against the sequential baseline (same quadrics), symmetric distances in % of the bounding-box diagonal\n"
         );
@@ -81,7 +104,7 @@ pub fn run(data: &Path, terrain_side: usize, skip_quality: bool) -> CliResult {
         println!("|---|---|---|---|---|---|---|---|---|---|---|");
         for (input, mesh) in &loaded {
             for fraction in [0.25, 0.0625] {
-                quality_row(input, mesh, fraction)?;
+                quality_row(input, mesh, fraction, &simplify_options)?;
             }
         }
         println!("\n## Vertices kept at the same maximum quadric error\n");
@@ -90,18 +113,22 @@ pub fn run(data: &Path, terrain_side: usize, skip_quality: bool) -> CliResult {
         );
         println!("|---|---|---|---|---|");
         for (input, mesh) in &loaded {
-            equal_error_row(input, mesh)?;
+            equal_error_row(input, mesh, &simplify_options)?;
         }
     }
-    println!("\n## Throughput on the synthetic {terrain_side}x{terrain_side} terrain\n");
-    throughput(terrain_side)?;
+    if !settings.skip_throughput {
+        let side = settings.terrain_side;
+        println!("\n## Throughput on the synthetic {side}x{side} terrain\n");
+        throughput(side, admit)?;
+    }
     Ok(())
 }
 
-fn size_row(name: &str, mesh: &Mesh, units: Units, mode: PositionMode) -> CliResult {
+fn size_row(name: &str, mesh: &Mesh, units: Units, mode: PositionMode, admit: f64) -> CliResult {
     let options = EncodeOptions {
         position_mode: mode,
         units,
+        admit_quantile: admit,
         ..EncodeOptions::default()
     };
     let t = Instant::now();
@@ -155,7 +182,9 @@ fn metric_mesh(q: &QuantizedMesh) -> Mesh {
     }
 }
 
-fn quality_row(input: &Input, mesh: &Mesh, fraction: f64) -> CliResult {
+type OptionsFor<'a> = &'a dyn Fn(usize, Option<f64>) -> SimplifyOptions;
+
+fn quality_row(input: &Input, mesh: &Mesh, fraction: f64, options: OptionsFor<'_>) -> CliResult {
     let q = quantized(input, mesh);
     let metric = QuantizedMesh {
         origin: [0.0; 3],
@@ -165,14 +194,7 @@ fn quality_row(input: &Input, mesh: &Mesh, fraction: f64) -> CliResult {
     let reference = metric_mesh(&q);
     let target = ((mesh.positions.len() as f64) * fraction).round() as usize;
     let t = Instant::now();
-    let s = simplify(
-        &q,
-        &SimplifyOptions {
-            target_vertices: target,
-            ..SimplifyOptions::default()
-        },
-        |_| {},
-    );
+    let s = simplify(&q, &options(target, None), |_| {});
     let parallel_seconds = t.elapsed().as_secs_f64();
     let parallel = s.to_mesh(&metric);
     let sequential = simplify_sequential(
@@ -203,28 +225,13 @@ fn quality_row(input: &Input, mesh: &Mesh, fraction: f64) -> CliResult {
     Ok(())
 }
 
-fn equal_error_row(input: &Input, mesh: &Mesh) -> CliResult {
+fn equal_error_row(input: &Input, mesh: &Mesh, options: OptionsFor<'_>) -> CliResult {
     let q = quantized(input, mesh);
     let reference = metric_mesh(&q);
     let target = mesh.positions.len() / 16;
-    let first = simplify(
-        &q,
-        &SimplifyOptions {
-            target_vertices: target,
-            ..SimplifyOptions::default()
-        },
-        |_| {},
-    );
+    let first = simplify(&q, &options(target, None), |_| {});
     let limit = first.max_error();
-    let parallel = simplify(
-        &q,
-        &SimplifyOptions {
-            target_vertices: 0,
-            max_error: Some(limit),
-            ..SimplifyOptions::default()
-        },
-        |_| {},
-    );
+    let parallel = simplify(&q, &options(0, Some(limit)), |_| {});
     let sequential = simplify_sequential(
         &reference,
         &BaselineOptions {
@@ -246,11 +253,15 @@ fn equal_error_row(input: &Input, mesh: &Mesh) -> CliResult {
     Ok(())
 }
 
-fn throughput(side: usize) -> CliResult {
+fn throughput(side: usize, admit: f64) -> CliResult {
     let mesh = fractal_terrain(side, 2012);
     let triangles = mesh.triangles.len() as f64;
     let t = Instant::now();
-    let encoded = encode(&mesh, &EncodeOptions::default(), |_| {}).map_err(|e| e.to_string())?;
+    let options = EncodeOptions {
+        admit_quantile: admit,
+        ..EncodeOptions::default()
+    };
+    let encoded = encode(&mesh, &options, |_| {}).map_err(|e| e.to_string())?;
     let seconds = t.elapsed().as_secs_f64();
     println!(
         "- encode end to end: {:.2} s for {} triangles = {:.3} M triangles/s ({} rounds; simplify {:.2} s, emit {:.2} s; {} threads)",

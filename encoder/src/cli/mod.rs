@@ -119,6 +119,15 @@ pub enum Command {
         /// Only sizes and throughput.
         #[arg(long)]
         skip_quality: bool,
+        /// Fraction of candidate collapses admitted per step (0..1].
+        #[arg(long, default_value_t = 0.5)]
+        admit: f64,
+        /// Only inputs whose name contains this.
+        #[arg(long)]
+        only: Option<String>,
+        /// Skip the synthetic-terrain throughput run.
+        #[arg(long)]
+        skip_throughput: bool,
     },
     /// The main job on a built-in default: generate a terrain, encode it,
     /// decode it level by level and print the level table.
@@ -180,7 +189,17 @@ pub fn run(cli: Cli) -> CliResult {
             data,
             terrain_side,
             skip_quality,
-        } => bench::run(&data, terrain_side, skip_quality),
+            admit,
+            only,
+            skip_throughput,
+        } => bench::run(&bench::Settings {
+            data,
+            terrain_side,
+            skip_quality,
+            admit,
+            only,
+            skip_throughput,
+        }),
         Command::Demo { side, output } => demo::run(side, output.as_deref()),
     }
 }

@@ -162,7 +162,9 @@ pub fn simplify(
         let edge = mean_edge_length(&s);
         let scale = Scale {
             cell: options.subgrid_cells * edge,
-            flat: 1e-6 * edge * edge,
+            // A collapse moving the surface by 1e-4 of an edge length or less
+            // (error ~ area x distance^2 ~ L^2 x (1e-4 L)^2) counts as flat.
+            flat: 1e-8 * edge.powi(4),
         };
         // Only vertices whose 2-ring changed can have a new best edge.
         best = (0..n as u32)
@@ -190,18 +192,20 @@ pub fn simplify(
         let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
         threshold = threshold.max(*quantile).min(limit);
         let mut winners = step_winners(&s, &mut best, threshold, scale);
-        if winners.is_empty() {
-            // Nothing under S: raise it to the smallest candidate error (the
-            // paper's "S is increased"), unless that passes the maximum.
-            let smallest = errors.iter().copied().fold(f64::INFINITY, f64::min);
-            if smallest > limit || smallest <= threshold && threshold >= limit {
-                break;
-            }
-            threshold = threshold.max(smallest).min(limit);
+        // Nothing under S: raise it (the paper's "S is increased"), doubling
+        // past the smallest candidate error, until a step finds collapses or
+        // S passes every candidate error or the maximum error.
+        let largest = errors.iter().copied().fold(0.0f64, f64::max);
+        let smallest = errors.iter().copied().fold(f64::INFINITY, f64::min);
+        while winners.is_empty() && threshold < limit && threshold < largest {
+            threshold = (2.0 * threshold)
+                .max(smallest)
+                .max(f64::MIN_POSITIVE)
+                .min(limit);
             winners = step_winners(&s, &mut best, threshold, scale);
-            if winners.is_empty() {
-                break;
-            }
+        }
+        if winners.is_empty() {
+            break;
         }
         // Hit the target exactly: keep the cheapest collapses of the last step.
         let room = alive_count - options.target_vertices;
