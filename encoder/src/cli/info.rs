@@ -153,10 +153,10 @@ pub fn run(input: &Path, json: bool) -> CliResult {
         );
     }
     println!("  field            bytes   raw bytes  bits/vertex");
-    for i in 1..12 {
+    for (i, name) in NAMES.iter().enumerate().skip(1) {
         println!(
             "  {:<14} {:>9} {:>11} {:>10.3}",
-            NAMES[i],
+            name,
             sizes.stored[i],
             sizes.raw[i],
             bpv(sizes.stored[i])
