@@ -104,6 +104,11 @@ impl MeshState<'_> {
         }
         self.vertex_count = vertices;
         self.triangle_count = triangles;
+        self.candidates.fill(0);
+        for v in 0..vertices {
+            let d = self.deficit[v as usize];
+            self.set_candidate(v, d);
+        }
         Ok(())
     }
 

@@ -39,6 +39,8 @@ pub struct Decoder<'h, 'ws> {
     next_level: u16,
     levels_that_fit: u16,
     poisoned: bool,
+    /// A level was begun and not completed yet.
+    level_open: bool,
 }
 
 impl<'h, 'ws> Decoder<'h, 'ws> {
@@ -85,6 +87,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
             next_level: 0,
             levels_that_fit: fit,
             poisoned: false,
+            level_open: false,
         })
     }
 
@@ -151,6 +154,11 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
         bytes: &'l [u8],
     ) -> Result<LevelDecoder<'d, 'l, 'ws>, Error> {
         if self.poisoned {
+            return Err(Error::Poisoned);
+        }
+        if self.level_open {
+            // The previous level was dropped half way: its state is mixed.
+            self.poisoned = true;
             return Err(Error::Poisoned);
         }
         if level != self.next_level || level >= self.levels_that_fit {
@@ -271,6 +279,10 @@ fn open_level<'d, 'l, 'ws>(
         ring: &mut decoder.ring,
         next_level: &mut decoder.next_level,
         poisoned: &mut decoder.poisoned,
+        level_open: {
+            decoder.level_open = true;
+            &mut decoder.level_open
+        },
         done: false,
     }
 }
@@ -287,6 +299,7 @@ pub struct LevelDecoder<'d, 'l, 'ws> {
     ring: &'d mut Ring,
     next_level: &'d mut u16,
     poisoned: &'d mut bool,
+    level_open: &'d mut bool,
     done: bool,
 }
 
@@ -350,6 +363,7 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
             return Err(Error::LevelCountMismatch);
         }
         self.done = true;
+        *self.level_open = false;
         *self.next_level += 1;
         Ok(())
     }

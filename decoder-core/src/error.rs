@@ -52,8 +52,11 @@ pub enum Error {
     InvalidPlacement,
     /// API misuse: levels must be fed in order, once each.
     LevelOutOfOrder { expected: u16, got: u16 },
-    /// API misuse: the decoder already returned an error.
+    /// API misuse: the decoder already returned an error, or a level was
+    /// abandoned half way.
     Poisoned,
+    /// API misuse: a vertex index beyond the current vertex count.
+    NoSuchVertex,
 }
 
 /// Which checksum failed (SPEC §3.3, §4.2, §5.1, §5.2).
@@ -88,7 +91,7 @@ impl Error {
             Error::DependentSplits => "dependent-splits",
             Error::NonManifold(_) => "non-manifold",
             Error::PositionOutOfRange => "position-out-of-range",
-            Error::LevelOutOfOrder { .. } | Error::Poisoned => "api-misuse",
+            Error::LevelOutOfOrder { .. } | Error::Poisoned | Error::NoSuchVertex => "api-misuse",
         }
     }
 }
@@ -160,7 +163,11 @@ impl fmt::Display for Error {
             Error::LevelOutOfOrder { expected, got } => {
                 write!(f, "level {got} given where level {expected} was expected")
             }
-            Error::Poisoned => write!(f, "decoder already failed; start a new one"),
+            Error::Poisoned => write!(
+                f,
+                "decoder already failed or a level was abandoned; start a new one"
+            ),
+            Error::NoSuchVertex => write!(f, "vertex index beyond the current vertex count"),
         }
     }
 }

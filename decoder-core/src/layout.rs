@@ -51,7 +51,7 @@ impl Layout {
             4 * opposite_len,
             4 * v,
             v,
-            8 * v.div_ceil(64),
+            2 * 8 * v.div_ceil(64),
             SLOTS as u64 * chunk_buffer_len,
         ];
         let mut ranges = [(0u64, 0u64); 7];

@@ -62,6 +62,9 @@ impl MeshState<'_> {
     /// Fills `ring` with the canonical ring of `r` (SPEC §7.1). Fails with
     /// [`Error::ValenceOverflow`] when the ring is longer than 255.
     pub fn ring(&self, r: u32, ring: &mut Ring) -> Result<(), Error> {
+        if r >= self.vertex_count {
+            return Err(Error::NoSuchVertex);
+        }
         let start = self.vertex_corner[r as usize];
         let mut c = start;
         let mut n = 0usize;

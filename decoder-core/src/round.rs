@@ -40,33 +40,47 @@ impl MeshState<'_> {
         if n as u64 + declared as u64 > self.vertex_capacity() as u64 {
             return Err(Error::CapacityExceeded);
         }
-        let candidates = self.mark_candidates(n);
+        let words = (n as usize).div_ceil(64);
+        // Step 1: the candidates are the vertices below n with deficit 0;
+        // the bitmap is kept up to date by every split (SPEC §7.3).
+        let (candidates, flagged) = self.bitmaps();
         let mut stats = RoundStats {
-            candidates,
+            candidates: candidates[..words].iter().map(|w| w.count_ones()).sum(),
             ..RoundStats::default()
         };
-        // Step 2: one flag per candidate, in ascending order; unflagged ones
-        // leave the set, so the set becomes the round's splits.
-        let words = (n as usize).div_ceil(64);
+        // Step 2: one flag per candidate, in ascending order.
         for w in 0..words {
-            let mut bits = self.candidates[w];
+            let mut bits = candidates[w];
             while bits != 0 {
                 let v = (w * 64) as u32 + bits.trailing_zeros();
                 bits &= bits - 1;
                 if source.flag(v)? {
+                    flagged[w] |= 1u64 << (v % 64);
                     stats.splits += 1;
-                } else {
-                    self.candidates[w] &= !(1u64 << (v % 64));
                 }
             }
         }
         if stats.splits != declared {
+            flagged[..words].fill(0);
             return Err(Error::FlagCountMismatch { round: 0 });
         }
         // Step 3: the splits, in ascending order of the split vertex.
+        let result = self.split_flagged(n, words, source, ring, &mut stats);
+        self.bitmaps().1[..words].fill(0);
+        result.map(|()| stats)
+    }
+
+    fn split_flagged<S: RecordSource>(
+        &mut self,
+        n: u32,
+        words: usize,
+        source: &mut S,
+        ring: &mut Ring,
+        stats: &mut RoundStats,
+    ) -> Result<(), Error> {
         let mut c = n;
         for w in 0..words {
-            let mut bits = self.candidates[w];
+            let mut bits = self.bitmaps().1[w];
             while bits != 0 {
                 let r = (w * 64) as u32 + bits.trailing_zeros();
                 bits &= bits - 1;
@@ -79,34 +93,19 @@ impl MeshState<'_> {
                 c += 1;
             }
         }
-        self.candidates[..words].fill(0);
-        Ok(stats)
-    }
-
-    /// Step 1 (SPEC §7.3): marks every vertex below `n` whose deficit is 0.
-    fn mark_candidates(&mut self, n: u32) -> u32 {
-        let n = n as usize;
-        let mut count = 0;
-        for (w, chunk) in self.deficit[..n].chunks(64).enumerate() {
-            let mut word = 0u64;
-            for (i, &d) in chunk.iter().enumerate() {
-                word |= ((d == 0) as u64) << i;
-            }
-            self.candidates[w] = word;
-            count += word.count_ones();
-        }
-        count
+        Ok(())
     }
 
     /// The independence rule (SPEC §7.2): no neighbour of a split vertex may
     /// be split in the same round. Flagged vertices are still marked; a
     /// vertex created earlier in this round has an index of at least `n`.
     fn check_independent(&self, ring: &Ring, n: u32) -> Result<(), Error> {
+        let flagged = &self.candidates[self.candidates.len() / 2..];
         for &x in ring.vertices() {
             if x == crate::limits::NONE {
                 continue;
             }
-            if x >= n || self.candidates[(x / 64) as usize] & (1u64 << (x % 64)) != 0 {
+            if x >= n || flagged[(x / 64) as usize] & (1u64 << (x % 64)) != 0 {
                 return Err(Error::DependentSplits);
             }
         }

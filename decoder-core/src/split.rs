@@ -93,6 +93,10 @@ impl MeshState<'_> {
         for w in [a, b] {
             if w != NONE && self.deficit[w as usize] != LEAF {
                 self.deficit[w as usize] -= 1;
+                // A wing reaching deficit 0 is a candidate from the next
+                // round on (the round's candidates were fixed at its start).
+                let d = self.deficit[w as usize];
+                self.set_candidate(w, d);
             }
         }
         // X owns arc 1 (from a to b), Y arc 2.
@@ -150,6 +154,8 @@ impl MeshState<'_> {
         self.positions[c as usize] = rec.position_c;
         self.deficit[r as usize] = rec.deficit_p;
         self.deficit[c as usize] = rec.deficit_c;
+        self.set_candidate(r, rec.deficit_p);
+        self.set_candidate(c, rec.deficit_c);
         self.vertex_count += 1;
         self.triangle_count = next_t;
         Ok(SplitOutcome {

@@ -44,7 +44,8 @@ pub struct StateMemory<'ws> {
     pub opposite: &'ws mut [u32],
     pub vertex_corner: &'ws mut [u32],
     pub deficit: &'ws mut [u8],
-    /// One bit per vertex.
+    /// Two bitmaps of one bit per vertex, one after the other: the current
+    /// candidates (deficit 0) and the vertices flagged in the current round.
     pub candidates: &'ws mut [u64],
 }
 
@@ -83,7 +84,7 @@ impl<'ws> MeshState<'ws> {
 
     /// Largest vertex count the memory holds.
     pub fn vertex_capacity(&self) -> u32 {
-        let by_bits = (self.candidates.len() as u64) * 64;
+        let by_bits = (self.candidates.len() as u64 / 2) * 64;
         let n = self
             .positions
             .len()
@@ -130,9 +131,27 @@ impl<'ws> MeshState<'ws> {
         self.bits
     }
 
-    /// Whether `v` is a leaf.
+    /// Whether `v` is a leaf (`false` for a vertex that does not exist).
     pub fn is_leaf(&self, v: u32) -> bool {
-        self.deficit[v as usize] == LEAF
+        v < self.vertex_count && self.deficit[v as usize] == LEAF
+    }
+
+    /// The candidate bitmap and the flagged bitmap (SPEC §7.3).
+    pub(crate) fn bitmaps(&mut self) -> (&mut [u64], &mut [u64]) {
+        let half = self.candidates.len() / 2;
+        self.candidates.split_at_mut(half)
+    }
+
+    /// Records whether `v` is a candidate (deficit 0) for the next round.
+    #[inline]
+    pub(crate) fn set_candidate(&mut self, v: u32, deficit: u8) {
+        let word = &mut self.candidates[(v / 64) as usize];
+        let bit = 1u64 << (v % 64);
+        if deficit == 0 {
+            *word |= bit;
+        } else {
+            *word &= !bit;
+        }
     }
 
     #[inline]

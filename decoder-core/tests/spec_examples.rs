@@ -113,10 +113,10 @@ fn appendix_a_tetrahedron() {
     );
     assert_eq!(mesh.positions[4], [2, 2, 2]);
     // §9: workspace_bytes of the example.
-    assert_eq!(u64::from_le_bytes(stream[80..88].try_into().unwrap()), 360);
+    assert_eq!(u64::from_le_bytes(stream[80..88].try_into().unwrap()), 368);
     assert_eq!(
         splitstream_decoder_core::Layout::new(5, 6, 4, 4, 4).total,
-        64 + 72 + 120 + 24 + 8 + 8 + 64
+        64 + 72 + 120 + 24 + 8 + 16 + 64
     );
 }
 

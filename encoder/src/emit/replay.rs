@@ -56,7 +56,7 @@ impl Memory {
             opposite: vec![0; (3 * t).max(6 * base_t + base_v + 1)],
             vertex_corner: vec![0; v],
             deficit: vec![0; v],
-            candidates: vec![0; v.div_ceil(64)],
+            candidates: vec![0; 2 * v.div_ceil(64)],
         }
     }
 
