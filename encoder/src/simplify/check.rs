@@ -36,15 +36,20 @@ pub struct CheckScratch {
 /// for a boundary vertex.
 fn neighbours(s: &State, fan: &Fan, out: &mut Vec<u32>) {
     out.clear();
+    // Each neighbour is the next vertex of one corner, except, on a
+    // boundary, the end of the open fan, which is only a previous vertex.
     for &c in &fan.corners {
         out.push(s.table.v(next(c)));
-        out.push(s.table.v(prev(c)));
     }
     if fan.boundary {
+        for &c in &fan.corners {
+            let x = s.table.v(prev(c));
+            if !out.contains(&x) {
+                out.push(x);
+            }
+        }
         out.push(NONE);
     }
-    out.sort_unstable();
-    out.dedup();
 }
 
 /// Checks collapsing `c` into `p` (p < c survives) placed at `target`.
@@ -85,29 +90,14 @@ pub fn check_collapse(
     neighbours(s, &k.fan_c, &mut k.nc);
     // Link condition on the ghost-closed mesh: the common neighbours are
     // exactly the two wings (one may be the ghost).
-    let mut common = 0;
-    let mut union = 0;
-    let (mut i, mut j) = (0, 0);
-    while i < k.np.len() || j < k.nc.len() {
-        let a = k.np.get(i).copied().unwrap_or(u32::MAX);
-        let b = k.nc.get(j).copied().unwrap_or(u32::MAX);
-        let x = a.min(b);
-        if a == b {
-            // NONE (the ghost) sorts last: both at the end means common ghost.
-            if i < k.np.len() && j < k.nc.len() {
-                common += 1;
-            }
-            i += 1;
-            j += 1;
-        } else if a < b {
-            i += 1;
-        } else {
-            j += 1;
-        }
-        if x != p && x != c {
-            union += 1;
-        }
-    }
+    // Short unsorted lists (valences are small): a direct count beats sorting.
+    let common =
+        k.np.iter()
+            .filter(|&&x| x != c && k.nc.contains(&x))
+            .count();
+    let p_side = k.np.iter().filter(|&&x| x != c).count();
+    let c_side = k.nc.iter().filter(|&&x| x != p).count();
+    let union = p_side + c_side - common;
     if common != 2 {
         return Err(());
     }
