@@ -158,8 +158,15 @@ pub fn simplify(
     let mut best = vec![Best::NONE; n];
     let mut dirty = vec![true; n];
     let limit = options.max_error.unwrap_or(f64::INFINITY);
+    // The mean edge length sets the sub-grid and the flat threshold; it
+    // changes slowly, so it is measured again only when a fifth of the
+    // vertices are gone since the last measure (a full pass over the corners).
+    let (mut edge, mut edge_measured_at) = (mean_edge_length(&s), alive_count);
     while alive_count > options.target_vertices {
-        let edge = mean_edge_length(&s);
+        if alive_count * 5 < edge_measured_at * 4 {
+            edge = mean_edge_length(&s);
+            edge_measured_at = alive_count;
+        }
         let scale = Scale {
             cell: options.subgrid_cells * edge,
             // A collapse moving the surface by 1e-4 of an edge length or less
