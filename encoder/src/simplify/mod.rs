@@ -4,6 +4,15 @@
 //! of their 1-ring, so the collapses of a step touch disjoint neighbourhoods
 //! and can be reversed as one round of independent vertex splits.
 //!
+//! The data layout follows the paper's four flat arrays, so the same steps
+//! port to compute kernels: per vertex (Vertex) the quantized position, its
+//! metric copy, the 10-coefficient quadric, the split valence and an alive
+//! flag; per corner (Triangle and its adjacency) the corner table of
+//! `corner_table`; per corner again (Edge) the cached error and merged
+//! position of the edge facing it (`select::EdgeSlot`). The Index array's
+//! job (who was merged into whom, in which order) is the list of
+//! [`Collapse`] records per step.
+//!
 //! Each step is three data-parallel passes over the vertex array (rayon here,
 //! compute kernels later): best edge per vertex (§2 step a, with the sub-grid
 //! tie-break of Fig. 2), reciprocity (step b), local minimum with index
