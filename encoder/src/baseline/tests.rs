@@ -32,73 +32,7 @@ pub fn grid(n: u32, height: impl Fn(f64, f64) -> f64) -> Mesh {
 
 /// A unit icosphere subdivided `levels` times (CCW seen from outside).
 pub fn icosphere(levels: u32) -> Mesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut positions: Vec<[f64; 3]> = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ]
-    .map(normalize)
-    .to_vec();
-    let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    for _ in 0..levels {
-        let mut mids = HashMap::new();
-        let mut mid = |a: u32, b: u32, positions: &mut Vec<[f64; 3]>| {
-            *mids.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                let (p, q) = (positions[a as usize], positions[b as usize]);
-                positions.push(normalize([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
-                positions.len() as u32 - 1
-            })
-        };
-        triangles = triangles
-            .iter()
-            .flat_map(|&[a, b, c]| {
-                let ab = mid(a, b, &mut positions);
-                let bc = mid(b, c, &mut positions);
-                let ca = mid(c, a, &mut positions);
-                [[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]
-            })
-            .collect();
-    }
-    Mesh {
-        positions,
-        triangles,
-    }
-}
-
-fn normalize(p: [f64; 3]) -> [f64; 3] {
-    let l = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-    [p[0] / l, p[1] / l, p[2] / l]
+    crate::input::icosphere(levels as usize)
 }
 
 /// Checks that `mesh` is an oriented manifold: indices in range, no

@@ -17,6 +17,7 @@ mod obj;
 mod off;
 mod ply;
 mod repair;
+mod shapes;
 mod terrain;
 
 use std::path::Path;
@@ -27,6 +28,7 @@ pub use check::{MeshError, MeshStats, check_mesh};
 pub use error::{InputError, SUPPORTED_EXTENSIONS};
 pub use grid::{Grid, grid_to_mesh};
 pub use repair::{RepairReport, repair_mesh};
+pub use shapes::icosphere;
 pub use terrain::fractal_terrain;
 
 /// How to interpret an input file.
