@@ -173,6 +173,7 @@ pub fn simplify(
             // (error ~ area x distance^2 ~ L^2 x (1e-4 L)^2) counts as flat.
             flat: 1e-8 * edge.powi(4),
         };
+        let t_best = std::time::Instant::now();
         // Only vertices whose 2-ring changed can have a new best edge.
         best = (0..n as u32)
             .into_par_iter()
@@ -198,6 +199,7 @@ pub fn simplify(
         let q = ((errors.len() - 1) as f64 * options.admit_quantile.clamp(0.0, 1.0)) as usize;
         let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
         threshold = threshold.max(*quantile).min(limit);
+        let t_select = std::time::Instant::now();
         let mut winners = step_winners(&s, &mut best, threshold, scale);
         // Nothing under S: raise it (the paper's "S is increased"), doubling
         // past the smallest candidate error, until a step finds collapses or
@@ -221,6 +223,7 @@ pub fn simplify(
             winners.truncate(room);
             winners.sort_unstable();
         }
+        let t_apply = std::time::Instant::now();
         let mut collapses = Vec::with_capacity(winners.len());
         let mut fans = [Fan::default(), Fan::default()];
         let mut step_error = 0.0f64;
@@ -230,16 +233,23 @@ pub fn simplify(
             step_error = step_error.max(b.error);
             collapses.push(collapse);
         }
-        if std::env::var_os("SPLITSTREAM_DEBUG").is_some() {
-            eprintln!(
-                "step {}: alive {alive_count}, candidates {}, threshold {threshold:.3e}, collapses {}",
-                steps.len(),
-                errors.len(),
-                winners.len()
-            );
-        }
+        let t_refresh = std::time::Instant::now();
         refresh_edges(&mut s, &winners);
         mark_two_rings(&s, &winners, &mut dirty);
+        if std::env::var_os("SPLITSTREAM_DEBUG").is_some() {
+            let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
+            let now = std::time::Instant::now();
+            eprintln!(
+                "step {}: alive {alive_count}, collapses {}, dirty {}, ms: best {:.1} select {:.1} apply {:.1} refresh {:.1}",
+                steps.len(),
+                winners.len(),
+                dirty.iter().filter(|&&d| d).count(),
+                ms(t_best, t_select),
+                ms(t_select, t_apply),
+                ms(t_apply, t_refresh),
+                ms(t_refresh, now),
+            );
+        }
         alive_count -= collapses.len();
         steps.push(collapses);
         step_errors.push(step_error);
