@@ -430,10 +430,19 @@ fn refresh_edges(s: &mut State, merged: &[u32]) {
         .flat_map_iter(|&r| {
             let mut fan = Fan::default();
             s.table.fan(r, &mut fan);
-            let mut out = Vec::with_capacity(2 * fan.corners.len());
+            let mut out = Vec::with_capacity(4 * fan.corners.len());
             for &c in &fan.corners {
-                for k in [next(c), prev(c)] {
-                    out.push((k, edge_slot(s, k)));
+                // Edge (r, prev c) faces next c and, across it, the opposite
+                // corner: evaluate it once for both. A boundary edge
+                // (r, next c) has no other side and is evaluated on its own.
+                let slot = edge_slot(s, next(c));
+                out.push((next(c), slot));
+                let across = s.table.o(next(c));
+                if across != NONE {
+                    out.push((across, slot));
+                }
+                if s.table.o(prev(c)) == NONE {
+                    out.push((prev(c), edge_slot(s, prev(c))));
                 }
             }
             out
@@ -456,13 +465,10 @@ fn mark_two_rings(s: &State, merged: &[u32], dirty: &mut [bool]) {
             let mut inner = Fan::default();
             let mut out = vec![r];
             s.table.fan(r, &mut fan);
-            for &c in &fan.corners {
-                for x in [s.table.v(next(c)), s.table.v(prev(c))] {
-                    out.push(x);
-                    s.table.fan(x, &mut inner);
-                    out.extend(inner.corners.iter().map(|&k| s.table.v(next(k))));
-                    out.extend(inner.corners.iter().map(|&k| s.table.v(prev(k))));
-                }
+            for x in neighbours_of(s, &fan) {
+                out.push(x);
+                s.table.fan(x, &mut inner);
+                out.extend(neighbours_of(s, &inner));
             }
             out
         })
@@ -470,6 +476,20 @@ fn mark_two_rings(s: &State, merged: &[u32], dirty: &mut [bool]) {
     for v in touched {
         dirty[v as usize] = true;
     }
+}
+
+/// The neighbours of a fan's centre: the next vertex of each corner, and on
+/// a boundary also the previous ones (which adds the end of the open fan).
+fn neighbours_of<'a>(s: &'a State, fan: &'a Fan) -> impl Iterator<Item = u32> + 'a {
+    let ends = if fan.boundary {
+        fan.corners.as_slice()
+    } else {
+        &[]
+    };
+    fan.corners
+        .iter()
+        .map(|&k| s.table.v(next(k)))
+        .chain(ends.iter().map(|&k| s.table.v(prev(k))))
 }
 
 /// Mean length of the live edges, for the sub-grid cell size.
