@@ -54,12 +54,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
     ) -> Result<Self, Error> {
         let header = Header::parse(head)?;
         let table = LevelTable::parse(head, &header)?;
-        let full = layout_for(&header, &table, header.level_count - 1);
-        if full.total != header.workspace_bytes {
-            return Err(Error::InvalidHeader(
-                "declared workspace size differs from SPEC §9",
-            ));
-        }
+        declared_layout(&header, &table)?;
         // The largest prefix of levels whose layout fits the workspace.
         let mut fit = header.level_count;
         let layout = loop {
@@ -367,6 +362,18 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
         *self.next_level += 1;
         Ok(())
     }
+}
+
+/// The layout of the whole stream, checked against the header's declared
+/// `workspace_bytes` (SPEC §9).
+pub fn declared_layout(header: &Header, table: &LevelTable<'_>) -> Result<Layout, Error> {
+    let full = layout_for(header, table, header.level_count - 1);
+    if full.total != header.workspace_bytes {
+        return Err(Error::InvalidHeader(
+            "declared workspace size differs from SPEC §9",
+        ));
+    }
+    Ok(full)
 }
 
 /// Layout for decoding levels `0 ..= last` of a stream (SPEC §9).

@@ -46,7 +46,7 @@ pub mod substream;
 pub mod writer;
 
 pub use bytes::crc32;
-pub use decoder::{Decoder, LevelDecoder, RoundInfo, layout_for};
+pub use decoder::{Decoder, LevelDecoder, RoundInfo, declared_layout, layout_for};
 pub use error::{ChecksumScope, Error};
 pub use hash::Fnv1a;
 pub use header::{Header, PositionMode};

@@ -2,10 +2,13 @@
 //! workspace, and whole-stream decoding to plain vectors.
 
 use alloc::boxed::Box;
-use alloc::vec;
 use alloc::vec::Vec;
 
-use crate::{Decoder, Error, Inflater, workspace_len};
+use crate::{Decoder, Error, Header, Inflater, LevelTable, workspace_len};
+
+/// Largest workspace [`OwnedWorkspace::for_stream`] allocates per byte of
+/// stream.
+pub const MAX_WORKSPACE_PER_STREAM_BYTE: u64 = 1024;
 
 /// A decoded mesh, detached from any workspace.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -26,10 +29,32 @@ pub struct OwnedWorkspace {
 
 impl OwnedWorkspace {
     /// Sized for the whole stream whose head is `head`.
+    ///
+    /// A stream's header could ask for any amount of memory; this refuses
+    /// (with [`Error::CapacityExceeded`]) workspaces more than
+    /// [`MAX_WORKSPACE_PER_STREAM_BYTE`] times the stream's length, far above
+    /// what real streams need (about 11 times for a 1M-vertex terrain), and
+    /// allocations the system refuses. Callers with other needs size a
+    /// workspace themselves (see [`crate::Layout`]).
     pub fn for_stream(head: &[u8]) -> Result<OwnedWorkspace, Error> {
+        let header = Header::parse(head)?;
+        let table = LevelTable::parse(head, &header)?;
+        crate::decoder::declared_layout(&header, &table)?;
         let len = workspace_len(head)?;
+        let limit = table
+            .stream_len()
+            .saturating_mul(MAX_WORKSPACE_PER_STREAM_BYTE)
+            .saturating_add(1 << 20);
+        if len as u64 > limit {
+            return Err(Error::CapacityExceeded);
+        }
+        let mut words = Vec::new();
+        words
+            .try_reserve_exact(len.div_ceil(8))
+            .map_err(|_| Error::CapacityExceeded)?;
+        words.resize(len.div_ceil(8), 0u64);
         Ok(OwnedWorkspace {
-            words: vec![0u64; len.div_ceil(8)],
+            words,
             inflater: Box::new(Inflater::new()),
         })
     }

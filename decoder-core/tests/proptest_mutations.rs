@@ -94,6 +94,12 @@ fn decode_both(stream: &[u8]) -> Result<(), TestCaseError> {
                 .map_err(TestCaseError::fail)?;
         }
         (Err(a), Some(b)) => {
+            // The owned path refuses absurd workspaces (CapacityExceeded)
+            // where the capped no-alloc path finds its buffer too small:
+            // the same class.
+            if *a == Error::CapacityExceeded && matches!(b, Error::WorkspaceTooSmall { .. }) {
+                return Ok(());
+            }
             prop_assert_eq!(*a, b);
             prop_assert!(!a.class().is_empty());
             prop_assert!(!a.to_string().is_empty());

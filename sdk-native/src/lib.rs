@@ -1,4 +1,9 @@
-//! Native SDK for splitstream streams (Rust API and C ABI).
+//! Native SDK for splitstream clients.
 //!
-//! Not built yet: this crate is an empty placeholder in the fixed workspace
-//! layout. It exports nothing, so nothing can mistake it for a working SDK.
+//! So far it holds one piece: [`grid_tile`], a client-side simplifier for
+//! regular elevation tiles (quad-tree split and merge with edge
+//! straightening, after Rishe et al., "Mesh Simplification Algorithm for
+//! Online 3D GIS", 2005). The API is plain Rust; a C ABI will follow.
+#![forbid(unsafe_code)]
+
+pub mod grid_tile;

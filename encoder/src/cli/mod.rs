@@ -4,6 +4,7 @@ mod bench;
 mod decode;
 mod demo;
 mod encode;
+mod grid;
 mod info;
 mod output;
 mod verify;
@@ -129,6 +130,41 @@ pub enum Command {
         #[arg(long)]
         skip_throughput: bool,
     },
+    /// Simplify an elevation grid (.tif .asc .npy .npz) as one tile on the
+    /// client side: quad-tree split/merge with edge straightening, threshold
+    /// min(H/800, Res/25); print facets before/after and the max vertical
+    /// error; write the mesh.
+    Grid {
+        input: PathBuf,
+        /// Viewing height H, in the units of the elevations.
+        #[arg(long, allow_negative_numbers = true)]
+        height: f64,
+        /// Resolution of the neighbouring tile on each side, N,E,S,W (a
+        /// number or - for none; in the units of the spacing, metres with
+        /// --geographic); a coarser one sets that border's threshold.
+        #[arg(long)]
+        neighbour_res: Option<String>,
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// x and y are longitude and latitude in degrees: convert the
+        /// spacing to metres (~111 km per degree, times cos(latitude) for x).
+        #[arg(long)]
+        geographic: bool,
+        /// .npz only: the array with the elevations.
+        #[arg(long)]
+        npz_array: Option<String>,
+        /// Multiply z by this.
+        #[arg(long, default_value_t = 1.0)]
+        z_scale: f64,
+        /// Keep a leftover border corner when removing it would cost more
+        /// than 2 T (a T-junction exactly on the neighbour's edge).
+        #[arg(long)]
+        bounded_border: bool,
+        /// Cut tiles of this many cells a side, time them and compare with
+        /// QEM at the same triangle count (see encoder/BENCHMARKS.md).
+        #[arg(long)]
+        bench: Option<usize>,
+    },
     /// The main job on a built-in default: generate a terrain, encode it,
     /// decode it level by level and print the level table.
     Demo {
@@ -199,6 +235,27 @@ pub fn run(cli: Cli) -> CliResult {
             admit,
             only,
             skip_throughput,
+        }),
+        Command::Grid {
+            input,
+            height,
+            neighbour_res,
+            output,
+            geographic,
+            npz_array,
+            z_scale,
+            bounded_border,
+            bench,
+        } => grid::run(grid::Args {
+            input,
+            height,
+            neighbour_res,
+            output,
+            geographic,
+            npz_array,
+            z_scale,
+            bounded_border,
+            bench,
         }),
         Command::Demo { side, output } => demo::run(side, output.as_deref()),
     }
