@@ -49,13 +49,26 @@ const INPUTS: [Input; 4] = [
     },
 ];
 
-/// What `splitstream bench` measures.
+/// `splitstream bench`'s arguments.
+#[derive(clap::Args)]
 pub struct Settings {
+    /// Folder with the real inputs (encoder/data/fetch.sh).
+    #[arg(long, default_value = "encoder/data/real")]
     pub data: std::path::PathBuf,
+    /// Side of the synthetic terrain for the throughput figures.
+    #[arg(long, default_value_t = 1000)]
     pub terrain_side: usize,
+    /// Only sizes and throughput.
+    #[arg(long)]
     pub skip_quality: bool,
+    /// Fraction of candidate collapses admitted per step (0..1].
+    #[arg(long, default_value_t = 0.5)]
     pub admit: f64,
+    /// Only inputs whose name contains this.
+    #[arg(long)]
     pub only: Option<String>,
+    /// Skip the synthetic-terrain throughput run.
+    #[arg(long)]
     pub skip_throughput: bool,
 }
 

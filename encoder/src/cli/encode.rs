@@ -13,22 +13,53 @@ use splitstream_encoder::quantize::Units;
 
 use super::{CliResult, Codec, Position};
 
+/// `splitstream encode`'s arguments.
+#[derive(clap::Args)]
 pub struct Args {
     pub input: PathBuf,
+    #[arg(short, long)]
     pub output: PathBuf,
+    /// Quantization bits per axis (1..=31).
+    #[arg(long, default_value_t = 14)]
     pub bits: u8,
+    /// Levels of detail, base mesh included.
+    #[arg(long, default_value_t = 5)]
     pub levels: usize,
+    /// Base mesh vertex count (default: vertices / 2^(levels-1)).
+    #[arg(long)]
     pub base_vertices: Option<usize>,
+    #[arg(long, value_enum, default_value_t = Position::Optimal)]
     pub position: Position,
+    /// Largest quadric error a collapse may have.
+    #[arg(long)]
     pub max_error: Option<f64>,
+    #[arg(long, value_enum, default_value_t = Codec::Deflate)]
     pub codec: Codec,
+    /// Largest raw chunk in bytes (bounds decoder buffers).
+    #[arg(long, default_value_t = 16384)]
     pub chunk_size: u32,
+    /// Keep boundary vertices in place (patch borders).
+    #[arg(long)]
     pub lock_boundary: bool,
+    /// Fix what the checker rejects: drop degenerate/duplicate triangles,
+    /// reorient, split non-manifold vertices.
+    #[arg(long)]
     pub repair: bool,
+    /// Write the input vertex id of each decoded vertex, one per line.
+    #[arg(long)]
     pub permutation: Option<PathBuf>,
+    /// .npz only: the array with the elevations.
+    #[arg(long)]
     pub npz_array: Option<String>,
+    /// Multiply z by this (e.g. to match x/y units).
+    #[arg(long, default_value_t = 1.0)]
     pub z_scale: f64,
+    /// Fraction of candidate collapses admitted per step (0..1].
+    #[arg(long, default_value_t = 0.5)]
     pub admit: f64,
+    /// x and y are longitude and latitude in degrees (z in metres):
+    /// errors are measured in metres.
+    #[arg(long)]
     pub geographic: bool,
 }
 

@@ -17,16 +17,37 @@ use splitstream_encoder::simplify::{SimplifyOptions, simplify};
 use super::CliResult;
 use super::output::write_mesh;
 
-/// What `splitstream grid` was asked to do.
+/// `splitstream grid`'s arguments.
+#[derive(clap::Args)]
 pub struct Args {
     pub input: PathBuf,
+    /// Viewing height H, in the units of the elevations.
+    #[arg(long, allow_negative_numbers = true)]
     pub height: f64,
+    /// Resolution of the neighbouring tile on each side, N,E,S,W (a
+    /// number or - for none; in the units of the spacing, metres with
+    /// --geographic); a coarser one sets that border's threshold.
+    #[arg(long)]
     pub neighbour_res: Option<String>,
+    #[arg(short, long)]
     pub output: Option<PathBuf>,
+    /// x and y are longitude and latitude in degrees: convert the
+    /// spacing to metres (~111 km per degree, times cos(latitude) for x).
+    #[arg(long)]
     pub geographic: bool,
+    /// .npz only: the array with the elevations.
+    #[arg(long)]
     pub npz_array: Option<String>,
+    /// Multiply z by this.
+    #[arg(long, default_value_t = 1.0)]
     pub z_scale: f64,
+    /// Keep a leftover border corner when removing it would cost more
+    /// than 2 T (a T-junction exactly on the neighbour's edge).
+    #[arg(long)]
     pub bounded_border: bool,
+    /// Cut tiles of this many cells a side, time them and compare with
+    /// QEM at the same triangle count (see encoder/BENCHMARKS.md).
+    #[arg(long)]
     pub bench: Option<usize>,
 }
 
