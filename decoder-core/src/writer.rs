@@ -112,6 +112,45 @@ pub struct SeedPayload {
     pub substreams: Vec<SubstreamWriter>,
 }
 
+impl SeedPayload {
+    /// The seed substreams of SPEC §6.3: positions as zigzag deltas from the
+    /// previous vertex, triangles as varints, one deficit byte per vertex.
+    pub fn new(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> SeedPayload {
+        let mut substreams = vec![SubstreamWriter::default(); 3];
+        let mut previous = [0i64; 3];
+        for p in positions {
+            for k in 0..3 {
+                substreams[0].signed((p[k] as i64 - previous[k]) as i32);
+                previous[k] = p[k] as i64;
+            }
+        }
+        for t in triangles {
+            for &v in t {
+                substreams[1].varint(v);
+            }
+        }
+        for &d in deficits {
+            substreams[2].byte(d);
+        }
+        SeedPayload {
+            vertices: positions.len() as u32,
+            triangles: triangles.len() as u32,
+            substreams,
+        }
+    }
+
+    /// This seed as a level 0 without rounds, for [`write_stream`].
+    pub fn into_level(self, geometric_error: f32) -> LevelPayload {
+        LevelPayload {
+            round_splits: Vec::new(),
+            vertex_count: self.vertices,
+            triangle_count: self.triangles,
+            substreams: self.substreams,
+            geometric_error,
+        }
+    }
+}
+
 /// Frames a base level (seed mesh only) and refinement levels.
 pub fn write_stream(params: &StreamParams, levels: &[LevelPayload]) -> Vec<u8> {
     let base = &levels[0];

@@ -4,7 +4,7 @@
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+    ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
 use splitstream_decoder_core::{Error, PositionMode};
 
@@ -19,30 +19,8 @@ fn params(codec: ChunkCodec) -> StreamParams {
     }
 }
 
-fn base(positions: &[[i32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
-    let mut subs = vec![SubstreamWriter::default(); 3];
-    let mut prev = [0i32; 3];
-    for p in positions {
-        for k in 0..3 {
-            subs[0].signed(p[k] - prev[k]);
-        }
-        prev = *p;
-    }
-    for t in triangles {
-        for &v in t {
-            subs[1].varint(v);
-        }
-    }
-    for &d in deficits {
-        subs[2].byte(d);
-    }
-    LevelPayload {
-        round_splits: vec![],
-        substreams: subs,
-        vertex_count: positions.len() as u32,
-        triangle_count: triangles.len() as u32,
-        geometric_error: 1.0,
-    }
+fn base(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
+    SeedPayload::new(positions, triangles, deficits).into_level(1.0)
 }
 
 /// One optimal-mode split record: o, d, q, deficits, edge vector, midpoint offset.

@@ -6,7 +6,7 @@ use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
+    ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
 
 /// 8 bits per axis, unit scale, 4-byte chunks: every substream spans chunks.
@@ -21,32 +21,10 @@ pub fn params(codec: ChunkCodec) -> StreamParams {
     }
 }
 
-/// A base level holding only a seed mesh (ids 9..=11): delta-coded
-/// positions, triangles, deficits; `write_stream` frames it as level 0.
-pub fn base(positions: &[[i32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
-    let mut subs = vec![SubstreamWriter::default(); 3];
-    let mut prev = [0i32; 3];
-    for p in positions {
-        for k in 0..3 {
-            subs[0].signed(p[k] - prev[k]);
-        }
-        prev = *p;
-    }
-    for t in triangles {
-        for &v in t {
-            subs[1].varint(v);
-        }
-    }
-    for &d in deficits {
-        subs[2].byte(d);
-    }
-    LevelPayload {
-        round_splits: vec![],
-        substreams: subs,
-        vertex_count: positions.len() as u32,
-        triangle_count: triangles.len() as u32,
-        geometric_error: 1.0,
-    }
+/// A base level holding only a seed mesh (ids 9..=11); `write_stream`
+/// frames it as level 0.
+pub fn base(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
+    SeedPayload::new(positions, triangles, deficits).into_level(1.0)
 }
 
 /// Replaces substream `index` of `level` by raw bytes.
@@ -136,7 +114,7 @@ pub fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> 
     }
 }
 
-pub const TETRA_POSITIONS: [[i32; 3]; 4] = [[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]];
+pub const TETRA_POSITIONS: [[u32; 3]; 4] = [[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]];
 pub const TETRA_TRIANGLES: [[u32; 3]; 4] = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
 
 /// The tetrahedron of SPEC Appendix A, vertex 0 a candidate.

@@ -152,29 +152,7 @@ pub fn bases() -> Vec<BaseMesh> {
 
 /// The base level (substreams 9..=11) of `base` with `deficits`.
 pub fn base_level(base: &BaseMesh, deficits: &[u8]) -> LevelPayload {
-    let mut subs = vec![SubstreamWriter::default(); 3];
-    let mut prev = [0i64; 3];
-    for p in &base.positions {
-        for k in 0..3 {
-            subs[0].signed((p[k] as i64 - prev[k]) as i32);
-            prev[k] = p[k] as i64;
-        }
-    }
-    for t in &base.triangles {
-        for &v in t {
-            subs[1].varint(v);
-        }
-    }
-    for &d in deficits {
-        subs[2].byte(d);
-    }
-    LevelPayload {
-        round_splits: vec![],
-        substreams: subs,
-        vertex_count: base.positions.len() as u32,
-        triangle_count: base.triangles.len() as u32,
-        geometric_error: 1.0,
-    }
+    SeedPayload::new(&base.positions, &base.triangles, deficits).into_level(1.0)
 }
 
 /// A generated stream with what a decoder must see.

@@ -6,28 +6,19 @@ use super::*;
 
 /// An `n` x `n` vertex grid on [0, 1]², heights from `height`.
 pub fn grid(n: u32, height: impl Fn(f64, f64) -> f64) -> Mesh {
-    let mut positions = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            let (x, y) = (
-                f64::from(i) / f64::from(n - 1),
-                f64::from(j) / f64::from(n - 1),
-            );
-            positions.push([x, y, height(x, y)]);
-        }
-    }
-    let mut triangles = Vec::new();
-    for j in 0..n - 1 {
-        for i in 0..n - 1 {
-            let v = j * n + i;
-            triangles.push([v, v + 1, v + n + 1]);
-            triangles.push([v, v + n + 1, v + n]);
-        }
-    }
-    Mesh {
-        positions,
-        triangles,
-    }
+    let step = 1.0 / f64::from(n - 1);
+    let elevations = (0..n * n)
+        .map(|k| height(f64::from(k % n) * step, f64::from(k / n) * step))
+        .collect();
+    let n = n as usize;
+    crate::input::grid_to_mesh(&crate::input::Grid {
+        rows: n,
+        cols: n,
+        elevations,
+        origin: [0.0, 0.0],
+        spacing: [step, step],
+        nodata: None,
+    })
 }
 
 /// A unit icosphere subdivided `levels` times (CCW seen from outside).

@@ -8,6 +8,7 @@ use super::output::write_mesh;
 use super::{CliResult, read_file};
 
 pub fn run(input: &Path, output: &Path, level: Option<u16>) -> CliResult {
+    super::output::mesh_extension(output)?;
     let stream = read_file(input)?;
     let fail = |e: splitstream_decoder_core::Error| format!("{}: {e}", input.display());
     let mut ws = OwnedWorkspace::for_stream(&stream).map_err(fail)?;

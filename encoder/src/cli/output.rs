@@ -3,6 +3,22 @@
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
+/// The output format of `path`, or an error naming it, so commands can
+/// refuse a bad output before doing their work.
+pub fn mesh_extension(path: &Path) -> Result<String, String> {
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    match ext.as_str() {
+        "ply" | "obj" => Ok(ext),
+        _ => Err(format!(
+            "{}: output must end in .ply or .obj",
+            path.display()
+        )),
+    }
+}
+
 /// Writes `positions` and `triangles` to `path`, format chosen by extension.
 pub fn write_mesh(
     path: &Path,
@@ -10,10 +26,7 @@ pub fn write_mesh(
     triangles: &[[u32; 3]],
 ) -> Result<(), String> {
     let name = path.display();
-    let ext = path
-        .extension()
-        .map(|e| e.to_string_lossy().to_ascii_lowercase())
-        .unwrap_or_default();
+    let ext = mesh_extension(path)?;
     let file = std::fs::File::create(path).map_err(|e| format!("{name}: {e}"))?;
     let mut w = BufWriter::new(file);
     let io = |e: std::io::Error| format!("{name}: {e}");

@@ -253,37 +253,19 @@ pub fn replay(
     let (v0, t0) = (dec2enc.len(), base_triangles.len());
     let mut memory = Memory::new(n, t_total, v0, t0);
     let mut state = memory.state(mesh.bits);
-    let mut base_subs = vec![SubstreamWriter::default(); 3];
+    let base_positions: Vec<[u32; 3]> = dec2enc.iter().map(|&e| s.positions[e as usize]).collect();
     {
         let (positions, corners, deficits) = state.base_arrays();
-        let mut previous = [0i64; 3];
-        for (d, &e) in dec2enc.iter().enumerate() {
-            let p = s.positions[e as usize];
-            positions[d] = p;
-            for k in 0..3 {
-                base_subs[0].signed((p[k] as i64 - previous[k]) as i32);
-                previous[k] = p[k] as i64;
-            }
-        }
+        positions[..v0].copy_from_slice(&base_positions);
         for (i, t) in base_triangles.iter().enumerate() {
             corners[3 * i..3 * i + 3].copy_from_slice(t);
-            for &v in t {
-                base_subs[1].varint(v);
-            }
         }
-        for (d, &x) in base_deficits.iter().enumerate() {
-            deficits[d] = x;
-            base_subs[2].byte(x);
-        }
+        deficits[..v0].copy_from_slice(&base_deficits);
     }
     state
         .finish_base(v0 as u32, t0 as u32)
         .map_err(|e| ReplayError(format!("base mesh rejected by the decoder: {e}")))?;
-    let seed = SeedPayload {
-        vertices: v0 as u32,
-        triangles: t0 as u32,
-        substreams: base_subs,
-    };
+    let seed = SeedPayload::new(&base_positions, &base_triangles, &base_deficits);
     let mut levels = Vec::with_capacity(plan.rounds.len());
     let mut current = vec![NONE; n];
     let mut ring = Ring::default();

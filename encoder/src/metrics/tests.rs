@@ -2,25 +2,17 @@
 
 use super::*;
 
+/// An `n` x `n` unit-spaced grid at height `z`.
 fn grid(n: u32, z: f64) -> Mesh {
-    let mut positions = Vec::new();
-    for j in 0..n {
-        for i in 0..n {
-            positions.push([f64::from(i), f64::from(j), z]);
-        }
-    }
-    let mut triangles = Vec::new();
-    for j in 0..n - 1 {
-        for i in 0..n - 1 {
-            let v = j * n + i;
-            triangles.push([v, v + 1, v + n + 1]);
-            triangles.push([v, v + n + 1, v + n]);
-        }
-    }
-    Mesh {
-        positions,
-        triangles,
-    }
+    let n = n as usize;
+    crate::input::grid_to_mesh(&crate::input::Grid {
+        rows: n,
+        cols: n,
+        elevations: vec![z; n * n],
+        origin: [0.0, 0.0],
+        spacing: [1.0, 1.0],
+        nodata: None,
+    })
 }
 
 #[test]
