@@ -35,12 +35,26 @@ pub const BUILTINS: &[Builtin] = &[
         hidden: false,
         decode: decoder_core,
     },
-    // Later: "c-abi" (sdk-native), "wasm" (sdk-wasm), "wgpu" and "opencl" (kernels).
+    #[cfg(feature = "gpu")]
     Builtin {
-        name: "broken-config",
-        summary: "test only: decoder-core's pieces driven by hand with every configuration bit inverted; must fail",
+        name: "wgpu",
+        summary: "decoder-core reads the stream, the rounds run on a wgpu device (sdk-native gpu, kernels' decoder); the GPU's hashes",
+        hidden: false,
+        decode: crate::builtin_gpu::wgpu,
+    },
+    #[cfg(feature = "opencl")]
+    Builtin {
+        name: "opencl",
+        summary: "as wgpu, with the rounds on an OpenCL device (the kernels' OpenCL C port)",
+        hidden: false,
+        decode: crate::builtin_gpu::opencl,
+    },
+    // Later: "c-abi" (sdk-native), "wasm" (sdk-wasm).
+    Builtin {
+        name: "broken-swap",
+        summary: "test only: decoder-core's pieces driven by hand with the positions of P and C swapped in every split; must fail",
         hidden: true,
-        decode: broken_config,
+        decode: broken_swap,
     },
 ];
 
@@ -91,39 +105,39 @@ pub fn decoder_core(stream: &[u8]) -> Outcome {
     finish(hashes, result)
 }
 
-fn broken_config(stream: &[u8]) -> Outcome {
+fn broken_swap(stream: &[u8]) -> Outcome {
     decode_by_pieces(stream, true)
 }
 
-/// Inverts the configuration bit of every split record it passes on.
-struct FlipConfig<S>(S);
+/// Swaps the positions of P and C in every split record it passes on.
+struct SwapPositions<S>(S);
 
-impl<S: RecordSource> RecordSource for FlipConfig<S> {
-    fn flag(&mut self, v: u32) -> Result<bool, Error> {
-        self.0.flag(v)
+impl<S: RecordSource> RecordSource for SwapPositions<S> {
+    fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
+        self.0.flag(state, v)
     }
 
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let mut record = self.0.record(state, r, ring)?;
-        record.config = !record.config;
+        core::mem::swap(&mut record.position_p, &mut record.position_c);
         Ok(record)
     }
 }
 
 /// Decodes with decoder-core's public pieces, in the order of SPEC §10.3
-/// (the order `Decoder` uses); with `flip_config`, every split record's
-/// configuration bit is inverted. Without it this must agree with
+/// (the order `Decoder` uses); with `broken`, every split record's P and C
+/// positions are swapped. Without it this must agree with
 /// [`decoder_core`] on every vector (a test checks it), except that it
 /// reports the seed mesh's hash right after the seed as SPEC §8 says, also
 /// when level 0 has no rounds and then fails its end-of-level checks, where
 /// `Decoder` (which completes such a level inside `begin_level`) reports none.
-pub fn decode_by_pieces(stream: &[u8], flip_config: bool) -> Outcome {
+pub fn decode_by_pieces(stream: &[u8], broken: bool) -> Outcome {
     let mut hashes = Vec::new();
-    let result = pieces(stream, flip_config, &mut hashes);
+    let result = pieces(stream, broken, &mut hashes);
     finish(hashes, result)
 }
 
-fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(), Error> {
+fn pieces(stream: &[u8], broken: bool, hashes: &mut Vec<u64>) -> Result<(), Error> {
     let header = Header::parse(stream)?;
     let table = LevelTable::parse(stream, &header)?;
     let layout = layout_for(&header, &table, header.level_count - 1);
@@ -170,7 +184,7 @@ fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(),
         state.set_triangle_limit(info.triangle_count);
         let rounds = level_header.round_count;
         if is_base {
-            // SPEC §6.3: the seed mesh (substreams 9..=11) comes first.
+            // SPEC §6.3: the seed mesh (substreams 8..=10) comes first.
             let slots = buffers.each_mut().map(|b| &mut **b);
             let mut seed = Substreams::open(
                 bytes,
@@ -178,6 +192,7 @@ fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(),
                 substream::BASE_POSITIONS,
                 slots,
                 &mut inflater,
+                header.lane_count,
             );
             let (v, t) = (level_header.seed_vertices, level_header.seed_triangles);
             read_base(&mut state, &mut seed, v, t)?;
@@ -186,16 +201,22 @@ fn pieces(stream: &[u8], flip_config: bool, hashes: &mut Vec<u64>) -> Result<(),
             hashes.push(state.state_hash());
         }
         let slots = buffers.each_mut().map(|b| &mut **b);
-        let mut subs =
-            Substreams::open(bytes, level_header, substream::FLAGS, slots, &mut inflater);
+        let mut subs = Substreams::open(
+            bytes,
+            level_header,
+            substream::FLAGS,
+            slots,
+            &mut inflater,
+            header.lane_count,
+        );
         for r in 0..rounds {
             let declared = level_header.split_count(r);
             let source = StreamSource {
                 subs: &mut subs,
                 mode: header.position_mode,
             };
-            let result = if flip_config {
-                state.run_round(declared, &mut FlipConfig(source), &mut ring)
+            let result = if broken {
+                state.run_round(declared, &mut SwapPositions(source), &mut ring)
             } else {
                 let mut source = source;
                 state.run_round(declared, &mut source, &mut ring)

@@ -4,6 +4,8 @@
 //! runner ([`runner`]). See conformance/README.md.
 
 pub mod builtin;
+#[cfg(feature = "gpu")]
+pub mod builtin_gpu;
 pub mod generate;
 pub mod manifest;
 pub mod protocol;

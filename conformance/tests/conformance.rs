@@ -51,7 +51,7 @@ fn run(args: &[&str]) -> (bool, String) {
 #[test]
 fn manifest_matches_the_files() {
     let m = manifest();
-    assert_eq!(m.format_version, "1.0");
+    assert_eq!(m.format_version, "2.0");
     let mut names = BTreeSet::new();
     let mut total = 0;
     for v in &m.vectors {
@@ -94,7 +94,6 @@ fn every_error_class_is_covered() {
         "count-mismatch",
         "ring-offset-out-of-range",
         "valence-overflow",
-        "dependent-splits",
         "non-manifold",
         "position-out-of-range",
     ] {
@@ -164,14 +163,14 @@ fn run_without_arguments_runs_the_builtins() {
     assert_eq!((passed, failed), (manifest().vectors.len(), 0));
     assert!(out.contains("decoder-core"));
     assert!(
-        !out.contains("broken-config"),
+        !out.contains("broken-swap"),
         "test-only decoders are hidden"
     );
 }
 
 #[test]
-fn broken_config_is_caught() {
-    let (ok, out) = run(&["run", "--builtin", "broken-config"]);
+fn broken_swap_is_caught() {
+    let (ok, out) = run(&["run", "--builtin", "broken-swap"]);
     assert!(!ok, "the runner must exit non-zero:\n{out}");
     let (passed, failed) = summary_line(&out);
     assert!(failed > 0 && passed > 0, "{out}");

@@ -16,11 +16,11 @@ mod streams;
 
 use std::path::PathBuf;
 
-use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
+use splitstream_decoder_core::{PositionMode, context};
 use streams::{BaseMesh, Choices};
 
 fn params(codec: ChunkCodec) -> StreamParams {
@@ -36,16 +36,18 @@ fn params(codec: ChunkCodec) -> StreamParams {
 
 /// One optimal-mode split record level (as in tests/handmade.rs).
 fn one_split(o: u8, d: u8, e: [i32; 3], m: [i32; 3], v: u32, t: u32) -> LevelPayload {
-    let mut s = vec![SubstreamWriter::default(); 8];
+    // Rings of 3 here: the rANS contexts follow (SPEC §5.5.5).
+    let mut s = vec![SubstreamWriter::default(); 7];
     s[0].bit(true);
     s[1].byte(o);
-    s[2].byte(d);
-    s[3].bit(false);
-    s[4].byte(LEAF);
-    s[5].byte(LEAF);
-    for k in 0..3 {
-        s[6].signed(e[k]);
-        s[7].signed(m[k]);
+    s[2].byte_in(context::wing_distance(3), d);
+    s[3].byte(LEAF);
+    s[4].byte_in(context::deficit_c(LEAF), LEAF);
+    for (k, &x) in e.iter().enumerate() {
+        s[5].signed_in(context::axis(k), x);
+    }
+    for (k, &x) in m.iter().enumerate() {
+        s[6].signed_in(context::axis(k), x);
     }
     LevelPayload {
         round_splits: vec![1],
@@ -64,26 +66,33 @@ pub fn handmade() -> Vec<(&'static str, Vec<u8>)> {
     let tetra = streams::base_level(&streams::tetrahedron(), &[0, LEAF, LEAF, LEAF]);
     let tri = streams::base_level(&streams::triangle(), &[0, LEAF, LEAF]);
     let octa: BaseMesh = streams::octahedron();
-    vec![
+    let streams = vec![
         (
             "tetrahedron_stored",
             write_stream(
                 &params(ChunkCodec::Stored),
-                &[tetra.clone(), one_split(0, 1, [2; 3], [-1; 3], 5, 6)],
+                &[tetra.clone(), one_split(0, 1, [2; 3], [4; 3], 5, 6)],
             ),
         ),
         (
             "tetrahedron_deflate",
             write_stream(
                 &params(ChunkCodec::Deflate(9)),
-                &[tetra, one_split(0, 1, [2; 3], [-1; 3], 5, 6)],
+                &[tetra.clone(), one_split(0, 1, [2; 3], [4; 3], 5, 6)],
+            ),
+        ),
+        (
+            "tetrahedron_rans",
+            write_stream(
+                &params(ChunkCodec::RansAlways { lanes: 2 }),
+                &[tetra, one_split(0, 1, [2; 3], [4; 3], 5, 6)],
             ),
         ),
         (
             "triangle_boundary",
             write_stream(
                 &params(ChunkCodec::Stored),
-                &[tri, one_split(0, 1, [0, 4, 0], [0, -2, 0], 4, 2)],
+                &[tri, one_split(0, 1, [0, 4, 0], [3, 5, 0], 4, 2)],
             ),
         ),
         (
@@ -93,7 +102,13 @@ pub fn handmade() -> Vec<(&'static str, Vec<u8>)> {
                 &[streams::base_level(&octa, &[LEAF; 6])],
             ),
         ),
-    ]
+    ];
+    for (name, stream) in &streams {
+        if let Err(e) = splitstream_decoder_core::owned::decode_all(stream, false) {
+            panic!("hand-made seed {name} does not decode: {e}");
+        }
+    }
+    streams
 }
 
 fn main() {

@@ -172,7 +172,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
         };
         self.state.set_triangle_limit(info.triangle_count);
         if level == 0 {
-            // The seed mesh first (ids 9..=11), then the level's rounds.
+            // The seed mesh first (ids 8..=10), then the level's rounds.
             let buffers = self.buffers.each_mut().map(|b| &mut **b);
             let mut subs = Substreams::open(
                 bytes,
@@ -180,6 +180,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
                 substream::BASE_POSITIONS,
                 buffers,
                 self.inflater,
+                self.header.lane_count,
             );
             let seed = (header.seed_vertices, header.seed_triangles);
             if let Err(e) = read_base(&mut self.state, &mut subs, seed.0, seed.1) {
@@ -262,7 +263,15 @@ fn open_level<'d, 'l, 'ws>(
     bytes: &'l [u8],
 ) -> LevelDecoder<'d, 'l, 'ws> {
     let buffers = decoder.buffers.each_mut().map(|b| &mut **b);
-    let subs = Substreams::open(bytes, header, substream::FLAGS, buffers, decoder.inflater);
+    let lanes = decoder.header.lane_count;
+    let subs = Substreams::open(
+        bytes,
+        header,
+        substream::FLAGS,
+        buffers,
+        decoder.inflater,
+        lanes,
+    );
     LevelDecoder {
         level,
         info,

@@ -38,12 +38,16 @@ pub enum Error {
     LevelCountMismatch,
     /// §5.4: a varint longer than 5 bytes, over 32 bits, or not minimal.
     InvalidVarint(u8),
+    /// §5.5: a rANS chunk's tables or lanes are malformed, or a lane did not
+    /// end exactly where its chunk ends.
+    InvalidRansChunk(&'static str),
+    /// §5.5: a rANS-coded value too large for its field (a bit above 1, a
+    /// byte above 255), in the substream with this id.
+    ValueOutOfRange(u8),
     /// §7.4: a wing offset or distance outside the ring of the split vertex.
     RingOffsetOutOfRange,
     /// §6.2, §7.5: a valence above its split valence or above 255.
     ValenceOverflow,
-    /// §7.2: two flagged candidates of one round are adjacent.
-    DependentSplits,
     /// §6.3: the base mesh is not a consistently oriented 2-manifold.
     NonManifold(&'static str),
     /// §6.3, §7.4: a decoded coordinate outside `0 .. 2^bits`.
@@ -81,6 +85,8 @@ impl Error {
             | Error::InvalidLevelHeader(_)
             | Error::CorruptChunk
             | Error::InvalidVarint(_)
+            | Error::InvalidRansChunk(_)
+            | Error::ValueOutOfRange(_)
             | Error::InvalidPlacement => "malformed",
             Error::CapacityExceeded | Error::WorkspaceTooSmall { .. } => "capacity-exceeded",
             Error::FlagCountMismatch { .. }
@@ -88,7 +94,6 @@ impl Error {
             | Error::LevelCountMismatch => "count-mismatch",
             Error::RingOffsetOutOfRange => "ring-offset-out-of-range",
             Error::ValenceOverflow => "valence-overflow",
-            Error::DependentSplits => "dependent-splits",
             Error::NonManifold(_) => "non-manifold",
             Error::PositionOutOfRange => "position-out-of-range",
             Error::LevelOutOfOrder { .. } | Error::Poisoned | Error::NoSuchVertex => "api-misuse",
@@ -110,7 +115,7 @@ impl fmt::Display for Error {
             Error::UnsupportedVersion { major, minor } => {
                 write!(
                     f,
-                    "unsupported format version {major}.{minor} (this decoder reads 1.x)"
+                    "unsupported format version {major}.{minor} (this decoder reads 2.x)"
                 )
             }
             Error::InvalidHeader(what) => write!(f, "invalid header: {what}"),
@@ -150,11 +155,18 @@ impl fmt::Display for Error {
             Error::InvalidVarint(id) => {
                 write!(f, "substream {}: invalid varint", substream_name(*id))
             }
+            Error::InvalidRansChunk(what) => write!(f, "invalid rANS chunk: {what}"),
+            Error::ValueOutOfRange(id) => {
+                write!(
+                    f,
+                    "substream {}: value out of its field's range",
+                    substream_name(*id)
+                )
+            }
             Error::RingOffsetOutOfRange => {
                 write!(f, "wing offset outside the ring of the split vertex")
             }
             Error::ValenceOverflow => write!(f, "a valence exceeds its split valence or 255"),
-            Error::DependentSplits => write!(f, "two adjacent vertices split in the same round"),
             Error::NonManifold(what) => write!(f, "base mesh is not a 2-manifold: {what}"),
             Error::PositionOutOfRange => {
                 write!(f, "decoded position outside the quantization grid")

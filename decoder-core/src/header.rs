@@ -3,6 +3,7 @@
 use crate::bytes::{crc32, f64_at, u8_at, u16_at, u32_at, u64_at};
 use crate::limits::{
     HEADER_LEN, MAGIC, MAX_BITS, MAX_TRIANGLES, MAX_VERTICES, MIN_BITS, VERSION_MAJOR,
+    rans::MAX_LANES,
 };
 use crate::{ChecksumScope, Error};
 
@@ -28,6 +29,8 @@ pub struct Header {
     pub vertex_capacity: u32,
     /// Triangle count after the last level.
     pub triangle_capacity: u32,
+    /// Independent rANS lanes per chunk (SPEC §5.5), 1..=32.
+    pub lane_count: u8,
     /// Largest raw (decompressed) chunk length in the stream.
     pub max_chunk_len: u32,
     /// Real coordinate of quantized value 0 on each axis.
@@ -71,8 +74,12 @@ impl Header {
         if !(MIN_BITS..=MAX_BITS).contains(&bits) {
             return Err(Error::InvalidHeader("bits per axis outside 1..=31"));
         }
-        if u8_at(bytes, 13)? != 0 || u32_at(bytes, 28)? != 0 || u32_at(bytes, 88)? != 0 {
+        if u32_at(bytes, 28)? != 0 || u32_at(bytes, 88)? != 0 {
             return Err(Error::InvalidHeader("reserved field not zero"));
+        }
+        let lane_count = u8_at(bytes, 13)?;
+        if !(1..=MAX_LANES).contains(&lane_count) {
+            return Err(Error::InvalidHeader("lane count outside 1..=32"));
         }
         let level_count = u16_at(bytes, 14)?;
         if level_count == 0 {
@@ -107,6 +114,7 @@ impl Header {
             version_minor: minor,
             position_mode,
             bits,
+            lane_count,
             level_count,
             vertex_capacity,
             triangle_capacity,
@@ -131,6 +139,7 @@ impl Header {
         };
         out[10..12].copy_from_slice(&flags.to_le_bytes());
         out[12] = self.bits;
+        out[13] = self.lane_count;
         out[14..16].copy_from_slice(&self.level_count.to_le_bytes());
         out[16..20].copy_from_slice(&self.vertex_capacity.to_le_bytes());
         out[20..24].copy_from_slice(&self.triangle_capacity.to_le_bytes());

@@ -4,7 +4,12 @@
 //! no allocation, and one number for the caller to size.
 
 use crate::Error;
+use crate::limits::rans::{MAX_LANES, TABLE_WORDS};
 use crate::limits::substream::SLOTS;
+use crate::rans::LANE_WORDS;
+
+/// Bytes of a substream slot under rANS: tables, then the lanes (SPEC §9).
+pub const RANS_SLOT_BYTES: u64 = 4 * (TABLE_WORDS + LANE_WORDS * MAX_LANES as usize) as u64;
 use crate::state::{MeshState, StateMemory};
 
 /// Alignment of every region, and of the buffer start the layout assumes.
@@ -44,14 +49,15 @@ impl Layout {
             3 * base_triangles as u64
                 + MeshState::base_scratch_len(base_vertices, base_triangles) as u64,
         );
-        let chunk_buffer_len = round_up(max_chunk_len as u64);
+        // A slot holds a byte-codec chunk, or a rANS chunk's tables and lanes.
+        let chunk_buffer_len = round_up((max_chunk_len as u64).max(RANS_SLOT_BYTES));
         let sizes = [
             12 * v,
             12 * t,
             4 * opposite_len,
             4 * v,
             v,
-            2 * 8 * v.div_ceil(64),
+            3 * 8 * v.div_ceil(64),
             SLOTS as u64 * chunk_buffer_len,
         ];
         let mut ranges = [(0u64, 0u64); 7];

@@ -78,6 +78,7 @@ impl<'l> LevelHeader<'l> {
             substream::FLAGS..=substream::PLACEMENT
         };
         let mut previous_id = 0u8;
+        let mut previous_rans = false;
         let mut payload = self.payload_start as u64;
         for k in 0..self.chunk_count {
             let e = self.chunk(k)?;
@@ -89,7 +90,14 @@ impl<'l> LevelHeader<'l> {
             if e.substream < previous_id {
                 return Err(Error::InvalidLevelHeader("chunks not ordered by substream"));
             }
+            let rans = e.codec == codec::RANS;
+            if e.substream == previous_id && rans != previous_rans {
+                return Err(Error::InvalidLevelHeader(
+                    "a substream mixes rANS and byte-codec chunks",
+                ));
+            }
             previous_id = e.substream;
+            previous_rans = rans;
             if e.raw_len == 0 || e.raw_len > max_chunk_len {
                 return Err(Error::InvalidLevelHeader(
                     "chunk raw length 0 or above the header maximum",
@@ -99,7 +107,7 @@ impl<'l> LevelHeader<'l> {
                 codec::STORED if e.stored_len != e.raw_len => {
                     return Err(Error::InvalidLevelHeader("stored chunk lengths differ"));
                 }
-                codec::STORED | codec::DEFLATE => {}
+                codec::STORED | codec::DEFLATE | codec::RANS => {}
                 _ => return Err(Error::InvalidLevelHeader("unknown codec")),
             }
             payload += e.stored_len as u64;

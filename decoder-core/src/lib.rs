@@ -24,6 +24,7 @@ extern crate alloc;
 
 mod base;
 mod bytes;
+pub mod context;
 mod decoder;
 mod error;
 mod hash;
@@ -36,6 +37,9 @@ pub mod limits;
 #[cfg(feature = "alloc")]
 pub mod owned;
 mod predict;
+mod rans;
+#[cfg(feature = "alloc")]
+mod rans_writer;
 pub mod record;
 mod ring;
 mod round;
@@ -54,7 +58,8 @@ pub use inflate::Inflater;
 pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader};
 pub use level_table::{LevelInfo, LevelTable, head_len, write_level_table};
-pub use predict::predict_split;
+pub use predict::{predict_split, refine_c};
+pub use rans::token_of;
 pub use ring::Ring;
 pub use round::{RecordSource, RoundStats};
 pub use split::{SplitOutcome, SplitRecord};

@@ -5,7 +5,7 @@
 pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 
 /// Format version this crate reads and writes (SPEC §1).
-pub const VERSION_MAJOR: u8 = 1;
+pub const VERSION_MAJOR: u8 = 2;
 pub const VERSION_MINOR: u8 = 0;
 
 /// Size of the fixed header in bytes (SPEC §3).
@@ -38,24 +38,24 @@ pub mod substream {
     pub const FLAGS: u8 = 1;
     pub const WING_OFFSET: u8 = 2;
     pub const WING_DISTANCE: u8 = 3;
-    pub const CONFIG: u8 = 4;
-    pub const DEFICIT_P: u8 = 5;
-    pub const DEFICIT_C: u8 = 6;
-    pub const EDGE: u8 = 7;
-    pub const PLACEMENT: u8 = 8;
-    pub const BASE_POSITIONS: u8 = 9;
-    pub const BASE_TRIANGLES: u8 = 10;
-    pub const BASE_DEFICITS: u8 = 11;
+    pub const DEFICIT_P: u8 = 4;
+    pub const DEFICIT_C: u8 = 5;
+    pub const EDGE: u8 = 6;
+    pub const PLACEMENT: u8 = 7;
+    pub const BASE_POSITIONS: u8 = 8;
+    pub const BASE_TRIANGLES: u8 = 9;
+    pub const BASE_DEFICITS: u8 = 10;
     /// Number of substream slots a decoder keeps open at once (refinement
-    /// levels use ids 1..=8, the base level 9..=11 through slots 0..=2).
-    pub const SLOTS: usize = 8;
+    /// levels use ids 1..=7, the base level 8..=10 through slots 0..=2).
+    pub const SLOTS: usize = 7;
+    /// Highest substream id.
+    pub const LAST: u8 = BASE_DEFICITS;
     /// Human-readable names, indexed by id (0 unused).
-    pub const NAMES: [&str; 12] = [
+    pub const NAMES: [&str; 11] = [
         "",
         "flags",
         "wing-offset",
         "wing-distance",
-        "config",
         "deficit-p",
         "deficit-c",
         "edge",
@@ -64,10 +64,35 @@ pub mod substream {
         "base-triangles",
         "base-deficits",
     ];
+    /// Contexts of each substream under the rANS codec (SPEC §5.5), by id.
+    pub const CONTEXTS: [u8; 11] = [0, 1, 1, 8, 1, 4, 3, 3, 3, 1, 1];
 }
 
 /// Chunk codecs (SPEC §5.2).
 pub mod codec {
     pub const STORED: u8 = 0;
     pub const DEFLATE: u8 = 1;
+    pub const RANS: u8 = 2;
+}
+
+/// The rANS codec's constants (SPEC §5.5).
+pub mod rans {
+    /// Frequencies of a distribution sum to `1 << PROB_BITS`.
+    pub const PROB_BITS: u32 = 12;
+    pub const PROB_SCALE: u32 = 1 << PROB_BITS;
+    /// Lower bound of a lane's normalised state; states live in `L .. L << 8`.
+    pub const STATE_LOW: u32 = 1 << 23;
+    /// Tokens of the hybrid integer code: 0..=15 direct, 16..=43 by exponent.
+    pub const TOKENS: usize = 44;
+    /// Values below this are their own token.
+    pub const DIRECT_TOKENS: u32 = 16;
+    /// Raw bits are drawn from a lane at most this many at a time.
+    pub const RAW_BITS_STEP: u32 = 16;
+    /// Most contexts any substream has.
+    pub const MAX_CONTEXTS: usize = 8;
+    /// Most lanes a stream may declare (header byte 13).
+    pub const MAX_LANES: u8 = 32;
+    /// u32 words of one substream's rANS tables: per context the token
+    /// count and the cumulative frequencies (`TOKENS + 1` entries).
+    pub const TABLE_WORDS: usize = MAX_CONTEXTS * (TOKENS + 2);
 }

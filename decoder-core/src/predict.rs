@@ -9,23 +9,26 @@ use crate::limits::NONE;
 use crate::ring::Ring;
 
 /// Predicted positions of P and C: for each, the floor of the mean of R and
-/// the real vertices of its arc (wings included), per axis, in i64.
+/// the real vertices of its arc (wings included), per axis, in i64. P owns
+/// arc 1 (`offset ..= offset + distance`), C arc 2.
 pub fn predict_split(
     positions: &[[u32; 3]],
     parent: [u32; 3],
     ring: &Ring,
     offset: usize,
     distance: usize,
-    config: bool,
 ) -> ([i64; 3], [i64; 3]) {
     let k = ring.len();
     let arc_1 = centroid(positions, parent, ring, offset, distance);
     let arc_2 = centroid(positions, parent, ring, offset + distance, k - distance);
-    if config {
-        (arc_2, arc_1)
-    } else {
-        (arc_1, arc_2)
-    }
+    (arc_1, arc_2)
+}
+
+/// Optimal mode's prediction of C once P is known (SPEC §7.4): the floor of
+/// the mean of C's arc centroid and the reflection `2R - P` of P through R
+/// (an edge collapse puts R between P and C).
+pub fn refine_c(c_hat: [i64; 3], parent: [u32; 3], p: [i64; 3]) -> [i64; 3] {
+    core::array::from_fn(|k| (c_hat[k] + 2 * parent[k] as i64 - p[k]).div_euclid(2))
 }
 
 /// Mean of `parent` and the real ring vertices `start ..= start + len` (mod k).

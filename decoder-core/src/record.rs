@@ -1,21 +1,22 @@
 //! Reading split records and the base mesh from substreams (SPEC §6.3, §7.4, §7.5).
 
 use crate::Error;
+use crate::context::{self, SINGLE};
 use crate::header::PositionMode;
 use crate::limits::substream::{self, SLOTS};
-use crate::predict::predict_split;
+use crate::predict::{predict_split, refine_c};
 use crate::ring::Ring;
 use crate::round::RecordSource;
 use crate::split::SplitRecord;
 use crate::state::MeshState;
 use crate::substream::Substreams;
 
-/// Substream slot of a refinement substream id (ids 1..=8 use slots 0..=7).
+/// Substream slot of a refinement substream id (ids 1..=7 use slots 0..=6).
 const fn slot(id: u8) -> usize {
     (id - substream::FLAGS) as usize
 }
 
-/// Substream slot of a base substream id (ids 9..=11 use slots 0..=2).
+/// Substream slot of a base substream id (ids 8..=10 use slots 0..=2).
 const fn base_slot(id: u8) -> usize {
     (id - substream::BASE_POSITIONS) as usize
 }
@@ -32,38 +33,43 @@ pub struct StreamSource<'s, 'l, 'b> {
 
 impl RecordSource for StreamSource<'_, '_, '_> {
     #[inline]
-    fn flag(&mut self, _v: u32) -> Result<bool, Error> {
-        self.subs.bit(slot(substream::FLAGS))
+    fn flag(&mut self, _state: &MeshState<'_>, _v: u32) -> Result<bool, Error> {
+        self.subs.bit(slot(substream::FLAGS), SINGLE)
     }
 
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let s = &mut *self.subs;
-        let wing_offset = s.byte(slot(substream::WING_OFFSET))?;
-        let wing_distance = s.byte(slot(substream::WING_DISTANCE))?;
-        let config = s.bit(slot(substream::CONFIG))?;
+        let wing_offset = s.byte(slot(substream::WING_OFFSET), SINGLE)?;
+        let wing_distance = s.byte(
+            slot(substream::WING_DISTANCE),
+            context::wing_distance(ring.len()),
+        )?;
         let (o, d) = (wing_offset as usize, wing_distance as usize);
         if d == 0 || o + d >= ring.len() {
             return Err(Error::RingOffsetOutOfRange);
         }
-        let deficit_p = s.byte(slot(substream::DEFICIT_P))?;
-        let deficit_c = s.byte(slot(substream::DEFICIT_C))?;
+        let deficit_p = s.byte(slot(substream::DEFICIT_P), SINGLE)?;
+        let deficit_c = s.byte(slot(substream::DEFICIT_C), context::deficit_c(deficit_p))?;
         let parent = state.positions()[r as usize];
-        let (p_hat, c_hat) = predict_split(state.positions(), parent, ring, o, d, config);
+        let (p_hat, c_hat) = predict_split(state.positions(), parent, ring, o, d);
         let mut first = [0i64; 3];
-        for x in &mut first {
-            *x = s.signed(slot(substream::EDGE))? as i64;
+        for (k, x) in first.iter_mut().enumerate() {
+            *x = s.signed(slot(substream::EDGE), context::axis(k))? as i64;
         }
         let (p, c) = match self.mode {
             PositionMode::Optimal => {
+                let p: [i64; 3] = core::array::from_fn(|k| p_hat[k] + first[k]);
+                let c_hat = refine_c(c_hat, parent, p);
                 let mut c = [0i64; 3];
                 for k in 0..3 {
-                    c[k] = c_hat[k] + s.signed(slot(substream::PLACEMENT))? as i64;
+                    c[k] =
+                        c_hat[k] + s.signed(slot(substream::PLACEMENT), context::axis(k))? as i64;
                 }
-                (core::array::from_fn(|k| p_hat[k] + first[k]), c)
+                (p, c)
             }
             PositionMode::Constrained => {
                 let parent = parent.map(|x| x as i64);
-                match s.byte(slot(substream::PLACEMENT))? {
+                match s.byte(slot(substream::PLACEMENT), SINGLE)? {
                     // R sits on P: C is coded.
                     0 => (parent, core::array::from_fn(|k| c_hat[k] + first[k])),
                     // R sits on C: P is coded.
@@ -82,7 +88,6 @@ impl RecordSource for StreamSource<'_, '_, '_> {
         Ok(SplitRecord {
             wing_offset,
             wing_distance,
-            config,
             deficit_p,
             deficit_c,
             position_p: to_grid(p, bits)?,
@@ -118,16 +123,16 @@ pub fn read_base(
     let (positions, corners, deficits) = state.base_arrays();
     let mut previous = [0i64; 3];
     for p in &mut positions[..vertices as usize] {
-        for axis in &mut previous {
-            *axis += subs.signed(base_slot(substream::BASE_POSITIONS))? as i64;
+        for (k, axis) in previous.iter_mut().enumerate() {
+            *axis += subs.signed(base_slot(substream::BASE_POSITIONS), context::axis(k))? as i64;
         }
         *p = to_grid(previous, bits)?;
     }
     for c in &mut corners[..3 * triangles as usize] {
-        *c = subs.varint(base_slot(substream::BASE_TRIANGLES))?;
+        *c = subs.varint(base_slot(substream::BASE_TRIANGLES), SINGLE)?;
     }
     for d in &mut deficits[..vertices as usize] {
-        *d = subs.byte(base_slot(substream::BASE_DEFICITS))?;
+        *d = subs.byte(base_slot(substream::BASE_DEFICITS), SINGLE)?;
     }
     subs.finish()?;
     state.finish_base(vertices, triangles)

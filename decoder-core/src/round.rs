@@ -6,10 +6,10 @@
 //! in a [`RecordSource`].
 
 use crate::Error;
-use crate::limits::NONE;
+use crate::limits::{MAX_SPLIT_VALENCE, NONE};
 use crate::ring::Ring;
 use crate::split::{SplitOutcome, SplitRecord};
-use crate::state::{MeshState, next};
+use crate::state::{MeshState, next, prev};
 
 /// Flagged vertices whose fans are warmed together (see `warm_fans`).
 const WARM_BATCH: usize = 32;
@@ -19,7 +19,7 @@ const WARM_STEPS: usize = 12;
 /// Where a round gets its flags and split records from.
 pub trait RecordSource {
     /// The flag of candidate `v` (SPEC §7.3), asked in ascending order.
-    fn flag(&mut self, v: u32) -> Result<bool, Error>;
+    fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error>;
     /// The record of the split of `r`, whose canonical ring is `ring` (SPEC §7.4).
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error>;
     /// Called after each applied split (the encoder tracks vertex identities).
@@ -49,31 +49,93 @@ impl MeshState<'_> {
         let words = (n as usize).div_ceil(64);
         // Step 1: the candidates are the vertices below n with deficit 0;
         // the bitmap is kept up to date by every split (SPEC §7.3).
-        let (candidates, flagged) = self.bitmaps();
         let mut stats = RoundStats {
-            candidates: candidates[..words].iter().map(|w| w.count_ones()).sum(),
+            candidates: self.bitmaps().0[..words]
+                .iter()
+                .map(|w| w.count_ones())
+                .sum(),
             ..RoundStats::default()
         };
-        // Step 2: one flag per candidate, in ascending order.
-        for w in 0..words {
-            let mut bits = candidates[w];
+        // Step 2: one flag per candidate, in ascending order; a candidate
+        // next to one flagged before it has no flag (it reads as 0).
+        let mut result = Ok(());
+        'flags: for w in 0..words {
+            let mut bits = self.bitmaps().0[w] & !self.bitmaps().2[w];
             while bits != 0 {
                 let v = (w * 64) as u32 + bits.trailing_zeros();
                 bits &= bits - 1;
-                if source.flag(v)? {
-                    flagged[w] |= 1u64 << (v % 64);
-                    stats.splits += 1;
+                if self.bitmaps().2[w] & (1u64 << (v % 64)) != 0 {
+                    continue;
+                }
+                match source.flag(self, v) {
+                    Ok(false) => {}
+                    Ok(true) => {
+                        self.bitmaps().1[w] |= 1u64 << (v % 64);
+                        stats.splits += 1;
+                        if let Err(e) = self.block_neighbours(v) {
+                            result = Err(e);
+                            break 'flags;
+                        }
+                    }
+                    Err(e) => {
+                        result = Err(e);
+                        break 'flags;
+                    }
                 }
             }
         }
-        if stats.splits != declared {
-            flagged[..words].fill(0);
-            return Err(Error::FlagCountMismatch { round: 0 });
+        self.bitmaps().2[..words].fill(0);
+        if result.is_ok() && stats.splits != declared {
+            result = Err(Error::FlagCountMismatch { round: 0 });
+        }
+        if let Err(e) = result {
+            self.bitmaps().1[..words].fill(0);
+            return Err(e);
         }
         // Step 3: the splits, in ascending order of the split vertex.
         let result = self.split_flagged(n, words, source, ring, &mut stats);
         self.bitmaps().1[..words].fill(0);
         result.map(|()| stats)
+    }
+
+    /// Marks the neighbours of a flagged vertex: their flags are inferred
+    /// (SPEC §7.2), which makes every round's splits independent. Walks the
+    /// fan both ways and marks both outer corners of every wedge (order and
+    /// duplicates do not matter here, so no canonical ring is needed).
+    fn block_neighbours(&mut self, v: u32) -> Result<(), Error> {
+        let half = self.candidates.len() / 3;
+        let start = self.vertex_corner[v as usize];
+        let mark = |state: &mut Self, c: u32| {
+            for x in [
+                state.corners[next(c) as usize],
+                state.corners[prev(c) as usize],
+            ] {
+                state.candidates[2 * half + (x / 64) as usize] |= 1u64 << (x % 64);
+            }
+        };
+        let mut c = start;
+        for _ in 0..MAX_SPLIT_VALENCE {
+            mark(self, c);
+            let o = self.opposite[next(c) as usize];
+            if o == NONE {
+                // An open fan: the wedges clockwise of the start remain.
+                let mut c = start;
+                for _ in 0..MAX_SPLIT_VALENCE {
+                    let o = self.opposite[prev(c) as usize];
+                    if o == NONE {
+                        return Ok(());
+                    }
+                    c = prev(o);
+                    mark(self, c);
+                }
+                return Err(Error::ValenceOverflow);
+            }
+            c = next(o);
+            if c == start {
+                return Ok(());
+            }
+        }
+        Err(Error::ValenceOverflow)
     }
 
     fn split_flagged<S: RecordSource>(
@@ -100,7 +162,6 @@ impl MeshState<'_> {
                 self.warm_fans(&batch[..len]);
                 for &r in &batch[..len] {
                     self.ring(r, ring)?;
-                    self.check_independent(ring, n)?;
                     let record = source.record(self, r, ring)?;
                     let outcome = self.apply_split(r, ring, &record, c)?;
                     source.applied(r, c, &outcome);
@@ -145,21 +206,5 @@ impl MeshState<'_> {
             }
         }
         core::hint::black_box(sum);
-    }
-
-    /// The independence rule (SPEC §7.2): no neighbour of a split vertex may
-    /// be split in the same round. Flagged vertices are still marked; a
-    /// vertex created earlier in this round has an index of at least `n`.
-    fn check_independent(&self, ring: &Ring, n: u32) -> Result<(), Error> {
-        let flagged = &self.candidates[self.candidates.len() / 2..];
-        for &x in ring.vertices() {
-            if x == NONE {
-                continue;
-            }
-            if x >= n || flagged[(x / 64) as usize] & (1u64 << (x % 64)) != 0 {
-                return Err(Error::DependentSplits);
-            }
-        }
-        Ok(())
     }
 }

@@ -13,8 +13,6 @@ pub struct SplitRecord {
     pub wing_offset: u8,
     /// Ring distance from the first wing to the second, `b = r_{o+d}`.
     pub wing_distance: u8,
-    /// Configuration bit: `false` gives the arc from `a` to `b` to P, `true` to C.
-    pub config: bool,
     /// Deficit of P right after the split, or [`LEAF`].
     pub deficit_p: u8,
     /// Deficit of C right after the split, or [`LEAF`].
@@ -52,8 +50,9 @@ impl MeshState<'_> {
         }
         let a = ring.vertices()[o];
         let b = ring.vertices()[o + d];
-        // Arc 1 is wedges o .. o+d (d wedges), arc 2 the other k - d.
-        let (len_p, len_c) = if rec.config { (k - d, d) } else { (d, k - d) };
+        // Arc 1 is wedges o .. o+d (d wedges) and goes to P, arc 2 (the
+        // other k - d) to C.
+        let (len_p, len_c) = (d, k - d);
         let valence_p = len_p + 2;
         let valence_c = len_c + 2;
         for (deficit, valence) in [(rec.deficit_p, valence_p), (rec.deficit_c, valence_c)] {
@@ -99,9 +98,9 @@ impl MeshState<'_> {
                 self.set_candidate(w, d);
             }
         }
-        // X owns arc 1 (from a to b), Y arc 2.
-        let (x, y) = if rec.config { (c, r) } else { (r, c) };
-        let c_arc_start = if rec.config { o } else { o + d };
+        // P (index r) owns arc 1 (from a to b), C arc 2.
+        let (x, y) = (r, c);
+        let c_arc_start = o + d;
         for j in 0..len_c {
             let corner = ring.corners()[(c_arc_start + j) % k];
             if corner != NONE {

@@ -44,8 +44,9 @@ pub struct StateMemory<'ws> {
     pub opposite: &'ws mut [u32],
     pub vertex_corner: &'ws mut [u32],
     pub deficit: &'ws mut [u8],
-    /// Two bitmaps of one bit per vertex, one after the other: the current
-    /// candidates (deficit 0) and the vertices flagged in the current round.
+    /// Three bitmaps of one bit per vertex, one after the other: the current
+    /// candidates (deficit 0), the vertices flagged in the current round, and
+    /// the candidates whose flag is inferred because a neighbour was flagged.
     pub candidates: &'ws mut [u64],
 }
 
@@ -136,10 +137,12 @@ impl<'ws> MeshState<'ws> {
         v < self.vertex_count && self.deficit[v as usize] == LEAF
     }
 
-    /// The candidate bitmap and the flagged bitmap (SPEC §7.3).
-    pub(crate) fn bitmaps(&mut self) -> (&mut [u64], &mut [u64]) {
-        let half = self.candidates.len() / 2;
-        self.candidates.split_at_mut(half)
+    /// The candidate, flagged and blocked bitmaps (SPEC §7.3).
+    pub(crate) fn bitmaps(&mut self) -> (&mut [u64], &mut [u64], &mut [u64]) {
+        let third = self.candidates.len() / 3;
+        let (candidates, rest) = self.candidates.split_at_mut(third);
+        let (flagged, blocked) = rest.split_at_mut(third);
+        (candidates, flagged, blocked)
     }
 
     /// Records whether `v` is a candidate (deficit 0) for the next round.

@@ -5,28 +5,52 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::bytes::crc32;
+use crate::context;
 use crate::header::{Header, PositionMode};
 use crate::layout::Layout;
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, codec, substream};
+use crate::rans_writer::{Symbol, encode_chunk};
 
-/// A growing substream: bytes, bits (least significant first) or varints.
+/// A growing substream: bytes, bits (least significant first) or varints
+/// for the byte codecs (SPEC §5.4), and the same values with their contexts
+/// for rANS (SPEC §5.5). The plain methods use context 0; the `_in` methods
+/// take the context the decoder will compute (see [`crate::context`]).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct SubstreamWriter {
     bytes: Vec<u8>,
     bit_count: u8,
+    symbols: Vec<Symbol>,
 }
 
 impl SubstreamWriter {
     pub fn byte(&mut self, b: u8) {
+        self.byte_in(0, b);
+    }
+
+    pub fn bit(&mut self, bit: bool) {
+        self.bit_in(0, bit);
+    }
+
+    pub fn varint(&mut self, v: u32) {
+        self.varint_in(0, v);
+    }
+
+    pub fn signed(&mut self, v: i32) {
+        self.signed_in(0, v);
+    }
+
+    pub fn byte_in(&mut self, context: u8, b: u8) {
         debug_assert_eq!(
             self.bit_count, 0,
             "bytes and bits do not mix in one substream"
         );
         self.bytes.push(b);
+        self.symbols.push((context, b as u32));
     }
 
-    pub fn bit(&mut self, bit: bool) {
+    pub fn bit_in(&mut self, context: u8, bit: bool) {
+        self.symbols.push((context, bit as u32));
         if self.bit_count == 0 {
             self.bytes.push(0);
         }
@@ -37,7 +61,8 @@ impl SubstreamWriter {
     }
 
     /// Minimal LEB128 (SPEC §5.4).
-    pub fn varint(&mut self, mut v: u32) {
+    pub fn varint_in(&mut self, context: u8, mut v: u32) {
+        self.symbols.push((context, v));
         loop {
             let low = (v & 0x7F) as u8;
             v >>= 7;
@@ -50,8 +75,13 @@ impl SubstreamWriter {
     }
 
     /// Zigzag then LEB128 (SPEC §5.4).
-    pub fn signed(&mut self, v: i32) {
-        self.varint(((v << 1) ^ (v >> 31)) as u32);
+    pub fn signed_in(&mut self, context: u8, v: i32) {
+        self.varint_in(context, ((v << 1) ^ (v >> 31)) as u32);
+    }
+
+    /// The values with their contexts, as rANS codes them.
+    pub fn symbols(&self) -> &[Symbol] {
+        &self.symbols
     }
 
     pub fn as_bytes(&self) -> &[u8] {
@@ -63,7 +93,7 @@ impl SubstreamWriter {
     }
 
     pub fn is_empty(&self) -> bool {
-        self.bytes.is_empty()
+        self.bytes.is_empty() && self.symbols.is_empty()
     }
 }
 
@@ -73,19 +103,39 @@ pub enum ChunkCodec {
     Stored,
     /// Raw deflate at this miniz_oxide level (1..=10).
     Deflate(u8),
+    /// rANS with this many lanes (1..=32); a substream whose deflate form
+    /// is smaller is written with deflate (level 10) instead.
+    Rans {
+        lanes: u8,
+    },
+    /// rANS for every substream, even where deflate or stored is smaller
+    /// (test streams and conformance vectors).
+    RansAlways {
+        lanes: u8,
+    },
+}
+
+impl ChunkCodec {
+    /// The header's lane count (SPEC §3.2): 1 unless rANS.
+    pub fn lane_count(&self) -> u8 {
+        match self {
+            ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } => *lanes,
+            _ => 1,
+        }
+    }
 }
 
 /// One level's content before framing.
 ///
 /// A base level given to [`write_stream`] holds just the seed mesh: its
-/// `substreams` are ids 9..=11 and it has no rounds. [`write_stream_seeded`]
+/// `substreams` are ids 8..=10 and it has no rounds. [`write_stream_seeded`]
 /// takes the seed separately, so that level 0 can also carry rounds.
 #[derive(Clone, Debug, Default)]
 pub struct LevelPayload {
     /// Declared split count of each round.
     pub round_splits: Vec<u32>,
-    /// Substreams in id order: ids 1..=8 for rounds (index 0 is id 1), or
-    /// ids 9..=11 for a base level given to [`write_stream`].
+    /// Substreams in id order: ids 1..=7 for rounds (index 0 is id 1), or
+    /// ids 8..=10 for a base level given to [`write_stream`].
     pub substreams: Vec<SubstreamWriter>,
     pub vertex_count: u32,
     pub triangle_count: u32,
@@ -104,7 +154,7 @@ pub struct StreamParams {
     pub chunk_limit: u32,
 }
 
-/// The seed mesh of level 0 (SPEC §6.3): counts and substreams 9..=11.
+/// The seed mesh of level 0 (SPEC §6.3): counts and substreams 8..=10.
 #[derive(Clone, Debug, Default)]
 pub struct SeedPayload {
     pub vertices: u32,
@@ -120,7 +170,7 @@ impl SeedPayload {
         let mut previous = [0i64; 3];
         for p in positions {
             for k in 0..3 {
-                substreams[0].signed((p[k] as i64 - previous[k]) as i32);
+                substreams[0].signed_in(context::axis(k), (p[k] as i64 - previous[k]) as i32);
                 previous[k] = p[k] as i64;
             }
         }
@@ -206,6 +256,7 @@ pub fn write_stream_seeded(
         version_minor: VERSION_MINOR,
         position_mode: params.position_mode,
         bits: params.bits,
+        lane_count: params.codec.lane_count(),
         level_count,
         vertex_capacity: top.vertex_count,
         triangle_capacity: top.triangle_count,
@@ -246,27 +297,33 @@ pub fn frame_level(
         .flat_map(|s| s.substreams.iter().enumerate())
         .map(|(i, s)| (substream::BASE_POSITIONS + i as u8, s));
     for (id, sub) in rounds.chain(base) {
-        for raw in sub.as_bytes().chunks(limit) {
-            let (codec_id, stored) = match params.codec {
-                ChunkCodec::Stored => (codec::STORED, raw.to_vec()),
-                ChunkCodec::Deflate(l) => {
-                    let packed = miniz_oxide::deflate::compress_to_vec(raw, l);
-                    if packed.len() < raw.len() {
-                        (codec::DEFLATE, packed)
-                    } else {
-                        (codec::STORED, raw.to_vec())
-                    }
+        let chunks = match params.codec {
+            ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None),
+            ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l)),
+            ChunkCodec::Rans { lanes } => {
+                let rans = rans_chunks(sub.symbols(), limit, id, lanes as usize);
+                let deflate = byte_chunks(sub.as_bytes(), limit, Some(10));
+                let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
+                if size(&rans) < size(&deflate) {
+                    rans
+                } else {
+                    deflate
                 }
-            };
+            }
+            ChunkCodec::RansAlways { lanes } => {
+                rans_chunks(sub.symbols(), limit, id, lanes as usize)
+            }
+        };
+        for chunk in chunks {
             let mut entry = [0u8; CHUNK_ENTRY_LEN];
             entry[0] = id;
-            entry[1] = codec_id;
-            entry[4..8].copy_from_slice(&(raw.len() as u32).to_le_bytes());
-            entry[8..12].copy_from_slice(&(stored.len() as u32).to_le_bytes());
-            entry[12..16].copy_from_slice(&crc32(&stored).to_le_bytes());
+            entry[1] = chunk.codec;
+            entry[4..8].copy_from_slice(&chunk.raw_len.to_le_bytes());
+            entry[8..12].copy_from_slice(&(chunk.stored.len() as u32).to_le_bytes());
+            entry[12..16].copy_from_slice(&crc32(&chunk.stored).to_le_bytes());
             directory.push(entry);
-            largest = largest.max(raw.len() as u32);
-            payload.extend_from_slice(&stored);
+            largest = largest.max(chunk.raw_len);
+            payload.extend_from_slice(&chunk.stored);
         }
     }
     let mut out = Vec::new();
@@ -286,4 +343,47 @@ pub fn frame_level(
     out.extend_from_slice(&crc.to_le_bytes());
     out.extend_from_slice(&payload);
     (out, largest)
+}
+
+/// One coded chunk before framing.
+struct Chunk {
+    codec: u8,
+    raw_len: u32,
+    stored: Vec<u8>,
+}
+
+/// Byte-codec chunks of at most `limit` raw bytes; deflated at `level` where
+/// that is smaller than storing.
+fn byte_chunks(bytes: &[u8], limit: usize, level: Option<u8>) -> Vec<Chunk> {
+    bytes
+        .chunks(limit)
+        .map(|raw| {
+            let packed = level.map(|l| miniz_oxide::deflate::compress_to_vec(raw, l));
+            match packed {
+                Some(p) if p.len() < raw.len() => Chunk {
+                    codec: codec::DEFLATE,
+                    raw_len: raw.len() as u32,
+                    stored: p,
+                },
+                _ => Chunk {
+                    codec: codec::STORED,
+                    raw_len: raw.len() as u32,
+                    stored: raw.to_vec(),
+                },
+            }
+        })
+        .collect()
+}
+
+/// rANS chunks of at most `limit` values each (SPEC §5.5).
+fn rans_chunks(symbols: &[Symbol], limit: usize, id: u8, lanes: usize) -> Vec<Chunk> {
+    let contexts = substream::CONTEXTS[id as usize] as usize;
+    symbols
+        .chunks(limit)
+        .map(|values| Chunk {
+            codec: codec::RANS,
+            raw_len: values.len() as u32,
+            stored: encode_chunk(values, contexts, lanes),
+        })
+        .collect()
 }

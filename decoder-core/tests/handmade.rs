@@ -6,7 +6,7 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{Error, PositionMode};
+use splitstream_decoder_core::{Error, PositionMode, context};
 
 fn params(codec: ChunkCodec) -> StreamParams {
     StreamParams {
@@ -23,11 +23,10 @@ fn base(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> Leve
     SeedPayload::new(positions, triangles, deficits).into_level(1.0)
 }
 
-/// One optimal-mode split record: o, d, q, deficits, edge vector, midpoint offset.
+/// One optimal-mode split record: o, d, deficits, and the residuals of P and C.
 struct Rec {
     o: u8,
     d: u8,
-    q: bool,
     dp: u8,
     dc: u8,
     e: [i32; 3],
@@ -35,19 +34,21 @@ struct Rec {
 }
 
 fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> LevelPayload {
-    let mut s = vec![SubstreamWriter::default(); 8];
+    // Every split here has a ring of 3: the rANS contexts follow (SPEC §5.5).
+    let mut s = vec![SubstreamWriter::default(); 7];
     for &f in flags {
         s[0].bit(f);
     }
     for r in recs {
         s[1].byte(r.o);
-        s[2].byte(r.d);
-        s[3].bit(r.q);
-        s[4].byte(r.dp);
-        s[5].byte(r.dc);
+        s[2].byte_in(context::wing_distance(3), r.d);
+        s[3].byte(r.dp);
+        s[4].byte_in(context::deficit_c(r.dp), r.dc);
         for k in 0..3 {
-            s[6].signed(r.e[k]);
-            s[7].signed(r.m[k]);
+            s[5].signed_in(context::axis(k), r.e[k]);
+        }
+        for k in 0..3 {
+            s[6].signed_in(context::axis(k), r.m[k]);
         }
     }
     LevelPayload {
@@ -69,16 +70,16 @@ fn tetrahedron() -> LevelPayload {
 
 /// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge (0,1,3).
 fn tetra_split() -> Rec {
-    // Predictions (SPEC §7.4): P̂ = mean(R, 1, 3) = (3, 0, 3),
-    // Ĉ = mean(R, 3, 2, 1) = (2, 2, 2). P = (0, 0, 0), C = (2, 2, 2).
+    // Predictions (SPEC §7.4): P̂ = mean(R, 1, 3) = (3, 0, 3), so P = (0, 0, 0)
+    // takes e = (-3, 0, -3); Ĉ = mean(R, 3, 2, 1) = (2, 2, 2), refined with
+    // 2R - P = (0, 0, 0) to (1, 1, 1), so C = (2, 2, 2) takes m = (1, 1, 1).
     Rec {
         o: 0,
         d: 1,
-        q: false,
         dp: LEAF,
         dc: LEAF,
         e: [-3, 0, -3],
-        m: [0; 3],
+        m: [1; 3],
     }
 }
 
@@ -97,7 +98,12 @@ fn assert_oriented_manifold(triangles: &[[u32; 3]]) {
 
 #[test]
 fn tetrahedron_one_split() {
-    for codec in [ChunkCodec::Stored, ChunkCodec::Deflate(9)] {
+    for codec in [
+        ChunkCodec::Stored,
+        ChunkCodec::Deflate(9),
+        ChunkCodec::RansAlways { lanes: 1 },
+        ChunkCodec::RansAlways { lanes: 32 },
+    ] {
         let stream = write_stream(
             &params(codec),
             &[
@@ -138,13 +144,12 @@ fn boundary_split_with_a_ghost_wing() {
     let rec = Rec {
         o: 0,
         d: 1,
-        q: false,
         dp: LEAF,
         dc: LEAF,
-        // P̂ = mean(R, 1) = (5, 0, 0); Ĉ = mean(R, 1, 2) = (3, 3, 0):
-        // P = (0, 0, 0), C = (0, 4, 0).
+        // P̂ = mean(R, 1) = (5, 0, 0); Ĉ = mean(R, 1, 2) = (3, 3, 0), refined
+        // with 2R - P = (0, 0, 0) to (1, 1, 0): P = (0, 0, 0), C = (0, 4, 0).
         e: [-5, 0, 0],
-        m: [-3, 1, 0],
+        m: [-1, 3, 0],
     };
     let stream = write_stream(
         &params(ChunkCodec::Stored),
@@ -180,8 +185,10 @@ fn flag_count_mismatch() {
 }
 
 #[test]
-fn dependent_splits() {
-    // Vertices 0 and 1 are both candidates (valence 3) and both flagged.
+fn flag_of_a_neighbour_of_a_flagged_vertex_is_inferred() {
+    // Vertices 0 and 1 are adjacent candidates. Once 0 is flagged, 1's flag
+    // is not read (SPEC §7.2): a second flag bit is left over as padding
+    // that is not zero, and the round has one split where two are declared.
     let b = base(
         &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
         &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
@@ -197,7 +204,27 @@ fn dependent_splits() {
             8,
         ),
     ]);
-    assert_eq!(err, Error::DependentSplits);
+    assert_eq!(err.class(), "count-mismatch");
+}
+
+#[test]
+fn inferred_flag_leaves_the_neighbour_a_candidate() {
+    // Vertices 0 and 2 are adjacent candidates; 0 splits (wings 1 and 3) and
+    // 2's flag is inferred 0, so one flag bit codes the whole round.
+    let b = base(
+        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
+        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        &[0, LEAF, 0, LEAF],
+    );
+    for codec in [ChunkCodec::Stored, ChunkCodec::RansAlways { lanes: 2 }] {
+        let stream = write_stream(
+            &params(codec),
+            &[b.clone(), level(&[true], vec![1], &[tetra_split()], 5, 6)],
+        );
+        let mesh = decode_all(&stream, true).unwrap();
+        assert_eq!(mesh.positions.len(), 5);
+        assert_eq!(mesh.positions[4], [2, 2, 2]);
+    }
 }
 
 #[test]
@@ -208,7 +235,7 @@ fn valence_overflow_on_a_wing() {
         &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
         &[0, 0, LEAF, LEAF],
     );
-    let err = decode_err(&[b, level(&[true, false], vec![1], &[tetra_split()], 5, 6)]);
+    let err = decode_err(&[b, level(&[true], vec![1], &[tetra_split()], 5, 6)]);
     assert_eq!(err, Error::ValenceOverflow);
 }
 

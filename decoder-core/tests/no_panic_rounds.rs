@@ -53,17 +53,18 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
     };
     // Each round: the centre is the only candidate; it splits with wings
     // r_0, r_1, keeps one wedge (valence 3) and deficit 0; C is a leaf.
-    let mut s = vec![SubstreamWriter::default(); 8];
+    let mut s = vec![SubstreamWriter::default(); 7];
     for _ in 0..rounds {
         s[0].bit(true);
         s[1].byte(0);
         s[2].byte(1);
-        s[3].bit(false);
-        s[4].byte(0);
-        s[5].byte(LEAF);
+        s[3].byte(0);
+        s[4].byte(LEAF);
+        for _ in 0..3 {
+            s[5].signed(0);
+        }
         for _ in 0..3 {
             s[6].signed(0);
-            s[7].signed(0);
         }
     }
     let level = LevelPayload {

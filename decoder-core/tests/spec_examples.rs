@@ -45,18 +45,17 @@ fn tetra_stream() -> Vec<u8> {
         triangle_count: 4,
         geometric_error: 1.0,
     };
-    let mut s = vec![SubstreamWriter::default(); 8];
+    let mut s = vec![SubstreamWriter::default(); 7];
     s[0].bit(true); // flags
     s[1].byte(0); // o
     s[2].byte(1); // d
-    s[3].bit(false); // q
-    s[4].byte(LEAF); // deficit P
-    s[5].byte(LEAF); // deficit C
+    s[3].byte(LEAF); // deficit P
+    s[4].byte(LEAF); // deficit C
     for x in [-3, 0, -3] {
-        s[6].signed(x); // residual of P against P̂ = (3, 0, 3)
+        s[5].signed(x); // residual of P against P̂ = (3, 0, 3)
     }
     for _ in 0..3 {
-        s[7].signed(0); // residual of C against Ĉ = (2, 2, 2)
+        s[6].signed(1); // residual of C against Ĉ = (1, 1, 1)
     }
     let l1 = LevelPayload {
         round_splits: vec![1],
@@ -85,7 +84,7 @@ const SPEC: &str = include_str!("../SPEC.md");
 #[test]
 fn appendix_a_tetrahedron() {
     let stream = tetra_stream();
-    assert_eq!(stream.len(), 480);
+    assert_eq!(stream.len(), 463);
     // The complete hex dump of Appendix A is the stream, byte for byte.
     assert!(
         SPEC.contains(&hex(&stream)),
@@ -113,10 +112,13 @@ fn appendix_a_tetrahedron() {
     );
     assert_eq!(mesh.positions[4], [2, 2, 2]);
     // §9: workspace_bytes of the example.
-    assert_eq!(u64::from_le_bytes(stream[80..88].try_into().unwrap()), 368);
+    assert_eq!(
+        u64::from_le_bytes(stream[80..88].try_into().unwrap()),
+        13304
+    );
     assert_eq!(
         splitstream_decoder_core::Layout::new(5, 6, 4, 4, 4).total,
-        64 + 72 + 120 + 24 + 8 + 16 + 64
+        64 + 72 + 120 + 24 + 8 + 24 + 7 * 1856
     );
 }
 
@@ -134,7 +136,7 @@ fn section_2_and_8_constants() {
 #[test]
 fn section_10_3_minor_versions_and_trailing_bytes() {
     let stream = tetra_stream();
-    // Any minor version of major 1 decodes as 1.0 (§1).
+    // Any minor version of major 2 decodes as 2.0 (§1).
     let mut m = stream.clone();
     m[9] = 7;
     let crc = crc32(&m[..92]);
@@ -157,7 +159,7 @@ fn section_10_3_minor_versions_and_trailing_bytes() {
         "truncated"
     );
     let mut v2 = stream[..10].to_vec();
-    v2[8] = 2;
+    v2[8] = 3;
     assert_eq!(
         decode_all(&v2, false).unwrap_err().class(),
         "unsupported-version"
@@ -272,19 +274,16 @@ fn spec_apply(
     c: u32,
 ) {
     let k = ring.len();
-    let (o, d, q) = (
-        rec.wing_offset as usize,
-        rec.wing_distance as usize,
-        rec.config,
-    );
+    let (o, d) = (rec.wing_offset as usize, rec.wing_distance as usize);
     let (a, b) = (ring[o], ring[o + d]);
     for w in [a, b] {
         if w != NONE && deficits[w as usize] != LEAF {
             deficits[w as usize] -= 1;
         }
     }
-    let (x, y) = if q { (c, r) } else { (r, c) };
-    let (start, len) = if q { (o, d) } else { (o + d, k - d) };
+    // P (index r) owns arc 1, C arc 2 (wedges o+d .. o+k-1).
+    let (x, y) = (r, c);
+    let (start, len) = (o + d, k - d);
     for j in 0..len {
         let i = (start + j) % k;
         let (u, w) = (ring[i], ring[(i + 1) % k]);
@@ -321,7 +320,7 @@ struct Shadow {
 }
 
 impl RecordSource for Shadow {
-    fn flag(&mut self, v: u32) -> Result<bool, Error> {
+    fn flag(&mut self, _state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
         Ok(self.flagged.contains(&v))
     }
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
@@ -339,9 +338,8 @@ impl RecordSource for Shadow {
             j = ok[self.rng.below(ok.len())];
         }
         let (lo, hi) = (i.min(j), i.max(j));
-        let q = self.rng.below(2) == 1;
         let d = hi - lo;
-        let (lp, lc) = if q { (k - d, d) } else { (d, k - d) };
+        let (lp, lc) = (d, k - d);
         let pick = |rng: &mut Rng, val: usize| -> u8 {
             match rng.below(5) {
                 0 => LEAF,
@@ -351,7 +349,6 @@ impl RecordSource for Shadow {
         let rec = SplitRecord {
             wing_offset: lo as u8,
             wing_distance: d as u8,
-            config: q,
             deficit_p: pick(&mut self.rng, lp + 2),
             deficit_c: pick(&mut self.rng, lc + 2),
             position_p: state.positions()[r as usize],

@@ -1,17 +1,35 @@
 //! Property-generated meshes: decode(encode(M)) == M exactly for terrains
 //! with flat patches (ties everywhere), holes from missing samples, closed
-//! noisy spheres, both position modes and any level count.
+//! noisy spheres, both position modes, any level count, and both codecs.
 
 mod common;
 mod roundtrip_check;
 
 use proptest::prelude::*;
 use splitstream_decoder_core::PositionMode;
+use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::emit::EncodeOptions;
 use splitstream_encoder::input::{Grid, check_mesh, grid_to_mesh};
 
-fn options(constrained: bool, levels: usize, admit: f64, lock: bool) -> EncodeOptions {
+/// The codecs a generated case may use: rANS in 1..=32 lanes (forced on
+/// every substream) or deflate.
+fn codec() -> impl Strategy<Value = ChunkCodec> {
+    prop_oneof![
+        (1u8..=32).prop_map(|lanes| ChunkCodec::RansAlways { lanes }),
+        Just(ChunkCodec::Rans { lanes: 4 }),
+        Just(ChunkCodec::Deflate(6)),
+    ]
+}
+
+fn options(
+    constrained: bool,
+    levels: usize,
+    admit: f64,
+    lock: bool,
+    codec: ChunkCodec,
+) -> EncodeOptions {
     EncodeOptions {
+        codec,
         position_mode: if constrained {
             PositionMode::Constrained
         } else {
@@ -38,6 +56,7 @@ proptest! {
         lock: bool,
         levels in 1usize..8,
         admit in prop_oneof![Just(0.3), Just(1.0)],
+        codec in codec(),
     ) {
         let mut elevations: Vec<f64> = (0..rows * cols).map(|i| heights[i % heights.len()] as f64 * 5.0).collect();
         for h in holes {
@@ -46,7 +65,7 @@ proptest! {
         let grid = Grid { rows, cols, elevations, origin: [0.0, 0.0], spacing: [10.0, 10.0], nodata: None };
         let mesh = grid_to_mesh(&grid);
         prop_assume!(mesh.triangles.len() >= 2 && check_mesh(&mesh).is_ok());
-        roundtrip_check::assert_roundtrip(&mesh, &options(constrained, levels, admit, lock));
+        roundtrip_check::assert_roundtrip(&mesh, &options(constrained, levels, admit, lock, codec));
     }
 
     #[test]
@@ -56,6 +75,7 @@ proptest! {
         constrained: bool,
         levels in 1usize..8,
         admit in prop_oneof![Just(0.3), Just(1.0)],
+        codec in codec(),
     ) {
         let mut mesh = common::icosphere(subdivisions);
         let mut state = seed | 1;
@@ -66,6 +86,6 @@ proptest! {
             let scale = 1.0 + ((state % 1000) as f64 / 1000.0 - 0.5) * 0.2;
             *p = p.map(|x| x * scale);
         }
-        roundtrip_check::assert_roundtrip(&mesh, &options(constrained, levels, admit, false));
+        roundtrip_check::assert_roundtrip(&mesh, &options(constrained, levels, admit, false, codec));
     }
 }

@@ -7,6 +7,7 @@ mod roundtrip_check;
 use std::path::Path;
 
 use splitstream_decoder_core::PositionMode;
+use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::emit::EncodeOptions;
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh};
 use splitstream_encoder::quantize::Units;
@@ -29,9 +30,18 @@ fn real_meshes_roundtrip_exactly() {
         }
         let mesh = read_mesh(&path, &ReadOptions::default()).unwrap();
         check_mesh(&mesh).unwrap();
-        for mode in [PositionMode::Optimal, PositionMode::Constrained] {
+        // The default codec (rANS, deflate where smaller) in optimal mode;
+        // rANS on every substream in 7 lanes in constrained mode.
+        for (mode, codec) in [
+            (PositionMode::Optimal, ChunkCodec::Rans { lanes: 4 }),
+            (
+                PositionMode::Constrained,
+                ChunkCodec::RansAlways { lanes: 7 },
+            ),
+        ] {
             let options = EncodeOptions {
                 position_mode: mode,
+                codec,
                 units,
                 ..EncodeOptions::default()
             };

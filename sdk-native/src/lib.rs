@@ -1,9 +1,20 @@
 //! Native SDK for splitstream clients.
 //!
-//! So far it holds one piece: [`grid_tile`], a client-side simplifier for
-//! regular elevation tiles (quad-tree split and merge with edge
-//! straightening, after Rishe et al., "Mesh Simplification Algorithm for
-//! Online 3D GIS", 2005). The API is plain Rust; a C ABI will follow.
-#![forbid(unsafe_code)]
+//! * [`Session`]: a progressive decoder owning its memory (sized from the
+//!   stream header once), fed level by level and decoded level by level or
+//!   round by round; what sdk-wasm and the C ABI wrap.
+//! * [`grid_tile`]: a client-side simplifier for regular elevation tiles
+//!   (quad-tree split and merge with edge straightening, after Rishe et al.,
+//!   "Mesh Simplification Algorithm for Online 3D GIS", 2005).
+//! * [`gpu`] (feature `gpu`): the refinement rounds on a wgpu device,
+//!   checked round by round against decoder-core.
+//! * [`ffi`]: the C ABI (header `include/splitstream.h`). `unsafe` code is
+//!   denied everywhere else in the crate.
+#![deny(unsafe_code)]
 
+pub mod ffi;
+#[cfg(feature = "gpu")]
+pub mod gpu;
 pub mod grid_tile;
+
+pub use ffi::Session;

@@ -9,13 +9,6 @@ fn params(h: f64) -> Params {
     Params::new(h)
 }
 
-fn bounded(h: f64) -> Params {
-    Params {
-        exact_border: false,
-        ..Params::new(h)
-    }
-}
-
 fn sample(rows: usize, cols: usize, mut f: impl FnMut(usize, usize) -> f64) -> Vec<f64> {
     let mut v = Vec::with_capacity(rows * cols);
     for r in 0..rows {
@@ -131,7 +124,7 @@ fn assert_watertight(out: &splitstream_sdk_native::grid_tile::Simplified) {
 }
 
 #[test]
-fn rough_tile_is_watertight_and_bounded() {
+fn rough_tile_is_watertight_and_params() {
     let (rows, cols, d) = (65, 65, 32.0);
     let h = sample(rows, cols, |r, c| hills(c as f64 * d, r as f64 * d));
     let tile = Tile {
@@ -142,13 +135,14 @@ fn rough_tile_is_watertight_and_bounded() {
         origin: [0.0, 0.0],
     };
     let mut s = Simplifier::new(rows, cols);
-    let (out, stats) = s.simplify(&tile, &bounded(700.0)).unwrap();
+    let (out, stats) = s.simplify(&tile, &params(700.0)).unwrap();
     assert_watertight(out);
     let t = threshold(700.0, d);
     assert_eq!(stats.threshold, t);
     assert!(stats.rectangles < stats.cells, "{stats:?}");
     assert!(stats.rectangles > 1);
-    assert!(stats.max_vertical_error <= 2.0 * t, "{stats:?}");
+    assert!(stats.max_vertical_error <= t * (1.0 + 1e-9), "{stats:?}");
+    assert!(stats.max_error_ratio <= 1.0 + 1e-9, "{stats:?}");
 }
 
 #[test]
@@ -168,10 +162,10 @@ fn error_respects_threshold_on_many_surfaces() {
             origin: [0.0, 0.0],
         };
         for height in [100.0, 700.0, 5000.0] {
-            let (out, stats) = simplify_tile(&tile, &bounded(height)).unwrap();
+            let (out, stats) = simplify_tile(&tile, &params(height)).unwrap();
             assert_watertight(&out);
             assert!(
-                stats.max_vertical_error <= 2.0 * stats.threshold + 1e-9,
+                stats.max_vertical_error <= stats.threshold * (1.0 + 1e-9),
                 "seed {seed} H {height}: {stats:?}"
             );
         }
@@ -223,38 +217,10 @@ fn neighbouring_tiles_at_different_resolutions_share_their_border() {
         assert_watertight(&fo);
         assert!(fstats.rectangles < fstats.cells);
 
-        // Error-bounded borders: leftover corners lie on the other side's
-        // straight edges, so there is still no gap.
-        let (co, _) = simplify_tile(
-            &coarse,
-            &Params {
-                exact_border: false,
-                ..pc
-            },
-        )
-        .unwrap();
-        let (fo, _) = simplify_tile(
-            &fine,
-            &Params {
-                exact_border: false,
-                ..pf
-            },
-        )
-        .unwrap();
-        for (a, b) in [(&co, &fo), (&fo, &co)] {
-            let mut pa: Vec<[f64; 3]> = a.positions.iter().filter(on_border).copied().collect();
-            pa.sort_by(|a, b| a[1].total_cmp(&b[1]));
-            for p in b.positions.iter().filter(on_border) {
-                let k = pa.partition_point(|q| q[1] < p[1]);
-                if pa[k][1] == p[1] {
-                    assert_eq!(pa[k][2], p[2]);
-                    continue;
-                }
-                let (lo, hi) = (pa[k - 1], pa[k]);
-                let z = lo[2] + (hi[2] - lo[2]) * (p[1] - lo[1]) / (hi[1] - lo[1]);
-                assert!((z - p[2]).abs() < 1e-9, "H {height}: gap at y {}", p[1]);
-            }
-        }
+        assert!(
+            fstats.max_error_ratio <= 1.0 + 1e-9,
+            "H {height}: {fstats:?}"
+        );
     }
 }
 
@@ -438,24 +404,19 @@ fn noisy_integer_terrain_is_watertight() {
         (seed % 1000) as f64 / 1000.0
     };
     for height in [700.0, 2000.0, 5000.0] {
-        for exact_border in [true, false] {
-            let h = sample(65, 65, |r, c| {
-                (hills(c as f64 * 80.0, r as f64 * 90.0) + 3.0 * rnd()).round()
-            });
-            let tile = Tile {
-                rows: 65,
-                cols: 65,
-                heights: &h,
-                spacing: [74.5, 92.1],
-                origin: [1000.0, 2000.0],
-            };
-            let p = Params {
-                exact_border,
-                ..Params::new(height)
-            };
-            let (out, _) = simplify_tile(&tile, &p).unwrap();
-            assert_watertight(&out);
-        }
+        let h = sample(65, 65, |r, c| {
+            (hills(c as f64 * 80.0, r as f64 * 90.0) + 3.0 * rnd()).round()
+        });
+        let tile = Tile {
+            rows: 65,
+            cols: 65,
+            heights: &h,
+            spacing: [74.5, 92.1],
+            origin: [1000.0, 2000.0],
+        };
+        let (out, stats) = simplify_tile(&tile, &Params::new(height)).unwrap();
+        assert_watertight(&out);
+        assert!(stats.max_error_ratio <= 1.0 + 1e-9, "{stats:?}");
     }
 }
 

@@ -1,4 +1,25 @@
-//! Browser SDK for splitstream streams (wasm-bindgen + TypeScript).
+//! Browser SDK for splitstream streams: wasm-bindgen bindings of
+//! splitstream-sdk-native's progressive decoder ([`StreamDecoder`]) and
+//! grid-tile simplifier ([`GridSimplifier`]). `wasm-bindgen` writes the
+//! JavaScript glue and the TypeScript `.d.ts`; usage is in README.md.
 //!
-//! Not built yet: this crate is an empty placeholder in the fixed workspace
-//! layout. It exports nothing, so nothing can mistake it for a working SDK.
+//! Errors reach JavaScript as exceptions: `Error` objects named
+//! `SplitstreamError` with a `class` property (the decoder's conformance
+//! error class, decoder-core SPEC §10, or `invalid-argument`, `grid-tile`)
+//! and the decoder's one-line message.
+//!
+//! The methods are plain Rust too (errors as [`SdkError`], arrays as
+//! slices), which is what the host unit tests exercise; only the
+//! conversions to JavaScript typed arrays and exceptions need a browser or
+//! node (tests/node).
+
+mod decoder;
+mod error;
+mod grid;
+
+pub use decoder::StreamDecoder;
+pub use error::SdkError;
+pub use grid::{GridSimplifier, TileStats};
+
+#[cfg(test)]
+mod tests;

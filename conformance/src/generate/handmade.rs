@@ -2,12 +2,12 @@
 //! decoder-core/tests/handmade.rs and SPEC Appendix A: the smallest legal
 //! streams, and faults that no encoder would write.
 
-use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
+use splitstream_decoder_core::{PositionMode, context};
 
 /// 8 bits per axis, unit scale, 4-byte chunks: every substream spans chunks.
 pub fn params(codec: ChunkCodec) -> StreamParams {
@@ -21,7 +21,7 @@ pub fn params(codec: ChunkCodec) -> StreamParams {
     }
 }
 
-/// A base level holding only a seed mesh (ids 9..=11); `write_stream`
+/// A base level holding only a seed mesh (ids 8..=10); `write_stream`
 /// frames it as level 0.
 pub fn base(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
     SeedPayload::new(positions, triangles, deficits).into_level(1.0)
@@ -37,16 +37,17 @@ pub fn with_raw_substream(mut level: LevelPayload, index: usize, bytes: &[u8]) -
     level
 }
 
-/// One optimal-mode split record: o, d, q, deficits, and the two position
+/// One optimal-mode split record: o, d, deficits, and the two position
 /// residuals as coded: `e` in the edge substream (P minus its prediction)
 /// and `m` in the placement substream (C minus its prediction), SPEC §7.4.
-/// Records built here start with zero residuals; [`solve`] sets them for
-/// wanted positions of P and C.
+/// `k` is the split vertex's ring length, which only selects the rANS
+/// context of `d` (SPEC §5.5). Records built here start with zero
+/// residuals; [`solve`] sets them for wanted positions of P and C.
 #[derive(Clone, Copy)]
 pub struct Rec {
+    pub k: u8,
     pub o: u8,
     pub d: u8,
-    pub q: bool,
     pub dp: u8,
     pub dc: u8,
     pub e: [i32; 3],
@@ -55,7 +56,8 @@ pub struct Rec {
 
 /// Sets the residuals of `rec` so that its split (of vertex `r`, creating
 /// vertex `c`) places P at `p` and C at `cpos`: the stream `build` makes is
-/// first decoded with zero residuals, which yields the predictions, whatever
+/// first decoded with zero residuals, which yields P's prediction; then with
+/// P's residual set, which yields C's (it may depend on P), whatever
 /// predictor SPEC §7.4 uses, as long as residuals are added to it.
 pub fn solve(
     rec: Rec,
@@ -65,17 +67,25 @@ pub fn solve(
     cpos: [i32; 3],
     build: &dyn Fn(Rec) -> Vec<u8>,
 ) -> Rec {
+    // C's probe residual is biased so that C stays inside the 8-bit grid
+    // whatever P is during the probes.
+    const BIAS: i32 = 64;
     let zero = Rec {
         e: [0; 3],
-        m: [0; 3],
+        m: [BIAS; 3],
         ..rec
     };
     let probe = decode_all(&build(zero), false).expect("the zero-residual probe decodes");
-    let (ph, ch) = (probe.positions[r], probe.positions[c]);
-    let solved = Rec {
+    let ph = probe.positions[r];
+    let half = Rec {
         e: std::array::from_fn(|k| p[k] - ph[k] as i32),
-        m: std::array::from_fn(|k| cpos[k] - ch[k] as i32),
-        ..rec
+        ..zero
+    };
+    let probe = decode_all(&build(half), false).expect("the P-residual probe decodes");
+    let ch = probe.positions[c];
+    let solved = Rec {
+        m: std::array::from_fn(|k| cpos[k] - (ch[k] as i32 - BIAS)),
+        ..half
     };
     if let Ok(mesh) = decode_all(&build(solved), false) {
         let want = (p.map(|x| x as u32), cpos.map(|x| x as u32));
@@ -88,21 +98,23 @@ pub fn solve(
     solved
 }
 
-/// A refinement level (ids 1..=8) in optimal mode.
+/// A refinement level (ids 1..=7) in optimal mode, values in the contexts
+/// SPEC §5.5 gives them.
 pub fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> LevelPayload {
-    let mut s = vec![SubstreamWriter::default(); 8];
+    let mut s = vec![SubstreamWriter::default(); 7];
     for &f in flags {
         s[0].bit(f);
     }
     for r in recs {
         s[1].byte(r.o);
-        s[2].byte(r.d);
-        s[3].bit(r.q);
-        s[4].byte(r.dp);
-        s[5].byte(r.dc);
+        s[2].byte_in(context::wing_distance(r.k as usize), r.d);
+        s[3].byte(r.dp);
+        s[4].byte_in(context::deficit_c(r.dp), r.dc);
         for k in 0..3 {
-            s[6].signed(r.e[k]);
-            s[7].signed(r.m[k]);
+            s[5].signed_in(context::axis(k), r.e[k]);
+        }
+        for k in 0..3 {
+            s[6].signed_in(context::axis(k), r.m[k]);
         }
     }
     LevelPayload {
@@ -133,16 +145,17 @@ pub fn tetrahedron_two_candidates() -> LevelPayload {
 }
 
 /// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge
-/// (0,1,3); zero residuals (P and C at their predictions).
+/// (0,1,3); P at its prediction (3, 0, 3), C at its prediction (-1, -1, -1)
+/// plus (2, 2, 2), inside the grid.
 pub fn tetra_split() -> Rec {
     Rec {
+        k: 3,
         o: 0,
         d: 1,
-        q: false,
         dp: LEAF,
         dc: LEAF,
         e: [0; 3],
-        m: [0; 3],
+        m: [2; 3],
     }
 }
 

@@ -9,6 +9,7 @@ mod mutate;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+use splitstream_decoder_core::limits::codec;
 use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
 use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
 use splitstream_decoder_core::{Fnv1a, Header, LevelHeader, LevelTable, PositionMode, head_len};
@@ -86,6 +87,14 @@ fn encoded(mesh: &Mesh, options: EncodeOptions) -> Vec<u8> {
 
 fn opts() -> EncodeOptions {
     EncodeOptions::default()
+}
+
+/// The encoder's defaults with deflate instead of rANS.
+fn deflate_opts() -> EncodeOptions {
+    EncodeOptions {
+        codec: ChunkCodec::Deflate(9),
+        ..opts()
+    }
 }
 
 /// Generates the whole set. `real_data` is `encoder/data/real` (filled by
@@ -354,9 +363,9 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
     let cone = meshes::checked(meshes::cone(96, 4), "cone");
     s.valid(
         "icosphere-optimal-deflate",
-        "Icosphere (642 vertices, closed), default encoder options: optimal positions, deflate, 5 levels.",
+        "Icosphere (642 vertices, closed): optimal positions, deflate, 5 levels.",
         &["encoded"],
-        encoded(&sphere3, opts()),
+        encoded(&sphere3, deflate_opts()),
     );
     s.valid(
         "icosphere-constrained-stored",
@@ -376,7 +385,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
         "grid-hole-optimal-deflate",
         "Height field with an outer boundary and a rectangular hole, optimal positions, deflate.",
         &["encoded", "hole"],
-        encoded(&holed, opts()),
+        encoded(&holed, deflate_opts()),
     );
     s.valid(
         "grid-hole-constrained-tiny-chunks",
@@ -400,7 +409,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             &sphere2,
             EncodeOptions {
                 chunk_limit: 24,
-                ..opts()
+                ..deflate_opts()
             },
         ),
     );
@@ -462,9 +471,60 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             EncodeOptions {
                 position_mode: PositionMode::Constrained,
                 levels: 6,
+                ..deflate_opts()
+            },
+        ),
+    );
+    s.valid(
+        "icosphere-rans",
+        "Icosphere (642 vertices), default encoder options: optimal positions, rANS with 4 lanes (deflate where smaller), 5 levels.",
+        &["encoded", "rans"],
+        encoded(&sphere3, opts()),
+    );
+    s.valid(
+        "grid-hole-rans-always-1-lane",
+        "Height field with a hole, every substream rANS-coded in a single lane.",
+        &["encoded", "hole", "rans", "rans-1-lane"],
+        encoded(
+            &holed,
+            EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 1 },
                 ..opts()
             },
         ),
+    );
+    s.valid(
+        "terrain-constrained-rans-32-lanes",
+        "33x33 fractal terrain, constrained positions, every substream rANS-coded with 32 lanes (more lanes than values in small chunks: empty lanes).",
+        &["encoded", "terrain", "rans", "rans-empty-lanes"],
+        encoded(
+            &terrain,
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::RansAlways { lanes: 32 },
+                levels: 6,
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "icosphere-rans-tiny-chunks",
+        "Icosphere (162 vertices), every substream rANS-coded in chunks of at most 5 values and 3 lanes: each chunk has its own tables and lanes.",
+        &["encoded", "rans", "tiny-chunks"],
+        encoded(
+            &sphere2,
+            EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 3 },
+                chunk_limit: 5,
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "handmade-tetra-split-rans",
+        "SPEC Appendix A's split with every substream rANS-coded (1 lane).",
+        &["minimal", "handmade", "one-split", "rans"],
+        handmade::tetra_stream(ChunkCodec::RansAlways { lanes: 1 }),
     );
     let bunny = meshes::real(real_data, "bunny.ply")?;
     s.valid(
@@ -483,7 +543,7 @@ fn flip(mut s: Vec<u8>, at: usize, mask: u8) -> Vec<u8> {
 
 fn invalid_vectors(s: &mut Specs) {
     let sphere = meshes::icosphere(3);
-    let subject = encoded(&sphere, opts());
+    let subject = encoded(&sphere, deflate_opts());
     let stored_subject = encoded(
         &meshes::icosphere(2),
         EncodeOptions {
@@ -583,18 +643,18 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "unsupported-version",
         "unsupported-version",
-        "Major version 2 (header CRC recomputed).",
+        "Major version 3 (header CRC recomputed).",
         &["header", "versioning"],
         {
             let mut b = subject.clone();
-            b[8] = 2;
+            b[8] = 3;
             fix_header_crc(&mut b);
             b
         },
     );
     s.valid(
         "minor-version-1",
-        "Minor version 1 of major 1 with every reserved field zero: decodes exactly as 1.0 (header CRC recomputed).",
+        "Minor version 1 of major 2 with every reserved field zero: decodes exactly as 2.0 (header CRC recomputed).",
         &["header", "versioning"],
         {
             let mut b = handmade::tetra_stream(ChunkCodec::Stored);
@@ -688,18 +748,20 @@ fn invalid_vectors(s: &mut Specs) {
             b
         },
     );
-    s.invalid(
-        "reserved-header-byte",
-        "malformed",
-        "Header byte 13 (reserved) not zero.",
-        &["reserved"],
-        {
-            let mut b = subject.clone();
-            b[13] = 1;
-            fix_header_crc(&mut b);
-            b
-        },
-    );
+    for (name, lanes) in [("lane-count-0", 0u8), ("lane-count-33", 33)] {
+        s.invalid(
+            name,
+            "malformed",
+            &format!("Header lane_count (byte 13) {lanes}, outside 1..=32."),
+            &["header", "rans"],
+            {
+                let mut b = subject.clone();
+                b[13] = lanes;
+                fix_header_crc(&mut b);
+                b
+            },
+        );
+    }
     s.invalid(
         "reserved-level-table",
         "malformed",
@@ -727,12 +789,12 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "unknown-codec",
         "malformed",
-        "Codec id 2 on a stored chunk of level 1 (level header CRC recomputed).",
+        "Codec id 3 (reserved) on a stored chunk of level 1 (level header CRC recomputed).",
         &["codec"],
         {
             let mut b = stored_subject.clone();
             assert_eq!(chunk_codec(&b, 1, 0), 0);
-            b[chunk_entry_at(&stored_subject, 1, 0) + 1] = 2;
+            b[chunk_entry_at(&stored_subject, 1, 0) + 1] = 3;
             fix_level_header_crc(&mut b, 1);
             b
         },
@@ -800,7 +862,7 @@ fn invalid_vectors(s: &mut Specs) {
         &["records", "record-count"],
         {
             let mut p = parts.clone();
-            p.levels[last as usize].substreams[6].push(0);
+            p.levels[last as usize].substreams[5].push(0);
             reframe(&p)
         },
     );
@@ -839,7 +901,7 @@ fn invalid_vectors(s: &mut Specs) {
         &["records", "position-constrained"],
         {
             let mut p = unframe(&constrained);
-            p.levels[1].substreams[7][0] = 3;
+            p.levels[1].substreams[6][0] = 3;
             reframe(&p)
         },
     );
@@ -868,10 +930,10 @@ fn invalid_vectors(s: &mut Specs) {
         hand(&[tetra(), level(&[false], vec![1], &[tetra_split()], 5, 6)]),
     );
     s.invalid(
-        "dependent-splits",
-        "dependent-splits",
-        "Tetrahedron with vertices 0 and 1 both candidates and both flagged: adjacent splits in one round.",
-        &["handmade", "independence"],
+        "flag-of-inferred-candidate",
+        "count-mismatch",
+        "Tetrahedron with adjacent candidates 0 and 1; the stream codes a flag 1 for vertex 1 too, but vertex 1's flag is inferred 0 once vertex 0 is flagged (SPEC §7.2), so the round flags 1 split where 2 are declared.",
+        &["handmade", "independence", "inferred-flags"],
         hand(&[
             handmade::tetrahedron_two_candidates(),
             level(&[true, true], vec![2], &[tetra_split(), tetra_split()], 6, 8),
@@ -880,13 +942,14 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "valence-overflow-wing",
         "valence-overflow",
-        "Vertex 1 (deficit 0, not flagged) is a wing of vertex 0's split.",
+        "Vertex 1 (deficit 0, its flag inferred 0) is a wing of vertex 0's split.",
         &["handmade", "valence"],
         hand(&[
             handmade::tetrahedron_two_candidates(),
-            level(&[true, false], vec![1], &[tetra_split()], 5, 6),
+            level(&[true], vec![1], &[tetra_split()], 5, 6),
         ]),
     );
+    rans_vectors(s);
     s.invalid(
         "valence-overflow-base",
         "valence-overflow",
@@ -1004,4 +1067,83 @@ fn invalid_vectors(s: &mut Specs) {
             hand(&[handmade::with_raw_substream(triangle(), 1, bytes)]),
         );
     }
+}
+
+/// Faults inside rANS chunks (SPEC §5.5), patched into SPEC Appendix A's
+/// stream coded with rANS in one lane (chunk CRCs recomputed).
+fn rans_vectors(s: &mut Specs) {
+    let subject = handmade::tetra_stream(ChunkCodec::RansAlways { lanes: 1 });
+    // Level 1's first chunk is its flags: one context, one lane.
+    let flags = chunk_payload(&subject, 1, 0);
+    assert_eq!(chunk_codec(&subject, 1, 0), codec::RANS);
+    let layout = rans_layout(&subject, flags, 1, 1);
+    let patched = |f: &dyn Fn(&mut Vec<u8>)| {
+        let mut b = subject.clone();
+        f(&mut b);
+        fix_chunk_crc(&mut b, 1, 0);
+        b
+    };
+    s.invalid(
+        "rans-lane-state-low",
+        "malformed",
+        "The flags lane's initial state is 1, below 2^23 (SPEC §5.5.3).",
+        &["rans", "handmade"],
+        patched(&|b| b[layout.lanes[0]..layout.lanes[0] + 4].copy_from_slice(&1u32.to_le_bytes())),
+    );
+    s.invalid(
+        "rans-lane-not-exhausted",
+        "malformed",
+        "The flags lane's initial state is 2^23 + 1: its only value decodes, but the lane does not end in state 2^23 (SPEC §5.5.4).",
+        &["rans", "handmade"],
+        patched(&|b| {
+            b[layout.lanes[0]..layout.lanes[0] + 4].copy_from_slice(&((1u32 << 23) + 1).to_le_bytes())
+        }),
+    );
+    s.invalid(
+        "rans-too-many-tokens",
+        "malformed",
+        "The flags table announces 45 tokens; the code has 44 (SPEC §5.5.2).",
+        &["rans", "handmade"],
+        patched(&|b| b[layout.token_counts[0]] = 45),
+    );
+    s.invalid(
+        "rans-bit-value-2",
+        "malformed",
+        "The flags substream, rANS-coded, holds the value 2 for a one-bit field (SPEC §5.5).",
+        &["rans", "handmade"],
+        {
+            let mut lvl = level(&[true], vec![1], &[tetra_split()], 5, 6);
+            let mut w = splitstream_decoder_core::writer::SubstreamWriter::default();
+            w.varint(2);
+            lvl.substreams[0] = w;
+            write_stream(
+                &handmade::params(ChunkCodec::RansAlways { lanes: 1 }),
+                &[handmade::tetrahedron(), lvl],
+            )
+        },
+    );
+    s.invalid(
+        "rans-mixed-codecs",
+        "malformed",
+        "A substream whose chunks mix rANS and stored (the codec byte of its second chunk set to 0; level header CRC recomputed).",
+        &["rans", "codec"],
+        {
+            let mut b = encoded(
+                &meshes::icosphere(2),
+                EncodeOptions {
+                    codec: ChunkCodec::RansAlways { lanes: 2 },
+                    chunk_limit: 5,
+                    ..opts()
+                },
+            );
+            let c = 1;
+            assert_eq!(chunk_codec(&b, 1, c), codec::RANS);
+            let id = |c: usize| b[chunk_entry_at(&b, 1, c)];
+            assert_eq!(id(0), id(1), "two chunks of one substream");
+            let at = chunk_entry_at(&b, 1, c) + 1;
+            b[at] = codec::STORED;
+            fix_level_header_crc(&mut b, 1);
+            b
+        },
+    );
 }

@@ -15,10 +15,10 @@ use splitstream_decoder_core::{Header, Inflater, LevelHeader, LevelTable, crc32,
 #[derive(Clone, Debug)]
 pub struct Level {
     /// Level 0 only: the seed mesh's vertex and triangle counts and its
-    /// substreams (ids 9..=11).
+    /// substreams (ids 8..=10).
     pub seed: Option<(u32, u32, Vec<Vec<u8>>)>,
     pub round_splits: Vec<u32>,
-    /// The rounds' substreams, ids 1..=8.
+    /// The rounds' substreams, ids 1..=7.
     pub substreams: Vec<Vec<u8>>,
     pub vertex_count: u32,
     pub triangle_count: u32,
@@ -43,13 +43,18 @@ pub fn unframe(stream: &[u8]) -> Unframed {
         let info = table.get(k);
         let bytes = &stream[level_range(stream, k)];
         let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len).expect("a valid level");
-        // Slots 0..8: ids 1..=8 (rounds); 8..11: ids 9..=11 (seed).
-        let mut substreams = vec![Vec::new(); 11];
+        // Slots 0..7: ids 1..=7 (rounds); 7..10: ids 8..=10 (seed).
+        let mut substreams = vec![Vec::new(); 10];
         let mut at = lh.payload_start;
         for c in 0..lh.chunk_count {
             let e = lh.chunk(c).expect("a valid chunk");
             let stored = &bytes[at..at + e.stored_len as usize];
             let mut raw = vec![0u8; e.raw_len as usize];
+            assert_ne!(
+                e.codec,
+                codec::RANS,
+                "unframe takes byte-codec streams only"
+            );
             if e.codec == codec::STORED {
                 raw.copy_from_slice(stored);
             } else {
@@ -61,7 +66,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
             substreams[(e.substream - 1) as usize].extend_from_slice(&raw);
             at += e.stored_len as usize;
         }
-        let seed_substreams = substreams.split_off(8);
+        let seed_substreams = substreams.split_off(7);
         let seed = (k == 0).then_some((lh.seed_vertices, lh.seed_triangles, seed_substreams));
         levels.push(Level {
             seed,
@@ -262,4 +267,48 @@ pub fn wrap_chunks_in_deflate(stream: &[u8]) -> Vec<u8> {
     }
     fix_table_crc(&mut out);
     out
+}
+
+/// Offsets inside a rANS chunk payload starting at `at` (SPEC §5.5.2,
+/// §5.5.3): of each context's token count, and of each lane's first byte.
+pub struct RansLayout {
+    pub token_counts: Vec<usize>,
+    pub lanes: Vec<usize>,
+}
+
+/// Parses the table and lane directory of the rANS chunk at `payload`.
+pub fn rans_layout(s: &[u8], payload: Range<usize>, contexts: usize, lanes: usize) -> RansLayout {
+    fn varint(s: &[u8], at: &mut usize) -> u32 {
+        let mut v = 0u32;
+        for i in 0..5 {
+            let b = s[*at];
+            *at += 1;
+            v |= ((b & 0x7F) as u32) << (7 * i);
+            if b & 0x80 == 0 {
+                break;
+            }
+        }
+        v
+    }
+    let mut at = payload.start;
+    let mut token_counts = Vec::new();
+    for _ in 0..contexts {
+        token_counts.push(at);
+        let n = s[at] as usize;
+        at += 1;
+        for _ in 0..n {
+            varint(s, &mut at);
+        }
+    }
+    let lengths: Vec<u32> = (0..lanes).map(|_| varint(s, &mut at)).collect();
+    let mut starts = Vec::new();
+    for len in lengths {
+        starts.push(at);
+        at += len as usize;
+    }
+    assert_eq!(at, payload.end, "rANS chunk layout");
+    RansLayout {
+        token_counts,
+        lanes: starts,
+    }
 }

@@ -16,8 +16,10 @@ use splitstream_decoder_core::{Decoder, Inflater};
 
 static STREAM: &[u8] = include_bytes!("../tetrahedron.sps");
 
-/// Workspace for the demo stream (it needs a few hundred bytes; 8-aligned).
-static mut WORKSPACE: [u64; 512] = [0; 512];
+/// Workspace for the demo stream (13,304 bytes, mostly the seven substream
+/// slots that can hold rANS tables, SPEC §9; 8-aligned).
+const WORDS: usize = 1664;
+static mut WORKSPACE: [u64; WORDS] = [0; WORDS];
 /// miniz_oxide's inflater state (about 10.5 KB); its constructor is not
 /// const, so it lives in `.bss` and is initialised on each call.
 static mut INFLATER: MaybeUninit<Inflater> = MaybeUninit::uninit();
@@ -49,10 +51,10 @@ pub extern "C" fn splitstream_decode_demo() -> u64 {
 }
 
 /// Views the word buffer as bytes.
-fn bytemuck_free_bytes(words: &mut [u64; 512]) -> &mut [u8] {
+fn bytemuck_free_bytes(words: &mut [u64; WORDS]) -> &mut [u8] {
     // SAFETY: u8 has no alignment or validity requirements; the length is
     // the byte size of the array.
-    unsafe { core::slice::from_raw_parts_mut(words.as_mut_ptr().cast::<u8>(), 512 * 8) }
+    unsafe { core::slice::from_raw_parts_mut(words.as_mut_ptr().cast::<u8>(), WORDS * 8) }
 }
 
 /// Entry point: decode, then park.

@@ -23,7 +23,7 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Decoder, Error, Inflater, Layout, MeshState, PositionMode, RecordSource, Ring, SplitRecord,
-    predict_split, workspace_len,
+    context, predict_split, refine_c, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -150,7 +150,7 @@ pub fn bases() -> Vec<BaseMesh> {
     ]
 }
 
-/// The base level (substreams 9..=11) of `base` with `deficits`.
+/// The base level (substreams 8..=10) of `base` with `deficits`.
 pub fn base_level(base: &BaseMesh, deficits: &[u8]) -> LevelPayload {
     SeedPayload::new(&base.positions, &base.triangles, deficits).into_level(1.0)
 }
@@ -246,7 +246,7 @@ fn small(b: u8) -> i64 {
 }
 
 impl RecordSource for GenSource<'_, '_> {
-    fn flag(&mut self, _v: u32) -> Result<bool, Error> {
+    fn flag(&mut self, _state: &MeshState<'_>, _v: u32) -> Result<bool, Error> {
         let f = self.flags.get(self.next_flag).copied().unwrap_or(false);
         self.next_flag += 1;
         Ok(f)
@@ -263,13 +263,8 @@ impl RecordSource for GenSource<'_, '_> {
         } else {
             pairs[c.below(pairs.len())]
         };
-        let config = c.byte() & 1 == 1;
         let d_clamped = d.min(k);
-        let (len_p, len_c) = if config {
-            (k - d_clamped, d_clamped)
-        } else {
-            (d_clamped, k - d_clamped)
-        };
+        let (len_p, len_c) = (d_clamped, k - d_clamped);
         let (mut deficit_p, mut deficit_c) = (
             pick_deficit(c.byte(), len_p + 2),
             pick_deficit(c.byte(), len_c + 2),
@@ -287,7 +282,7 @@ impl RecordSource for GenSource<'_, '_> {
         // which needs a valid ring partition; an invalid (o, d) is rejected
         // before any position is read, so anything may follow it.
         let (p_hat, c_hat) = if d >= 1 && o + d < k {
-            predict_split(state.positions(), parent, ring, o, d, config)
+            predict_split(state.positions(), parent, ring, o, d)
         } else {
             (parent64, parent64)
         };
@@ -299,11 +294,12 @@ impl RecordSource for GenSource<'_, '_> {
                     p[k] = clamp(parent64[k] + small(c.byte()));
                     q[k] = clamp(p[k] + small(c.byte()));
                 }
+                let c_hat = refine_c(c_hat, parent, p);
                 for k in 0..3 {
-                    self.subs[6].signed((p[k] - p_hat[k]) as i32);
+                    self.subs[5].signed_in(context::axis(k), (p[k] - p_hat[k]) as i32);
                 }
                 for k in 0..3 {
-                    self.subs[7].signed((q[k] - c_hat[k]) as i32);
+                    self.subs[6].signed_in(context::axis(k), (q[k] - c_hat[k]) as i32);
                 }
             }
             PositionMode::Constrained => {
@@ -336,20 +332,18 @@ impl RecordSource for GenSource<'_, '_> {
                         1 => p[k] - p_hat[k],
                         _ => (q[k] - p[k]) - (c_hat[k] - p_hat[k]),
                     };
-                    self.subs[6].signed(residual as i32);
+                    self.subs[5].signed_in(context::axis(k), residual as i32);
                 }
-                self.subs[7].byte(code);
+                self.subs[6].byte(code);
             }
         }
         self.subs[1].byte(o as u8);
-        self.subs[2].byte(d as u8);
-        self.subs[3].bit(config);
-        self.subs[4].byte(deficit_p);
-        self.subs[5].byte(deficit_c);
+        self.subs[2].byte_in(context::wing_distance(k), d as u8);
+        self.subs[3].byte(deficit_p);
+        self.subs[4].byte_in(context::deficit_c(deficit_p), deficit_c);
         Ok(SplitRecord {
             wing_offset: o as u8,
             wing_distance: d as u8,
-            config,
             deficit_p,
             deficit_c,
             position_p: [p[0] as u32, p[1] as u32, p[2] as u32],
@@ -371,6 +365,10 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
     // Deflate is rare: miniz_oxide's compressor state is large and is set
     // up per chunk, which would dominate the fuzzers' time.
     let codec = match choices.byte() % 8 {
+        4 => ChunkCodec::RansAlways { lanes: 1 },
+        5 => ChunkCodec::RansAlways {
+            lanes: 1 + choices.byte() % 32,
+        },
         6 => ChunkCodec::Deflate(1),
         7 => ChunkCodec::Deflate(6),
         _ => ChunkCodec::Stored,
@@ -423,47 +421,58 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
     let mut error = None;
 
     'levels: for _ in 0..refinement_levels {
-        let mut subs = vec![SubstreamWriter::default(); 8];
+        let mut subs = vec![SubstreamWriter::default(); 7];
         let mut round_splits = Vec::new();
         let level_start_v = state.vertex_count();
         let rounds = 3 - choices.below(3);
         for _ in 0..rounds {
             let n = state.vertex_count();
             let room = (vcap - n) as usize;
-            let mut flags = Vec::new();
-            let mut flagged: Vec<u32> = Vec::new();
-            let mut first_eligible = None;
-            for v in 0..n {
-                if state.deficits()[v as usize] != 0 {
-                    continue;
-                }
-                // Earlier splits of this round decrement each wing at most
-                // once: a pair of wings whose deficits exceed the number of
-                // splits flagged so far is still valid when `v` splits.
-                let eligible = flagged.len() < room
-                    && state.ring(v, &mut ring).is_ok()
-                    && ring.vertices().iter().all(|x| !flagged.contains(x))
-                    && has_robust_pair(&state, &ring, flagged.len());
-                let b = choices.byte();
-                let f = if eligible {
-                    if first_eligible.is_none() {
-                        first_eligible = Some(flags.len());
+            // One flag per candidate not next to a vertex flagged before it
+            // (those are inferred 0, SPEC §7.2).
+            let mut decide = |force: Option<u32>, choices: &mut Choices<'_>| {
+                let mut flags = Vec::new();
+                let mut flagged: Vec<u32> = Vec::new();
+                let mut first_eligible = None;
+                for v in 0..n {
+                    if state.deficits()[v as usize] != 0 {
+                        continue;
                     }
-                    b < 200
-                } else {
-                    allow_invalid && b == 0xFD && flagged.len() < room
-                };
-                if f {
-                    flagged.push(v);
+                    let ring_ok = state.ring(v, &mut ring).is_ok();
+                    if ring_ok && ring.vertices().iter().any(|x| flagged.contains(x)) {
+                        continue;
+                    }
+                    // Earlier splits of this round decrement each wing at most
+                    // once: a pair of wings whose deficits exceed the number of
+                    // splits flagged so far is still valid when `v` splits.
+                    let eligible = flagged.len() < room
+                        && ring_ok
+                        && has_robust_pair(&state, &ring, flagged.len());
+                    if eligible && first_eligible.is_none() {
+                        first_eligible = Some(v);
+                    }
+                    let f = match force {
+                        Some(forced) => v == forced,
+                        None => {
+                            let b = choices.byte();
+                            if eligible {
+                                b < 200
+                            } else {
+                                allow_invalid && b == 0xFD && flagged.len() < room
+                            }
+                        }
+                    };
+                    if f {
+                        flagged.push(v);
+                    }
+                    flags.push(f);
                 }
-                flags.push(f);
-            }
+                (flags, flagged, first_eligible)
+            };
+            let (mut flags, mut flagged, first_eligible) = decide(None, choices);
             if flagged.is_empty() {
                 match first_eligible {
-                    Some(i) => {
-                        flags[i] = true;
-                        flagged.push(i as u32); // count only
-                    }
+                    Some(v) => (flags, flagged, _) = decide(Some(v), choices),
                     None => break,
                 }
             }
@@ -528,7 +537,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
     }
 }
 
-/// Frames `levels` (`levels[0]` the seed mesh, substreams 9..=11): with
+/// Frames `levels` (`levels[0]` the seed mesh, substreams 8..=10): with
 /// `seeded`, level 0 is the seed followed by the rounds of `levels[1]`.
 pub fn frame(params: &StreamParams, levels: &[LevelPayload], seeded: bool) -> Vec<u8> {
     if seeded && levels.len() >= 2 {

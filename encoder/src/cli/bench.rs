@@ -7,16 +7,17 @@ use std::time::Instant;
 
 use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::baseline::{BaselineOptions, simplify_sequential};
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, fractal_terrain, read_mesh};
 use splitstream_encoder::metrics::surface_distance;
 use splitstream_encoder::quantize::{QuantizedMesh, Units, quantize};
-use splitstream_encoder::simplify::{SimplifyOptions, simplify};
+use splitstream_encoder::simplify::{Backend, Simplification, SimplifyOptions, simplify_on};
 
-use super::CliResult;
 use super::info::{field_sizes, is_geometry};
+use super::{BackendArg, CliResult};
 
 const SAMPLES: usize = 200_000;
 
@@ -70,11 +71,15 @@ pub struct Settings {
     /// Skip the synthetic-terrain throughput run.
     #[arg(long)]
     pub skip_throughput: bool,
+    /// Where the parallel simplifier's data-parallel passes run.
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    pub backend: BackendArg,
 }
 
 pub fn run(settings: &Settings) -> CliResult {
     let data: &Path = &settings.data;
     let admit = settings.admit;
+    let backend: Backend = settings.backend.into();
     let simplify_options = |target: usize, max_error: Option<f64>| SimplifyOptions {
         target_vertices: target,
         max_error,
@@ -83,8 +88,10 @@ pub fn run(settings: &Settings) -> CliResult {
     };
     println!("# splitstream encoder benchmark\n");
     println!("## Stream size (5 levels, 14-bit positions), bits per vertex\n");
-    println!("| input | vertices | mode | total | connectivity | geometry | rounds | encode s |");
-    println!("|---|---|---|---|---|---|---|---|");
+    println!(
+        "| input | vertices | mode | codec | total | connectivity | geometry | rounds | encode s | decode ms | M splits/s |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|---|");
     let mut loaded = Vec::new();
     for input in INPUTS.iter().filter(|i| {
         settings
@@ -95,7 +102,7 @@ pub fn run(settings: &Settings) -> CliResult {
         let path = data.join(input.file);
         if !path.exists() {
             println!(
-                "| {} | skipped: run encoder/data/fetch.sh | | | | | | |",
+                "| {} | skipped: run encoder/data/fetch.sh | | | | | | | | | |",
                 input.name
             );
             continue;
@@ -103,7 +110,16 @@ pub fn run(settings: &Settings) -> CliResult {
         let mesh = read_mesh(&path, &ReadOptions::default()).map_err(|e| e.to_string())?;
         check_mesh(&mesh).map_err(|e| format!("{}: {e}", path.display()))?;
         for mode in [PositionMode::Optimal, PositionMode::Constrained] {
-            size_row(input.name, &mesh, input.units, mode, admit)?;
+            for codec in [ChunkCodec::Rans { lanes: 4 }, ChunkCodec::Deflate(9)] {
+                size_row(
+                    input.name,
+                    &mesh,
+                    input.units,
+                    (mode, codec),
+                    admit,
+                    backend,
+                )?;
+            }
         }
         loaded.push((input, mesh));
     }
@@ -117,7 +133,7 @@ pub fn run(settings: &Settings) -> CliResult {
         println!("|---|---|---|---|---|---|---|---|---|---|---|");
         for (input, mesh) in &loaded {
             for fraction in [0.25, 0.0625] {
-                quality_row(input, mesh, fraction, &simplify_options)?;
+                quality_row(input, mesh, fraction, &simplify_options, backend)?;
             }
         }
         println!("\n## Vertices kept at the same maximum quadric error\n");
@@ -126,22 +142,31 @@ pub fn run(settings: &Settings) -> CliResult {
         );
         println!("|---|---|---|---|---|");
         for (input, mesh) in &loaded {
-            equal_error_row(input, mesh, &simplify_options)?;
+            equal_error_row(input, mesh, &simplify_options, backend)?;
         }
     }
     if !settings.skip_throughput {
         let side = settings.terrain_side;
         println!("\n## Throughput on the synthetic {side}x{side} terrain\n");
-        throughput(side, admit)?;
+        throughput(side, admit, backend)?;
     }
     Ok(())
 }
 
-fn size_row(name: &str, mesh: &Mesh, units: Units, mode: PositionMode, admit: f64) -> CliResult {
+fn size_row(
+    name: &str,
+    mesh: &Mesh,
+    units: Units,
+    (mode, codec): (PositionMode, ChunkCodec),
+    admit: f64,
+    backend: Backend,
+) -> CliResult {
     let options = EncodeOptions {
         position_mode: mode,
+        codec,
         units,
         admit_quantile: admit,
+        backend,
         ..EncodeOptions::default()
     };
     let t = Instant::now();
@@ -154,29 +179,60 @@ fn size_row(name: &str, mesh: &Mesh, units: Units, mode: PositionMode, admit: f6
     let sizes = field_sizes(stream, &header, &table)?;
     let n = mesh.positions.len() as f64;
     let bpv = |b: u64| 8.0 * b as f64 / n;
-    let connectivity: u64 = (1..12)
+    let fields = sizes.stored.len();
+    let connectivity: u64 = (1..fields)
         .filter(|&i| !is_geometry(i))
         .map(|i| sizes.stored[i])
         .sum();
-    let geometry: u64 = (1..12)
+    let geometry: u64 = (1..fields)
         .filter(|&i| is_geometry(i))
         .map(|i| sizes.stored[i])
         .sum();
+    let decode_ms = median_decode_ms(stream)?;
+    // Every vertex but the seed's comes from a split.
+    let level0 = table.get(0);
+    let level0 = &stream[level0.offset as usize..(level0.offset + level0.length as u64) as usize];
+    let seed = splitstream_decoder_core::LevelHeader::parse(level0, true, header.max_chunk_len)
+        .map_err(|e| e.to_string())?
+        .seed_vertices;
+    let splits = (header.vertex_capacity - seed) as f64;
     println!(
-        "| {name} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} |",
+        "| {name} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.2} |",
         mesh.positions.len(),
         if mode == PositionMode::Optimal {
             "optimal"
         } else {
             "constrained"
         },
+        match codec {
+            ChunkCodec::Deflate(_) => "deflate",
+            ChunkCodec::Stored => "stored",
+            _ => "rans",
+        },
         bpv(stream.len() as u64),
         bpv(connectivity),
         bpv(geometry),
         encoded.rounds,
-        seconds
+        seconds,
+        decode_ms,
+        splits / decode_ms / 1e3,
     );
     Ok(())
+}
+
+/// Median of 5 full decodes (workspace set up outside the timing), in ms.
+fn median_decode_ms(stream: &[u8]) -> Result<f64, String> {
+    let fail = |e: splitstream_decoder_core::Error| e.to_string();
+    let mut ws = OwnedWorkspace::for_stream(stream).map_err(fail)?;
+    let mut times = Vec::new();
+    for _ in 0..5 {
+        let mut decoder = ws.decoder(stream).map_err(fail)?;
+        let t = Instant::now();
+        decoder.decode_available(stream).map_err(fail)?;
+        times.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    times.sort_by(f64::total_cmp);
+    Ok(times[times.len() / 2])
 }
 
 fn quantized(input: &Input, mesh: &Mesh) -> QuantizedMesh {
@@ -197,7 +253,21 @@ fn metric_mesh(q: &QuantizedMesh) -> Mesh {
 
 type OptionsFor<'a> = &'a dyn Fn(usize, Option<f64>) -> SimplifyOptions;
 
-fn quality_row(input: &Input, mesh: &Mesh, fraction: f64, options: OptionsFor<'_>) -> CliResult {
+fn simplify(
+    backend: Backend,
+    q: &QuantizedMesh,
+    options: &SimplifyOptions,
+) -> Result<Simplification, String> {
+    simplify_on(backend, q, options, |_| {}).map_err(|e| e.to_string())
+}
+
+fn quality_row(
+    input: &Input,
+    mesh: &Mesh,
+    fraction: f64,
+    options: OptionsFor<'_>,
+    backend: Backend,
+) -> CliResult {
     let q = quantized(input, mesh);
     let metric = QuantizedMesh {
         origin: [0.0; 3],
@@ -207,7 +277,7 @@ fn quality_row(input: &Input, mesh: &Mesh, fraction: f64, options: OptionsFor<'_
     let reference = metric_mesh(&q);
     let target = ((mesh.positions.len() as f64) * fraction).round() as usize;
     let t = Instant::now();
-    let s = simplify(&q, &options(target, None), |_| {});
+    let s = simplify(backend, &q, &options(target, None))?;
     let parallel_seconds = t.elapsed().as_secs_f64();
     let parallel = s.to_mesh(&metric);
     let sequential = simplify_sequential(
@@ -238,13 +308,18 @@ fn quality_row(input: &Input, mesh: &Mesh, fraction: f64, options: OptionsFor<'_
     Ok(())
 }
 
-fn equal_error_row(input: &Input, mesh: &Mesh, options: OptionsFor<'_>) -> CliResult {
+fn equal_error_row(
+    input: &Input,
+    mesh: &Mesh,
+    options: OptionsFor<'_>,
+    backend: Backend,
+) -> CliResult {
     let q = quantized(input, mesh);
     let reference = metric_mesh(&q);
     let target = mesh.positions.len() / 16;
-    let first = simplify(&q, &options(target, None), |_| {});
+    let first = simplify(backend, &q, &options(target, None))?;
     let limit = first.max_error();
-    let parallel = simplify(&q, &options(0, Some(limit)), |_| {});
+    let parallel = simplify(backend, &q, &options(0, Some(limit)))?;
     let sequential = simplify_sequential(
         &reference,
         &BaselineOptions {
@@ -266,12 +341,13 @@ fn equal_error_row(input: &Input, mesh: &Mesh, options: OptionsFor<'_>) -> CliRe
     Ok(())
 }
 
-fn throughput(side: usize, admit: f64) -> CliResult {
+fn throughput(side: usize, admit: f64, backend: Backend) -> CliResult {
     let mesh = fractal_terrain(side, 2012);
     let triangles = mesh.triangles.len() as f64;
     let t = Instant::now();
     let options = EncodeOptions {
         admit_quantile: admit,
+        backend,
         ..EncodeOptions::default()
     };
     let encoded = encode(&mesh, &options, |_| {}).map_err(|e| e.to_string())?;

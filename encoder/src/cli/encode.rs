@@ -11,7 +11,7 @@ use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::Units;
 
-use super::{CliResult, Codec, Position};
+use super::{BackendArg, CliResult, Codec, Position};
 
 /// `splitstream encode`'s arguments.
 #[derive(clap::Args)]
@@ -33,8 +33,12 @@ pub struct Args {
     /// Largest quadric error a collapse may have.
     #[arg(long)]
     pub max_error: Option<f64>,
-    #[arg(long, value_enum, default_value_t = Codec::Deflate)]
+    #[arg(long, value_enum, default_value_t = Codec::Rans)]
     pub codec: Codec,
+    /// rANS lanes per chunk (1..=32): independent streams a decoder may
+    /// decode in parallel.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(1..=32))]
+    pub lanes: u8,
     /// Largest raw chunk in bytes (bounds decoder buffers).
     #[arg(long, default_value_t = 16384)]
     pub chunk_size: u32,
@@ -61,6 +65,10 @@ pub struct Args {
     /// errors are measured in metres.
     #[arg(long)]
     pub geographic: bool,
+    /// Where the simplification's data-parallel passes run (GPU backends:
+    /// quadrics, best edges and selection on the device, collapses on the CPU).
+    #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
+    pub backend: BackendArg,
 }
 
 pub fn run(a: Args) -> CliResult {
@@ -100,6 +108,7 @@ pub fn run(a: Args) -> CliResult {
         },
         max_error: a.max_error,
         codec: match a.codec {
+            Codec::Rans => ChunkCodec::Rans { lanes: a.lanes },
             Codec::Deflate => ChunkCodec::Deflate(9),
             Codec::Stored => ChunkCodec::Stored,
         },
@@ -111,6 +120,7 @@ pub fn run(a: Args) -> CliResult {
         } else {
             Units::Linear
         },
+        backend: a.backend.into(),
     };
     if !a.geographic && looks_geographic(&mesh) {
         eprintln!(

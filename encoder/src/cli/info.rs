@@ -2,17 +2,41 @@
 
 use std::path::Path;
 
+use splitstream_decoder_core::limits::VERSION_MAJOR;
 use splitstream_decoder_core::limits::substream::{self, NAMES};
 use splitstream_decoder_core::{Header, LevelHeader, LevelTable, PositionMode};
 
 use super::{CliResult, read_file};
 
-/// Bytes per substream id, stored (compressed) and raw.
+const FIELDS: usize = NAMES.len();
+
+/// Bytes per substream id, stored (compressed) and raw, and which codecs
+/// its chunks use.
 #[derive(Default)]
 pub struct FieldSizes {
-    pub stored: [u64; 12],
-    pub raw: [u64; 12],
+    pub stored: [u64; FIELDS],
+    /// Raw bytes (stored and deflate chunks) plus values (rANS chunks).
+    pub raw: [u64; FIELDS],
+    /// Per id, a bit per codec id seen (1 stored, 2 deflate, 4 rANS).
+    pub codecs: [u8; FIELDS],
     pub framing: u64,
+}
+
+impl FieldSizes {
+    /// The codecs of substream `id`, by name.
+    pub fn codec_names(&self, id: usize) -> String {
+        let names: Vec<&str> = ["stored", "deflate", "rans"]
+            .iter()
+            .enumerate()
+            .filter(|(bit, _)| self.codecs[id] & (1 << bit) != 0)
+            .map(|(_, n)| *n)
+            .collect();
+        if names.is_empty() {
+            "-".to_string()
+        } else {
+            names.join("+")
+        }
+    }
 }
 
 /// Sums chunk sizes per substream over every level of `stream`.
@@ -37,6 +61,7 @@ pub fn field_sizes(
             let chunk = lh.chunk(c).map_err(|e| e.to_string())?;
             sizes.stored[chunk.substream as usize] += chunk.stored_len as u64;
             sizes.raw[chunk.substream as usize] += chunk.raw_len as u64;
+            sizes.codecs[chunk.substream as usize] |= 1 << chunk.codec.min(7);
         }
     }
     Ok(sizes)
@@ -57,11 +82,11 @@ pub fn run(input: &Path, json: bool) -> CliResult {
     let sizes = field_sizes(&stream, &header, &table)?;
     let n = header.vertex_capacity as f64;
     let bpv = |bytes: u64| 8.0 * bytes as f64 / n;
-    let connectivity: u64 = (1..12)
+    let connectivity: u64 = (1..FIELDS)
         .filter(|&i| !is_geometry(i))
         .map(|i| sizes.stored[i])
         .sum();
-    let geometry: u64 = (1..12)
+    let geometry: u64 = (1..FIELDS)
         .filter(|&i| is_geometry(i))
         .map(|i| sizes.stored[i])
         .sum();
@@ -80,16 +105,17 @@ pub fn run(input: &Path, json: bool) -> CliResult {
                 })
             })
             .collect();
-        let fields: serde_json::Map<String, serde_json::Value> = (1..12)
+        let fields: serde_json::Map<String, serde_json::Value> = (1..FIELDS)
             .map(|i| {
                 (
                     NAMES[i].to_string(),
-                    serde_json::json!({"bytes": sizes.stored[i], "raw_bytes": sizes.raw[i], "bits_per_vertex": bpv(sizes.stored[i])}),
+                    serde_json::json!({"bytes": sizes.stored[i], "raw_bytes_or_values": sizes.raw[i], "codecs": sizes.codec_names(i), "bits_per_vertex": bpv(sizes.stored[i])}),
                 )
             })
             .collect();
         let doc = serde_json::json!({
-            "version": format!("1.{}", header.version_minor),
+            "version": format!("{VERSION_MAJOR}.{}", header.version_minor),
+            "lane_count": header.lane_count,
             "position_mode": mode,
             "bits": header.bits,
             "origin": header.origin,
@@ -114,9 +140,10 @@ pub fn run(input: &Path, json: bool) -> CliResult {
         return Ok(());
     }
     println!(
-        "{}: splitstream format 1.{}",
+        "{}: splitstream format {VERSION_MAJOR}.{}, {} rANS lane(s)",
         input.display(),
-        header.version_minor
+        header.version_minor,
+        header.lane_count
     );
     println!(
         "  {} vertices, {} triangles, {} bytes ({:.2} bits/vertex: connectivity {:.2}, geometry {:.2}, framing {:.2})",
@@ -152,13 +179,14 @@ pub fn run(input: &Path, json: bool) -> CliResult {
             e.geometric_error
         );
     }
-    println!("  field            bytes   raw bytes  bits/vertex");
+    println!("  field            bytes  raw bytes/values  codecs          bits/vertex");
     for (i, name) in NAMES.iter().enumerate().skip(1) {
         println!(
-            "  {:<14} {:>9} {:>11} {:>10.3}",
+            "  {:<14} {:>9} {:>17}  {:<14} {:>10.3}",
             name,
             sizes.stored[i],
             sizes.raw[i],
+            sizes.codec_names(i),
             bpv(sizes.stored[i])
         );
     }

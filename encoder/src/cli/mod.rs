@@ -4,6 +4,7 @@ mod bench;
 mod decode;
 mod demo;
 mod encode;
+mod gpu_bench;
 mod grid;
 mod info;
 mod output;
@@ -35,8 +36,33 @@ pub enum Position {
     Constrained,
 }
 
+/// Where the simplifier's data-parallel passes run.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum BackendArg {
+    /// CPU threads (rayon), f64.
+    #[default]
+    Cpu,
+    /// WGSL kernels through wgpu (Vulkan, Metal, DX12); topology on the CPU.
+    Wgpu,
+    /// OpenCL C kernels through ocl; topology on the CPU.
+    Opencl,
+}
+
+impl From<BackendArg> for splitstream_encoder::simplify::Backend {
+    fn from(b: BackendArg) -> Self {
+        use splitstream_encoder::simplify::Backend;
+        match b {
+            BackendArg::Cpu => Backend::Cpu,
+            BackendArg::Wgpu => Backend::Wgpu,
+            BackendArg::Opencl => Backend::OpenCl,
+        }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Codec {
+    /// Context-modelled rANS (SPEC §5.5), deflate where that is smaller.
+    Rans,
     Deflate,
     Stored,
 }
@@ -65,6 +91,10 @@ pub enum Command {
     /// Measure the encoder's goals: bits per vertex, quality and speed
     /// against the sequential baseline, throughput (see encoder/BENCHMARKS.md).
     Bench(bench::Settings),
+    /// Time the simplifier's backends (cpu, sequential baseline, wgpu,
+    /// opencl) on the 1M and 4M vertex fractal terrains in one run, each
+    /// stream checked by decoding it; ratios from the same run.
+    GpuBench(gpu_bench::Settings),
     /// Simplify an elevation grid (.tif .asc .npy .npz) as one tile on the
     /// client side: quad-tree split/merge with edge straightening, threshold
     /// min(H/800, Res/25); print facets before/after and the max vertical
@@ -93,6 +123,7 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Info { input, json } => info::run(&input, json),
         Command::Verify { input } => verify::run(&input),
         Command::Bench(settings) => bench::run(&settings),
+        Command::GpuBench(settings) => gpu_bench::run(&settings),
         Command::Grid(args) => grid::run(args),
         Command::Demo { side, output } => demo::run(side, output.as_deref()),
     }

@@ -12,7 +12,7 @@ use splitstream_decoder_core::writer::{
 
 use crate::mesh::Mesh;
 use crate::quantize::{QuantizedMesh, Units, quantize};
-use crate::simplify::{SimplifyOptions, simplify};
+use crate::simplify::{Backend, GpuError, SimplifyOptions, simplify_on};
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
 
@@ -39,6 +39,8 @@ pub struct EncodeOptions {
     pub admit_quantile: f64,
     /// Units of the input coordinates, for the error metric.
     pub units: Units,
+    /// Where the simplification's data-parallel passes run.
+    pub backend: Backend,
 }
 
 impl Default for EncodeOptions {
@@ -49,11 +51,12 @@ impl Default for EncodeOptions {
             base_vertices: None,
             position_mode: PositionMode::Optimal,
             max_error: None,
-            codec: ChunkCodec::Deflate(9),
+            codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
             lock_boundary: false,
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,
+            backend: Backend::Cpu,
         }
     }
 }
@@ -75,6 +78,7 @@ pub struct Encoded {
 pub enum EncodeError {
     BadOption(String),
     Replay(ReplayError),
+    Backend(GpuError),
 }
 
 impl std::fmt::Display for EncodeError {
@@ -82,6 +86,7 @@ impl std::fmt::Display for EncodeError {
         match self {
             EncodeError::BadOption(s) => write!(f, "{s}"),
             EncodeError::Replay(e) => write!(f, "{e}"),
+            EncodeError::Backend(e) => write!(f, "{e}"),
         }
     }
 }
@@ -131,7 +136,8 @@ pub fn encode_quantized(
         ..SimplifyOptions::default()
     };
     let started = std::time::Instant::now();
-    let simplification = simplify(mesh, &simplify_options, progress);
+    let simplification = simplify_on(options.backend, mesh, &simplify_options, progress)
+        .map_err(EncodeError::Backend)?;
     let simplify_seconds = started.elapsed().as_secs_f64();
     let started = std::time::Instant::now();
     let plan = plan_levels(&simplification, options.levels, base);

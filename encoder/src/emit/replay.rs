@@ -5,7 +5,7 @@ use splitstream_decoder_core::limits::{LEAF, NONE, substream};
 use splitstream_decoder_core::writer::{LevelPayload, SeedPayload, SubstreamWriter};
 use splitstream_decoder_core::{
     Error, MeshState, PositionMode, RecordSource, Ring, SplitOutcome, SplitRecord, StateMemory,
-    predict_split,
+    context, predict_split, refine_c,
 };
 
 use super::levels::LevelPlan;
@@ -56,7 +56,7 @@ impl Memory {
             opposite: vec![0; (3 * t).max(6 * base_t + base_v + 1)],
             vertex_corner: vec![0; v],
             deficit: vec![0; v],
-            candidates: vec![0; 2 * v.div_ceil(64)],
+            candidates: vec![0; 3 * v.div_ceil(64)],
         }
     }
 
@@ -85,6 +85,8 @@ struct StepSource<'a> {
     subs: &'a mut [SubstreamWriter],
     mode: PositionMode,
     pending: Option<usize>,
+    /// Whether the pending split gives the collapse's C index R (SPEC §7.4).
+    swapped: bool,
     problem: Option<String>,
 }
 
@@ -100,10 +102,10 @@ impl StepSource<'_> {
 }
 
 impl RecordSource for StepSource<'_> {
-    fn flag(&mut self, v: u32) -> Result<bool, Error> {
+    fn flag(&mut self, _state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
         let id = self.dec2enc[v as usize];
         let flagged = self.current[id as usize] != NONE;
-        self.subs[slot(substream::FLAGS)].bit(flagged);
+        self.subs[slot(substream::FLAGS)].bit_in(context::SINGLE, flagged);
         Ok(flagged)
     }
 
@@ -118,14 +120,33 @@ impl RecordSource for StepSource<'_> {
         let (Some(ia), Some(ib)) = (find(a), find(b)) else {
             return Err(self.fail(format!("wings of the collapse of {id} not in the ring")));
         };
-        // P's arc runs counter-clockwise from wing A to wing B.
-        let (o, d, config) = if ia < ib {
-            (ia, ib - ia, false)
+        // The collapse's P keeps R's index when its arc (counter-clockwise
+        // from wing A to wing B) is arc 1; otherwise the roles swap and its
+        // C keeps the index (SPEC §7.4: arc 1 always goes to P).
+        let swapped = ia > ib;
+        let (o, d) = if swapped {
+            (ib, ia - ib)
         } else {
-            (ib, ia - ib, true)
+            (ia, ib - ia)
+        };
+        self.swapped = swapped;
+        let (sv_p, sv_c, p, c) = if swapped {
+            (
+                col.split_valence_c,
+                col.split_valence_p,
+                col.position_c,
+                col.position_p,
+            )
+        } else {
+            (
+                col.split_valence_p,
+                col.split_valence_c,
+                col.position_p,
+                col.position_c,
+            )
         };
         let k = ring.len();
-        let len_p = if config { k - d } else { d };
+        let len_p = d;
         let deficit = |split_valence: u8, valence: usize| -> Option<u8> {
             if split_valence == LEAF {
                 Some(LEAF)
@@ -135,29 +156,30 @@ impl RecordSource for StepSource<'_> {
                     .map(|x| x as u8)
             }
         };
-        let (Some(dp), Some(dc)) = (
-            deficit(col.split_valence_p, len_p + 2),
-            deficit(col.split_valence_c, k - len_p + 2),
-        ) else {
+        let (Some(dp), Some(dc)) = (deficit(sv_p, len_p + 2), deficit(sv_c, k - len_p + 2)) else {
             return Err(self.fail(format!("valence of {id} grew past its split valence")));
         };
         let parent = state.positions()[r as usize];
         if parent != col.position_r {
             return Err(self.fail(format!("position of {id} differs from its collapse")));
         }
-        let (p, c) = (col.position_p, col.position_c);
-        let (p_hat, c_hat) = predict_split(state.positions(), parent, ring, o, d, config);
+        let (p_hat, c_hat) = predict_split(state.positions(), parent, ring, o, d);
         let residual = |x: [u32; 3], hat: [i64; 3]| -> [i64; 3] {
             std::array::from_fn(|i| x[i] as i64 - hat[i])
         };
         let s = &mut *self.subs;
-        s[slot(substream::WING_OFFSET)].byte(o as u8);
-        s[slot(substream::WING_DISTANCE)].byte(d as u8);
-        s[slot(substream::CONFIG)].bit(config);
-        s[slot(substream::DEFICIT_P)].byte(dp);
-        s[slot(substream::DEFICIT_C)].byte(dc);
+        s[slot(substream::WING_OFFSET)].byte_in(context::SINGLE, o as u8);
+        s[slot(substream::WING_DISTANCE)].byte_in(context::wing_distance(k), d as u8);
+        s[slot(substream::DEFICIT_P)].byte_in(context::SINGLE, dp);
+        s[slot(substream::DEFICIT_C)].byte_in(context::deficit_c(dp), dc);
         let (first, second): ([i64; 3], Option<[i64; 3]>) = match self.mode {
-            PositionMode::Optimal => (residual(p, p_hat), Some(residual(c, c_hat))),
+            PositionMode::Optimal => {
+                let p_wide = p.map(|x| x as i64);
+                (
+                    residual(p, p_hat),
+                    Some(residual(c, refine_c(c_hat, parent, p_wide))),
+                )
+            }
             PositionMode::Constrained => {
                 let e: [i64; 3] = std::array::from_fn(|i| c[i] as i64 - p[i] as i64);
                 let mid: [u32; 3] = std::array::from_fn(|i| (p[i] as i64 + (e[i] >> 1)) as u32);
@@ -172,7 +194,7 @@ impl RecordSource for StepSource<'_> {
                         "constrained position of {id} off P, C and midpoint"
                     )));
                 };
-                s[slot(substream::PLACEMENT)].byte(code);
+                s[slot(substream::PLACEMENT)].byte_in(context::SINGLE, code);
                 (first, None)
             }
         };
@@ -181,18 +203,17 @@ impl RecordSource for StepSource<'_> {
             return Err(self.fail(format!("position residual of {id} beyond 32 bits")));
         }
         let s = &mut *self.subs;
-        for x in first {
-            s[slot(substream::EDGE)].signed(x as i32);
+        for (axis, x) in first.into_iter().enumerate() {
+            s[slot(substream::EDGE)].signed_in(context::axis(axis), x as i32);
         }
         if let Some(second) = second {
-            for x in second {
-                s[slot(substream::PLACEMENT)].signed(x as i32);
+            for (axis, x) in second.into_iter().enumerate() {
+                s[slot(substream::PLACEMENT)].signed_in(context::axis(axis), x as i32);
             }
         }
         Ok(SplitRecord {
             wing_offset: o as u8,
             wing_distance: d as u8,
-            config,
             deficit_p: dp,
             deficit_c: dc,
             position_p: p,
@@ -200,11 +221,19 @@ impl RecordSource for StepSource<'_> {
         })
     }
 
-    fn applied(&mut self, _r: u32, c: u32, _outcome: &SplitOutcome) {
+    fn applied(&mut self, r: u32, c: u32, _outcome: &SplitOutcome) {
         if let Some(index) = self.pending.take() {
-            let gone = self.collapses[index].c;
-            self.enc2dec[gone as usize] = c;
-            self.dec2enc.push(gone);
+            let col = self.collapses[index];
+            // Which input vertex keeps index r and which gets the new index.
+            let (kept, new) = if self.swapped {
+                (col.c, col.p)
+            } else {
+                (col.p, col.c)
+            };
+            self.enc2dec[kept as usize] = r;
+            self.dec2enc[r as usize] = kept;
+            self.enc2dec[new as usize] = c;
+            self.dec2enc.push(new);
         }
     }
 }
@@ -270,7 +299,7 @@ pub fn replay(
     let mut current = vec![NONE; n];
     let mut ring = Ring::default();
     for (l, steps) in plan.rounds.iter().enumerate() {
-        let mut subs = vec![SubstreamWriter::default(); 8];
+        let mut subs = vec![SubstreamWriter::default(); 7];
         let mut round_splits = Vec::with_capacity(steps.len());
         for &k in steps {
             let collapses = &s.steps[k];
@@ -285,6 +314,7 @@ pub fn replay(
                 subs: &mut subs,
                 mode,
                 pending: None,
+                swapped: false,
                 problem: None,
             };
             let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);

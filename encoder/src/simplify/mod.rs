@@ -20,9 +20,29 @@
 //! of the Index array is not needed on the CPU: the collapses of a step are
 //! kept in ascending survivor id (a stable order) and the stream's vertex
 //! order is fixed by the decoder's own rule during replay (see `emit`).
+//!
+//! [`simplify_on`] runs the same steps with the data-parallel passes on a
+//! GPU backend (`gpu`: which step runs where is tabled there).
 
+mod backend;
 mod check;
+mod gpu;
 mod select;
 mod state;
 
+pub use backend::{Backend, GpuError};
 pub use state::{Collapse, Simplification, SimplifyOptions, simplify};
+
+/// [`simplify`] on `backend`. The CPU backend never fails; a GPU backend
+/// fails when it is not compiled in, has no adapter, or its kernels fail.
+pub fn simplify_on(
+    backend: Backend,
+    mesh: &crate::quantize::QuantizedMesh,
+    options: &SimplifyOptions,
+    progress: impl FnMut(usize),
+) -> Result<Simplification, GpuError> {
+    match backend.api() {
+        None => Ok(simplify(mesh, options, progress)),
+        Some(api) => gpu::simplify_gpu(api, mesh, options, progress),
+    }
+}

@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use super::check::{CheckScratch, check_collapse};
+use super::check::{CheckScratch, Plan, check_collapse};
 use super::select::{Best, EdgeSlot, Scale, best_edge, best_edge_avoiding, edge_slot, pair_key};
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
@@ -101,6 +101,41 @@ pub(super) struct State {
 }
 
 impl State {
+    /// The state before any collapse, without quadrics and edge slots
+    /// (each backend computes those its own way).
+    pub fn new(mesh: &QuantizedMesh, options: &SimplifyOptions) -> State {
+        let n = mesh.positions.len();
+        let metric = mesh.metric;
+        let geometry: Vec<[f64; 3]> = mesh
+            .positions
+            .iter()
+            .map(|p| std::array::from_fn(|k| p[k] as f64 * metric[k]))
+            .collect();
+        let table = CornerTable::new(n, &mesh.triangles);
+        let mut boundary = vec![false; n];
+        for (c, &o) in table.opposite.iter().enumerate() {
+            if o == NONE {
+                boundary[table.v(next(c as u32)) as usize] = true;
+                boundary[table.v(prev(c as u32)) as usize] = true;
+            }
+        }
+        let alive: Vec<bool> = table.corner_of.iter().map(|&c| c != NONE).collect();
+        State {
+            quadrics: Vec::new(),
+            positions: mesh.positions.clone(),
+            geometry,
+            table,
+            boundary,
+            alive,
+            split_valence: vec![LEAF; n],
+            edges: Vec::new(),
+            bits: mesh.bits,
+            metric,
+            constrained: options.constrained,
+            lock_boundary: options.lock_boundary,
+        }
+    }
+
     pub fn geometry(&self, v: u32) -> [f64; 3] {
         self.geometry[v as usize]
     }
@@ -118,35 +153,8 @@ pub fn simplify(
     mut progress: impl FnMut(usize),
 ) -> Simplification {
     let n = mesh.positions.len();
-    let metric = mesh.metric;
-    let geometry: Vec<[f64; 3]> = mesh
-        .positions
-        .iter()
-        .map(|p| std::array::from_fn(|k| p[k] as f64 * metric[k]))
-        .collect();
-    let table = CornerTable::new(n, &mesh.triangles);
-    let mut boundary = vec![false; n];
-    for (c, &o) in table.opposite.iter().enumerate() {
-        if o == NONE {
-            boundary[table.v(next(c as u32)) as usize] = true;
-            boundary[table.v(prev(c as u32)) as usize] = true;
-        }
-    }
-    let alive: Vec<bool> = table.corner_of.iter().map(|&c| c != NONE).collect();
-    let mut s = State {
-        quadrics: vertex_quadrics(&geometry, &mesh.triangles, options.boundary_weight),
-        positions: mesh.positions.clone(),
-        geometry,
-        table,
-        boundary,
-        alive,
-        split_valence: vec![LEAF; n],
-        edges: Vec::new(),
-        bits: mesh.bits,
-        metric,
-        constrained: options.constrained,
-        lock_boundary: options.lock_boundary,
-    };
+    let mut s = State::new(mesh, options);
+    s.quadrics = vertex_quadrics(&s.geometry, &mesh.triangles, options.boundary_weight);
     s.edges = (0..s.table.vertex.len() as u32)
         .into_par_iter()
         .map(|c| edge_slot(&s, c))
@@ -387,10 +395,23 @@ fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64]) -> bool {
 
 /// Applies the collapse chosen by `p`, returning its record.
 fn apply_collapse(s: &mut State, p: u32, b: Best, fans: &mut [Fan; 2]) -> Collapse {
+    try_apply_collapse(s, p, b, fans)
+        .expect("the winner was checked in this step and its neighbourhood is untouched")
+        .0
+}
+
+/// Applies the collapse chosen by `p` if `check_collapse` accepts it,
+/// returning its record and plan; `None` leaves the state untouched (GPU
+/// backends choose in f32, the CPU has the last word in f64).
+pub(super) fn try_apply_collapse(
+    s: &mut State,
+    p: u32,
+    b: Best,
+    fans: &mut [Fan; 2],
+) -> Option<(Collapse, Plan)> {
     let c = b.other;
     let mut scratch = CheckScratch::default();
-    let plan = check_collapse(s, p, c, s.to_metric(b.target), &mut scratch)
-        .expect("the winner was checked in this step and its neighbourhood is untouched");
+    let plan = check_collapse(s, p, c, s.to_metric(b.target), &mut scratch).ok()?;
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
     let weight = q.c[0] + q.c[4] + q.c[7];
     let distance = if weight > 0.0 {
@@ -419,7 +440,7 @@ fn apply_collapse(s: &mut State, p: u32, b: Best, fans: &mut [Fan; 2]) -> Collap
     s.boundary[pi] |= s.boundary[ci];
     s.alive[ci] = false;
     s.split_valence[pi] = plan.valence_r as u8;
-    record
+    Some((record, plan))
 }
 
 /// Re-evaluates the edges around each merged vertex: only their quadric or
@@ -456,7 +477,7 @@ fn refresh_edges(s: &mut State, merged: &[u32]) {
 /// Marks the vertices within two edges of each merged vertex: the only
 /// ones whose best collapse can have changed (errors, links, fold-overs and
 /// wing valences all live in the 2-ring).
-fn mark_two_rings(s: &State, merged: &[u32], dirty: &mut [bool]) {
+pub(super) fn mark_two_rings(s: &State, merged: &[u32], dirty: &mut [bool]) {
     dirty.fill(false);
     let touched: Vec<u32> = merged
         .par_iter()
@@ -493,7 +514,7 @@ fn neighbours_of<'a>(s: &'a State, fan: &'a Fan) -> impl Iterator<Item = u32> + 
 }
 
 /// Mean length of the live edges, for the sub-grid cell size.
-fn mean_edge_length(s: &State) -> f64 {
+pub(super) fn mean_edge_length(s: &State) -> f64 {
     let t = &s.table;
     let (sum, count) = (0..t.vertex.len() as u32)
         .into_par_iter()

@@ -11,11 +11,15 @@
 //! then lies exactly on the neighbour's straight edge, so wherever the
 //! quad-tree keeps it as a corner it cannot open a crack.
 //!
-//! This needs the shared side to be a whole side of both tiles (tiles of
-//! equal extent, as in a quad-tree of tiles one level apart on that side
-//! after the coarser one is split, or tiles of one level): a coarse tile
-//! whose side spans two fine tiles runs one pass over the whole side, the
-//! fine tiles one each over their halves, and those can disagree.
+//! A side shared with several tiles (a coarse tile next to two tiles of
+//! half its extent, say, `Params::neighbour_tiles`) is cut at their corners
+//! first, which both sides keep: each stretch is then the whole side of one
+//! neighbour and both run the pass on the same profile.
+//!
+//! The reference heights of a side next to a coarser tile: between two
+//! samples the neighbour has, the neighbour draws a straight edge at best,
+//! so the samples it lacks are measured against that edge (their linear
+//! interpolation), not against their own heights.
 
 use super::threshold::Thresholds;
 use super::{Side, Tile};
@@ -34,6 +38,25 @@ fn side_len(side: Side, rows: usize, cols: usize) -> usize {
     match side {
         Side::South | Side::North => cols,
         Side::East | Side::West => rows,
+    }
+}
+
+/// Overwrites the border entries of `reference` (a copy of the tile
+/// heights) that a coarser neighbour lacks with the interpolation of those
+/// it has.
+pub fn reference_heights(tile: &Tile, thresholds: &Thresholds, reference: &mut [f64]) {
+    let (rows, cols) = (tile.rows, tile.cols);
+    for side in Side::ALL {
+        let k = thresholds.sides[side as usize].stride;
+        let n = side_len(side, rows, cols);
+        for a in (0..n - 1).step_by(k) {
+            let ha = tile.heights[side_index(side, rows, cols, a)];
+            let hb = tile.heights[side_index(side, rows, cols, a + k)];
+            for p in a + 1..a + k {
+                let t = (p - a) as f64 / k as f64;
+                reference[side_index(side, rows, cols, p)] = ha + (hb - ha) * t;
+            }
+        }
     }
 }
 
@@ -57,10 +80,14 @@ pub fn fix_border(
         let h = |q: usize| tile.heights[side_index(side, rows, cols, q * k)];
         keep.clear();
         keep.resize(m + 1, false);
-        keep[0] = true;
-        keep[m] = true;
         stack.clear();
-        stack.push((0, m));
+        // Each neighbour tile's stretch on its own, its ends kept.
+        let per = m / rule.segments;
+        for s in 0..rule.segments {
+            keep[s * per] = true;
+            stack.push((s * per, (s + 1) * per));
+        }
+        keep[m] = true;
         while let Some((a, b)) = stack.pop() {
             if b - a < 2 {
                 continue;

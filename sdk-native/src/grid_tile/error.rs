@@ -29,6 +29,13 @@ pub enum GridTileError {
         spacing: f64,
         cells: usize,
     },
+    /// The neighbour tile count of a side is zero or does not divide the
+    /// cells of that side.
+    NeighbourTilesMismatch {
+        side: Side,
+        tiles: u32,
+        cells: usize,
+    },
 }
 
 impl fmt::Display for GridTileError {
@@ -67,7 +74,11 @@ impl fmt::Display for GridTileError {
             } => write!(
                 f,
                 "{side:?} neighbour resolution {resolution} is not a whole multiple of the \
-                 spacing {spacing} dividing the {cells} cells of that side"
+                 spacing {spacing} dividing the {cells} cells of that side (per neighbour tile)"
+            ),
+            GridTileError::NeighbourTilesMismatch { side, tiles, cells } => write!(
+                f,
+                "{side:?} side: {tiles} neighbour tiles cannot share its {cells} cells evenly"
             ),
         }
     }

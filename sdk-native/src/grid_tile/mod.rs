@@ -13,15 +13,28 @@
 //! (`triangulate.rs`) and the largest vertical error is measured
 //! (`measure.rs`).
 //!
-//! Error bound: every merge keeps all samples of the merged rectangle within
-//! T of its two-triangle surface, and border samples within T of the border
-//! polyline. Where a rectangle is fanned through vertices on its sides, the
-//! fan differs from the two-triangle surface by at most the error at those
-//! vertices, so the error can reach 2 T. Two things can exceed that: samples
-//! of a side next to a coarser tile that the coarser tile lacks (the paper
-//! accepts this: that side is drawn at the coarser resolution), and, with
-//! [`Params::exact_border`], the re-triangulation where a leftover border
-//! corner is removed. [`Stats::max_vertical_error`] reports the exact figure.
+//! Error bound: every sample of the tile ends within its T of the surface
+//! drawn (T of the side, from the coarser resolution, on a side next to a
+//! coarser tile). The merges alone do not ensure it: a rectangle fanned
+//! through vertices on its sides, or re-triangulated where a border corner
+//! is removed, can drift up to about 2 T (5 T next to borders). So after
+//! triangulating, the simplifier measures every sample and splits the
+//! rectangles around any sample over its T in halves, then triangulates
+//! again, until none is over. This ends: single cells are exact, and next
+//! to the border the strip of cells left is within T (border samples lie
+//! within T of the border polyline by the border pass).
+//!
+//! The reference heights are the tile's own, except on a side next to a
+//! coarser tile: samples the neighbour lacks are measured against the
+//! straight edge between the neighbour's samples around them (the paper
+//! draws that side at the coarser resolution; nothing finer can match the
+//! neighbour without a crack). [`Stats::max_vertical_error`] and
+//! [`Stats::max_error_ratio`] report the figures.
+//!
+//! Crack-free borders: two tiles sharing a side pick that side's vertices
+//! with the same pass over the samples they share and draw it with exactly
+//! those vertices ([`border`](self) module docs), also when a coarse tile's
+//! side is shared by several finer tiles ([`Params::neighbour_tiles`]).
 //!
 //! Memory: a [`Simplifier`] sizes every buffer from the tile size once;
 //! simplifying further tiles of that size allocates nothing.
@@ -45,6 +58,7 @@
 //! assert_eq!((stats.cells, stats.rectangles), (4096, 1));
 //! assert_eq!(mesh.triangles.len(), 2);
 //! assert!(stats.max_vertical_error < 1e-9);
+//! assert!(stats.max_error_ratio <= 1.0);
 //! ```
 
 mod border;
@@ -53,6 +67,7 @@ mod edge;
 mod error;
 mod measure;
 mod quadtree;
+mod refine;
 mod threshold;
 mod triangulate;
 
@@ -96,27 +111,21 @@ pub struct Params {
     /// not coarser. A coarser one must be a whole multiple of this tile's
     /// spacing along that side.
     pub neighbour_res: [Option<f64>; 4],
-    /// True: a tile side always carries exactly the vertices the neighbour
-    /// draws on it (the border pass's pinned ones), even where removing a
-    /// leftover rectangle corner costs more than 2 T next to the border.
-    /// False: such a corner stays when removing it would exceed 2 T; it
-    /// lies on the neighbour's straight edge (no gap, but a T-junction
-    /// across the tiles), counted in [`Stats::border_t_junctions`].
-    pub exact_border: bool,
-    /// Measure [`Stats::max_vertical_error`] (about half the run time on
-    /// 64 x 64 tiles; a renderer can leave it off, the figure is then NaN).
-    pub measure_error: bool,
+    /// How many neighbouring tiles share each side, indexed by [`Side`]:
+    /// 1 when one tile's side is the whole side (tiles of equal extent), 2
+    /// when two tiles of half this tile's extent line it, and so on. Their
+    /// corners are kept on this side, so that each of them and this tile
+    /// agree on the vertices. Must divide the cells of the side.
+    pub neighbour_tiles: [u32; 4],
 }
 
 impl Params {
-    /// Viewing height `h`, no coarser neighbour, exact borders, error
-    /// measured.
+    /// Viewing height `h`, no coarser neighbour, one neighbour tile a side.
     pub fn new(viewing_height: f64) -> Self {
         Params {
             viewing_height,
             neighbour_res: [None; 4],
-            exact_border: true,
-            measure_error: true,
+            neighbour_tiles: [1; 4],
         }
     }
 }
@@ -145,15 +154,17 @@ pub struct Stats {
     /// Triangles of the simplified mesh.
     pub triangles_after: usize,
     pub vertices_after: usize,
-    /// Max over the original samples of |h - simplified surface| (NaN
-    /// unless [`Params::measure_error`]).
+    /// Max over the samples of |h - simplified surface|, h the reference
+    /// height (see the module docs: the tile's own except for samples a
+    /// coarser neighbour lacks).
     pub max_vertical_error: f64,
+    /// Max over the samples of |h - surface| / T(sample): at most 1.
+    pub max_error_ratio: f64,
     /// T of interior samples.
     pub threshold: f64,
-    /// Border corners the border pass did not pin but that could not be
-    /// removed (see [`Params::exact_border`]); each lies exactly on the
-    /// straight edge the neighbour draws there.
-    pub border_t_junctions: usize,
+    /// Rounds of splitting that the error check needed (0: the merged
+    /// rectangles were within T at once).
+    pub refinements: usize,
 }
 
 impl Stats {
@@ -180,6 +191,7 @@ pub struct Simplifier {
     out: Simplified,
     work: Vec<Rect>,
     heights: Vec<f64>,
+    reference: Vec<f64>,
     thresholds: Vec<f64>,
     pinned: Vec<bool>,
     keep: Vec<bool>,
@@ -187,6 +199,7 @@ pub struct Simplifier {
     slot: Vec<u32>,
     tri: triangulate::Scratch,
     grid: Vec<[f64; 2]>,
+    refine: refine::Scratch,
 }
 
 impl Simplifier {
@@ -200,8 +213,11 @@ impl Simplifier {
                 positions: Vec::with_capacity(n + cells),
                 triangles: Vec::with_capacity(4 * n),
             },
-            work: Vec::with_capacity(cells),
+            // Merged-away rectangles stay in place; splits add at most one
+            // live rectangle each, and there are never more than `cells`.
+            work: Vec::with_capacity(2 * cells),
             heights: Vec::with_capacity(n),
+            reference: Vec::with_capacity(n),
             thresholds: Vec::with_capacity(n),
             pinned: Vec::with_capacity(n),
             keep: Vec::with_capacity(rows.max(cols)),
@@ -220,7 +236,14 @@ impl Simplifier {
                 remap: Vec::with_capacity(n + cells),
             },
             grid: Vec::with_capacity(n + cells),
+            refine: refine::Scratch::new(n, cells),
         }
+    }
+
+    /// The last result (empty before the first successful
+    /// [`Simplifier::simplify`]).
+    pub fn result(&self) -> &Simplified {
+        &self.out
     }
 
     /// Simplifies one tile; the result stays valid until the next call.
@@ -229,6 +252,9 @@ impl Simplifier {
         tile: &Tile,
         params: &Params,
     ) -> Result<(&Simplified, Stats), GridTileError> {
+        self.out.rectangles.clear();
+        self.out.positions.clear();
+        self.out.triangles.clear();
         check(tile)?;
         let th = threshold::Thresholds::new(tile, params)?;
         let (rows, cols) = (tile.rows, tile.cols);
@@ -236,6 +262,8 @@ impl Simplifier {
 
         self.heights.clear();
         self.heights.extend_from_slice(tile.heights);
+        self.reference.clear();
+        self.reference.extend_from_slice(tile.heights);
         self.pinned.clear();
         self.pinned.resize(n, false);
         self.thresholds.clear();
@@ -244,6 +272,7 @@ impl Simplifier {
                 self.thresholds.push(th.at(x, y, rows, cols));
             }
         }
+        border::reference_heights(tile, &th, &mut self.reference);
         border::fix_border(
             tile,
             &th,
@@ -261,42 +290,53 @@ impl Simplifier {
         };
         quadtree::build(&field, &mut self.work, &mut self.slot);
 
-        let border_t_junctions = triangulate::triangulate(
-            &triangulate::Layout {
+        let layout = triangulate::Layout {
+            rows,
+            cols,
+            heights: &self.heights,
+            reference: &self.reference,
+            thresholds: &self.thresholds,
+            origin: tile.origin,
+            spacing: tile.spacing,
+        };
+        // Triangulate, check, split where over T, until nothing is.
+        let mut refinements = 0;
+        let measured = loop {
+            self.refine.over.clear();
+            triangulate::triangulate(
+                &layout,
+                &self.work,
+                &self.pinned,
+                &mut self.tri,
+                triangulate::Mesh {
+                    positions: &mut self.out.positions,
+                    triangles: &mut self.out.triangles,
+                    grid: &mut self.grid,
+                },
+                &mut self.refine.over,
+            );
+            let measured = measure::check(
                 rows,
                 cols,
-                heights: &self.heights,
-                original: tile.heights,
-                thresholds: &self.thresholds,
-                exact_border: params.exact_border,
-                origin: tile.origin,
-                spacing: tile.spacing,
-            },
-            &self.work,
-            &self.pinned,
-            &mut self.tri,
-            triangulate::Mesh {
-                positions: &mut self.out.positions,
-                triangles: &mut self.out.triangles,
-                grid: &mut self.grid,
-            },
-        );
-        self.out.rectangles.clear();
+                &self.reference,
+                &self.thresholds,
+                measure::Surface {
+                    positions: &self.out.positions,
+                    grid: &self.grid,
+                    triangles: &self.out.triangles,
+                },
+                &mut self.refine.over,
+            );
+            if self.refine.over.is_empty()
+                || !refine::split_around(rows, cols, &mut self.work, &mut self.refine)
+            {
+                break measured;
+            }
+            refinements += 1;
+        };
         self.out
             .rectangles
             .extend(self.work.iter().filter(|r| r.alive).copied());
-        let max_vertical_error = if params.measure_error {
-            measure::max_vertical_error(
-                rows,
-                cols,
-                tile.heights,
-                &self.out.positions,
-                &self.grid,
-                &self.out.triangles,
-            )
-        } else {
-            f64::NAN
-        };
         let cells = (rows - 1) * (cols - 1);
         let stats = Stats {
             cells,
@@ -304,9 +344,10 @@ impl Simplifier {
             triangles_before: 2 * cells,
             triangles_after: self.out.triangles.len(),
             vertices_after: self.out.positions.len(),
-            max_vertical_error,
+            max_vertical_error: measured.max_error,
+            max_error_ratio: measured.max_ratio,
             threshold: th.interior,
-            border_t_junctions,
+            refinements,
         };
         Ok((&self.out, stats))
     }

@@ -21,6 +21,9 @@ pub struct SideRule {
     /// Only every `stride`-th sample of the side exists in the neighbour
     /// (1 unless the neighbour is coarser).
     pub stride: usize,
+    /// Neighbouring tiles along this side: the border pass treats each
+    /// one's stretch on its own, as that tile does (1 for a whole side).
+    pub segments: usize,
     /// T on this side: from the coarser of the tile and its neighbour.
     pub threshold: f64,
 }
@@ -44,9 +47,19 @@ impl Thresholds {
         let res = tile_resolution(tile.spacing);
         let mut sides = [SideRule {
             stride: 1,
+            segments: 1,
             threshold: threshold(h, res),
         }; 4];
         for side in Side::ALL {
+            let tiles = params.neighbour_tiles[side as usize];
+            let cells = match side {
+                Side::North | Side::South => tile.cols - 1,
+                Side::East | Side::West => tile.rows - 1,
+            };
+            if tiles == 0 || !cells.is_multiple_of(tiles as usize) {
+                return Err(GridTileError::NeighbourTilesMismatch { side, tiles, cells });
+            }
+            sides[side as usize].segments = tiles as usize;
             let Some(nres) = params.neighbour_res[side as usize] else {
                 continue;
             };
@@ -65,7 +78,11 @@ impl Thresholds {
                 1
             } else {
                 let k = ratio.round();
-                if (ratio - k).abs() > 1e-6 * k || k as usize == 0 || cells % (k as usize) != 0 {
+                let per_tile = cells / tiles as usize;
+                if (ratio - k).abs() > 1e-6 * k
+                    || k as usize == 0
+                    || !per_tile.is_multiple_of(k as usize)
+                {
                     return Err(GridTileError::NeighbourMismatch {
                         side,
                         resolution: nres,
@@ -77,6 +94,7 @@ impl Thresholds {
             };
             sides[side as usize] = SideRule {
                 stride,
+                segments: tiles as usize,
                 threshold: threshold(h, res.max(nres)),
             };
         }

@@ -9,23 +9,24 @@
 //! vertex is off the straight line, the paper's Fig. 4). Such a rectangle is
 //! instead fanned through every vertex on its perimeter, in order: from the
 //! (col0, row0) or (col1, row1) corner when both sides at that corner are
-//! bare (n - 2 triangles for n perimeter vertices); otherwise by ear
-//! clipping (n - 2 triangles) when that keeps every sample inside within
-//! 2 T; otherwise from a new vertex at its centre whose height is that of the
-//! two-triangle surface there (n triangles). Each edge of the mesh is then shared by exactly the
-//! two triangles on either side, with the same two end vertices, so there is
-//! neither a crack nor a T-junction inside the tile. Both fans stay within
-//! one two-triangle half per triangle, which is what the 2 T error bound of
-//! [`super`] relies on; the ear-clipped case checks the bound instead.
+//! bare (n - 2 triangles for n perimeter vertices), or else by ear clipping
+//! (n - 2 triangles), whichever first keeps every sample inside within its
+//! T; otherwise from a new vertex at its centre whose height is that of
+//! the two-triangle surface there (n triangles). Each edge of the mesh is
+//! then shared by exactly the two triangles on either side, with the same
+//! two end vertices, so there is neither a crack nor a T-junction inside the
+//! tile. None of this bounds the error by itself: [`super::Simplifier`]
+//! checks the result and splits the rectangles around any sample off by
+//! more than its T, then triangulates again.
 //!
 //! The tile border carries exactly the vertices the border pass pinned, so
 //! that the neighbouring tile, which pins the same ones, meets it edge to
 //! edge. A rectangle corner left on the border between two pinned vertices
 //! (where a merge across it was refused) is removed from the mesh and the
 //! hole its triangles leave is ear-clipped ([`super::earclip`]). Should that
-//! fail (it needs a strictly convex ear), the corner stays; its height was
-//! already moved onto the straight border edge, so the neighbour's edge
-//! passes exactly through it (a T-junction, but no gap).
+//! fail (it needs a strictly convex ear), the corner is reported and the
+//! caller splits the rectangles around it (next to the border, single cells
+//! always leave a strictly convex ear).
 //!
 //! Triangles are counter-clockwise seen from +z (the winding flips when one
 //! spacing is negative, since the axes are then mirrored).
@@ -55,9 +56,7 @@ const DEAD: [u32; 3] = [u32::MAX; 3];
 
 /// Removes border vertex `v` (inside a straight stretch of the tile border)
 /// by ear-clipping the polygon its triangles leave, choosing ears of least
-/// error. False, with nothing changed, when that fails or, unless
-/// `layout.exact_border`, leaves a sample further than twice its T from the
-/// surface.
+/// error. False, with nothing changed, when no ear can be clipped.
 fn remove_vertex(
     v: u32,
     layout: &Layout,
@@ -112,8 +111,10 @@ fn remove_vertex(
         &mut sc.work,
         &mut sc.new_tris,
     ) {
-        Some(worst) if layout.exact_border || worst <= 2.0 => {}
-        _ => return false,
+        // The caller checks the error of the result (and splits rectangles
+        // where it is too large); the border must match the neighbour's.
+        Some(_) => {}
+        None => return false,
     }
     let listed = sc.incident[lo..hi].iter().map(|&(_, t)| t);
     for t in listed.chain(sc.added.iter().copied()) {
@@ -132,15 +133,15 @@ fn remove_vertex(
 fn triangle_error(layout: &Layout, t: [u32; 3], positions: &[[f64; 3]], grid: &[[f64; 2]]) -> f64 {
     let mut worst: f64 = 0.0;
     visit_triangle(layout.rows, layout.cols, t, positions, grid, |i, z| {
-        worst = worst.max((layout.original[i] - z).abs() / layout.thresholds[i]);
+        worst = worst.max((layout.reference[i] - z).abs() / layout.thresholds[i]);
     });
     worst
 }
 
 /// Triangulates a rectangle whose perimeter `poly` has more than four
 /// vertices by ear clipping (shortest new edge first), keeping the result
-/// only if every sample inside stays within 2 T; false leaves `mesh` as it
-/// was.
+/// only if every sample inside stays within its T; false leaves `mesh` as
+/// it was.
 fn clip_rectangle(layout: &Layout, poly: &[u32], work: &mut Vec<u32>, mesh: &mut Mesh) -> bool {
     let start = mesh.triangles.len();
     let grid = &*mesh.grid;
@@ -154,7 +155,36 @@ fn clip_rectangle(layout: &Layout, poly: &[u32], work: &mut Vec<u32>, mesh: &mut
     }
     let ok = mesh.triangles[start..]
         .iter()
-        .all(|&t| triangle_error(layout, t, mesh.positions, grid) <= 2.0);
+        .all(|&t| triangle_error(layout, t, mesh.positions, grid) <= 1.0);
+    if !ok {
+        mesh.triangles.truncate(start);
+    }
+    ok
+}
+
+/// Fans a rectangle from a corner on its diagonal whose two sides are bare
+/// (`corner` holds the perimeter indices of its corners p00, p10, p11,
+/// p01): n - 2 triangles, kept only if every sample inside stays within
+/// its T; false leaves `mesh` as it was.
+fn corner_fan(layout: &Layout, perimeter: &[u32], corner: [usize; 4], mesh: &mut Mesh) -> bool {
+    let n = perimeter.len();
+    // South and west bare: p00 sees every other perimeter vertex.
+    let apex = if corner[1] == 1 && corner[3] == n - 1 {
+        0
+    } else {
+        corner[2]
+    };
+    let start = mesh.triangles.len();
+    for k in 1..n - 1 {
+        mesh.triangles.push([
+            perimeter[apex],
+            perimeter[(apex + k) % n],
+            perimeter[(apex + k + 1) % n],
+        ]);
+    }
+    let ok = mesh.triangles[start..]
+        .iter()
+        .all(|&t| triangle_error(layout, t, mesh.positions, mesh.grid) <= 1.0);
     if !ok {
         mesh.triangles.truncate(start);
     }
@@ -175,25 +205,25 @@ pub struct Layout<'a> {
     pub cols: usize,
     /// Heights after the border pass.
     pub heights: &'a [f64],
-    /// The tile's own heights.
-    pub original: &'a [f64],
+    /// The heights the error is measured against (`super::reference`).
+    pub reference: &'a [f64],
     /// T(V) of every sample.
     pub thresholds: &'a [f64],
-    /// See [`super::Params::exact_border`].
-    pub exact_border: bool,
     pub origin: [f64; 2],
     pub spacing: [f64; 2],
 }
 
 /// Fills `mesh` from the live rectangles; `pinned` marks the border
-/// vertices to keep. Returns how many unpinned border corners had to stay.
+/// vertices to keep. Unpinned border corners that could not be removed are
+/// pushed (as sample indices) to `kept`.
 pub fn triangulate(
     layout: &Layout,
     rects: &[Rect],
     pinned: &[bool],
     sc: &mut Scratch,
     mut mesh: Mesh,
-) -> usize {
+    kept: &mut Vec<u32>,
+) {
     let Layout {
         rows,
         cols,
@@ -286,24 +316,12 @@ pub fn triangulate(
         if n == 4 {
             mesh.triangles.push([v(x0, y0), v(x1, y0), v(x1, y1)]);
             mesh.triangles.push([v(x0, y0), v(x1, y1), v(x0, y1)]);
-        } else if south == 0 && west == 0 || east == 0 && north == 0 {
-            // Fan from a corner on the diagonal whose two sides are bare:
-            // n - 2 triangles, each inside one of the two-triangle halves.
-            let apex = if south == 0 && west == 0 {
-                0
-            } else {
-                corner[2]
-            };
-            for k in 1..n - 1 {
-                mesh.triangles.push([
-                    perimeter[apex],
-                    perimeter[(apex + k) % n],
-                    perimeter[(apex + k + 1) % n],
-                ]);
-            }
-        } else if clip_rectangle(layout, perimeter, work, &mut mesh) {
-            // n - 2 triangles by ear clipping, within 2 T.
-        } else {
+        } else if !((south == 0 && west == 0 || east == 0 && north == 0)
+            && corner_fan(layout, perimeter, corner, &mut mesh))
+            && !clip_rectangle(layout, perimeter, work, &mut mesh)
+        {
+            // Neither fits within T: from the centre (n triangles); the
+            // caller's check splits the rectangle if this does not fit.
             let centre = mesh.positions.len() as u32;
             let (cx, cy) = (0.5 * (x0 + x1) as f64, 0.5 * (y0 + y1) as f64);
             let hc = 0.5 * (heights[y0 * cols + x0] + heights[y1 * cols + x1]);
@@ -342,11 +360,11 @@ pub fn triangulate(
     }
     incident.sort_unstable();
     let mut k = 0;
-    let mut kept = 0;
     while k < sc.incident.len() {
         let v = sc.incident[k].0;
         if !remove_vertex(v, layout, mesh.triangles, mesh.positions, mesh.grid, sc) {
-            kept += 1;
+            let [x, y] = mesh.grid[v as usize];
+            kept.push(y as u32 * cols as u32 + x as u32);
         }
         k = sc.incident.partition_point(|&(w, _)| w <= v);
     }
@@ -377,5 +395,4 @@ pub fn triangulate(
         let m = t.map(|v| remap[v as usize]);
         *t = if mirrored { [m[0], m[2], m[1]] } else { m };
     }
-    kept
 }

@@ -1,0 +1,162 @@
+//! Host-side types shared by the wgpu (`refine`, feature `wgpu`) and OpenCL
+//! (`ocl_refine`, feature `opencl`) refiners, and the checks both make before a round.
+
+use super::adjacency::AdjacencyError;
+use super::layout::{GpuRecord, KernelFault, WORKGROUP};
+use crate::gpu::{Api, GpuError};
+
+/// Largest 1-D dispatch, in workgroups (WebGPU's per-dimension minimum).
+pub const MAX_GROUPS: u64 = 65_535;
+
+/// The base state uploaded once (decoder-core's state after level 0's seed).
+#[derive(Clone, Copy, Debug)]
+pub struct BaseMesh<'a> {
+    pub positions: &'a [[u32; 3]],
+    pub triangles: &'a [[u32; 3]],
+    pub deficits: &'a [u8],
+    /// Quantization bits per axis (SPEC §3.2).
+    pub bits: u8,
+}
+
+/// One round as the stream gives it.
+#[derive(Clone, Copy, Debug)]
+pub struct RoundInput<'a> {
+    /// Candidates at round start (the number of flags read).
+    pub candidates: u32,
+    /// One bit per candidate in ascending candidate order, LSB first.
+    pub flags: &'a [u32],
+    /// The flagged splits' records, in split order.
+    pub records: &'a [GpuRecord],
+    /// Triangle count the current level may reach (SPEC §7.5).
+    pub triangle_limit: u32,
+}
+
+/// Why the refiner could not be set up or run.
+#[derive(Debug)]
+pub enum RefineError {
+    Gpu(GpuError),
+    /// The base mesh has no consistent adjacency.
+    Base(AdjacencyError),
+    /// More vertices or triangles than the buffers were sized for.
+    Capacity {
+        what: &'static str,
+        needed: u64,
+        capacity: u64,
+    },
+    /// The round's input is inconsistent (flags too short for the count).
+    Input(&'static str),
+}
+
+impl core::fmt::Display for RefineError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            RefineError::Gpu(e) => write!(f, "{e}"),
+            RefineError::Base(e) => write!(f, "base mesh: {e}"),
+            RefineError::Capacity {
+                what,
+                needed,
+                capacity,
+            } => {
+                write!(f, "{what}: {needed} needed, room for {capacity}")
+            }
+            RefineError::Input(what) => write!(f, "round input: {what}"),
+        }
+    }
+}
+
+impl std::error::Error for RefineError {}
+
+impl From<GpuError> for RefineError {
+    fn from(e: GpuError) -> Self {
+        RefineError::Gpu(e)
+    }
+}
+
+/// A failure of the API itself (launch, transfer, mapping).
+pub fn kernel_error(api: Api, detail: impl ToString) -> RefineError {
+    RefineError::Gpu(GpuError::Kernel {
+        api,
+        detail: detail.to_string(),
+    })
+}
+
+/// The state read back from the device.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Snapshot {
+    pub positions: Vec<[u32; 3]>,
+    pub deficits: Vec<u8>,
+    /// Flat corners, 3 per triangle.
+    pub corners: Vec<u32>,
+    /// Present when asked for.
+    pub opposite: Vec<u32>,
+    pub vertex_corner: Vec<u32>,
+    /// The first fault of the last round that had one, if any.
+    pub fault: Option<KernelFault>,
+}
+
+/// Checks a base mesh against the capacities both hosts allocate.
+pub fn check_base(
+    base: &BaseMesh<'_>,
+    vertex_capacity: u32,
+    triangle_capacity: u32,
+) -> Result<(), RefineError> {
+    if base.deficits.len() != base.positions.len() {
+        return Err(RefineError::Input("one deficit per base vertex"));
+    }
+    for (what, needed, capacity) in [
+        (
+            "vertices",
+            base.positions.len() as u64,
+            vertex_capacity as u64,
+        ),
+        (
+            "triangles",
+            base.triangles.len() as u64,
+            triangle_capacity as u64,
+        ),
+        (
+            "vertices per dispatch",
+            vertex_capacity as u64,
+            MAX_GROUPS * WORKGROUP as u64,
+        ),
+    ] {
+        if needed > capacity {
+            return Err(RefineError::Capacity {
+                what,
+                needed,
+                capacity,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Checks a round's input against the host's vertex count `n` and the
+/// capacities.
+pub fn check_round(
+    input: &RoundInput<'_>,
+    n: u32,
+    vertex_capacity: u32,
+    split_capacity: u32,
+) -> Result<(), RefineError> {
+    let s = input.records.len() as u64;
+    if (input.flags.len() as u64) * 32 < input.candidates as u64 {
+        return Err(RefineError::Input("fewer flag bits than candidates"));
+    }
+    if input.candidates > n {
+        return Err(RefineError::Input("more candidates than vertices"));
+    }
+    if n as u64 + s > vertex_capacity as u64 || s > split_capacity as u64 {
+        return Err(RefineError::Capacity {
+            what: "vertices",
+            needed: n as u64 + s,
+            capacity: vertex_capacity as u64,
+        });
+    }
+    Ok(())
+}
+
+/// 2^bits, or 0 when every u32 is a valid coordinate.
+pub fn position_limit(bits: u8) -> u32 {
+    if bits >= 32 { 0 } else { 1u32 << bits }
+}

@@ -1,0 +1,280 @@
+//! The encoder's simplification kernels (Cellier et al. 2012, §2) and the
+//! engine that drives them on either API.
+//!
+//! What runs on the device, per step: best edge per vertex (step a, with
+//! the validity checks), reciprocity and local minimum with index priority
+//! (steps b and c, three passes with re-picks as on the CPU), and once at
+//! the start the quadric init. What stays on the host (the encoder): the
+//! corner-table surgery of the collapses, the threshold S (a quantile of
+//! the read-back errors, so no device sort is needed), and the 2-ring
+//! bookkeeping; the host uploads the triangles and vertices it changed with
+//! the two `update_*` kernels.
+//!
+//! Positions are the quantized grid coordinates (u32) and every float
+//! computation happens in a frame local to one vertex, so f32 suffices on
+//! meshes far from the origin.
+
+pub mod layout;
+pub mod sources;
+
+#[cfg(feature = "opencl")]
+mod ocl_host;
+#[cfg(feature = "wgpu")]
+mod wgpu_host;
+
+use crate::gpu::{Api, DeviceInfo, GpuError};
+use layout::{Best, MODE_ALL, MODE_REPICK, Params, TriangleUpdate, VertexUpdate, Winner};
+pub use sources::{Kernel, Slot, WgslModule};
+
+/// Device buffers, by role (`Slot::List` binds `Dirty` or `Live`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Buffer {
+    Params,
+    Corners,
+    CornerOf,
+    Vertices,
+    Quadrics,
+    Best,
+    Blocked,
+    Keys,
+    Dirty,
+    Live,
+    Winners,
+    Counter,
+    Updates,
+}
+
+impl Buffer {
+    pub const ALL: [Buffer; 13] = [
+        Buffer::Params,
+        Buffer::Corners,
+        Buffer::CornerOf,
+        Buffer::Vertices,
+        Buffer::Quadrics,
+        Buffer::Best,
+        Buffer::Blocked,
+        Buffer::Keys,
+        Buffer::Dirty,
+        Buffer::Live,
+        Buffer::Winners,
+        Buffer::Counter,
+        Buffer::Updates,
+    ];
+
+    /// Initial size in u32 words for a mesh of `n` vertices and `corners` corners.
+    pub fn words(self, n: usize, corners: usize) -> usize {
+        let n = n.max(1);
+        match self {
+            Buffer::Params => size_of::<Params>() / 4,
+            Buffer::Corners => 2 * corners.max(1),
+            Buffer::CornerOf | Buffer::Blocked | Buffer::Dirty | Buffer::Live => n,
+            Buffer::Vertices => 4 * n,
+            Buffer::Quadrics => 10 * n,
+            Buffer::Best => 6 * n,
+            Buffer::Keys => 2 * n,
+            // Winners of one step are disjoint pairs.
+            Buffer::Winners => 7 * (n / 2 + 1),
+            Buffer::Counter => 1,
+            // Grows on demand.
+            Buffer::Updates => 1024,
+        }
+    }
+
+    /// The buffer bound at `slot` (`list` for [`Slot::List`]).
+    pub fn for_slot(slot: Slot, list: Buffer) -> Buffer {
+        match slot {
+            Slot::Params => Buffer::Params,
+            Slot::Corners => Buffer::Corners,
+            Slot::CornerOf => Buffer::CornerOf,
+            Slot::Vertices => Buffer::Vertices,
+            Slot::Quadrics => Buffer::Quadrics,
+            Slot::Best => Buffer::Best,
+            Slot::Blocked => Buffer::Blocked,
+            Slot::Keys => Buffer::Keys,
+            Slot::List => list,
+            Slot::Winners => Buffer::Winners,
+            Slot::Counter => Buffer::Counter,
+            Slot::Updates => Buffer::Updates,
+        }
+    }
+}
+
+/// The primitive operations a compute API offers the engine.
+pub trait Device {
+    fn info(&self) -> &DeviceInfo;
+    /// Writes `words` at the start of `buffer`, growing it when needed.
+    fn write(&mut self, buffer: Buffer, words: &[u32]) -> Result<(), GpuError>;
+    /// Reads the first `words` words of `buffer` (waits for queued work).
+    fn read(&mut self, buffer: Buffer, words: usize) -> Result<Vec<u32>, GpuError>;
+    fn zero(&mut self, buffer: Buffer) -> Result<(), GpuError>;
+    /// Runs `kernel` on `items` threads with `params`, `list` bound as the list.
+    fn run(
+        &mut self,
+        kernel: Kernel,
+        params: &Params,
+        items: u32,
+        list: Buffer,
+    ) -> Result<(), GpuError>;
+}
+
+/// The mesh as the kernels see it.
+pub struct MeshData<'a> {
+    /// Per corner: (vertex, opposite corner).
+    pub corners: &'a [[u32; 2]],
+    pub corner_of: &'a [u32],
+    /// Per vertex: quantized x, y, z and flags (`layout::ALIVE | BOUNDARY`).
+    pub vertices: &'a [[u32; 4]],
+}
+
+/// Opens an OpenCL device and builds the encoder's program on it (the
+/// build check of the `.cl` sources).
+#[cfg(feature = "opencl")]
+pub fn build_opencl_program() -> Result<DeviceInfo, GpuError> {
+    let ctx = crate::gpu::open_opencl()?;
+    ocl_host::build_program(&ctx)?;
+    Ok(ctx.info)
+}
+
+/// Drives the kernels through one [`Device`].
+pub struct Engine {
+    device: Box<dyn Device>,
+    vertex_count: usize,
+    live_len: u32,
+}
+
+impl Engine {
+    /// Opens a device of `api` and uploads the mesh.
+    pub fn open(api: Api, mesh: &MeshData<'_>) -> Result<Engine, GpuError> {
+        let n = mesh.vertices.len();
+        let corners = mesh.corners.len();
+        let mut device: Box<dyn Device> = match api {
+            #[cfg(feature = "wgpu")]
+            Api::Wgpu => Box::new(wgpu_host::WgpuDevice::new(n, corners)?),
+            #[cfg(feature = "opencl")]
+            Api::OpenCl => Box::new(ocl_host::OclDevice::new(n, corners)?),
+            #[allow(unreachable_patterns)]
+            api => return Err(GpuError::NotCompiled { api }),
+        };
+        device.write(Buffer::Corners, bytemuck::cast_slice(mesh.corners))?;
+        device.write(Buffer::CornerOf, mesh.corner_of)?;
+        device.write(Buffer::Vertices, bytemuck::cast_slice(mesh.vertices))?;
+        // Never read before written, but keys must start "no request".
+        device.write(Buffer::Keys, &vec![u32::MAX; 2 * n.max(1)])?;
+        Ok(Engine {
+            device,
+            vertex_count: n,
+            live_len: 0,
+        })
+    }
+
+    pub fn info(&self) -> &DeviceInfo {
+        self.device.info()
+    }
+
+    /// Quadric init: every vertex's quadric in its own frame, left on the
+    /// device and returned (a2 ab ac ad b2 bc bd c2 cd d2).
+    pub fn quadric_init(&mut self, params: &Params) -> Result<Vec<[f32; 10]>, GpuError> {
+        let n = self.vertex_count as u32;
+        self.device
+            .run(Kernel::QuadricInit, params, n, Buffer::Dirty)?;
+        let words = self.device.read(Buffer::Quadrics, 10 * self.vertex_count)?;
+        Ok(bytemuck::cast_slice(&words).to_vec())
+    }
+
+    /// Uploads what the host changed.
+    pub fn update(
+        &mut self,
+        params: &Params,
+        triangles: &[TriangleUpdate],
+        vertices: &[VertexUpdate],
+    ) -> Result<(), GpuError> {
+        if triangles.is_empty() && vertices.is_empty() {
+            return Ok(());
+        }
+        let mut words: Vec<u32> = bytemuck::cast_slice(triangles).to_vec();
+        let vertex_offset = words.len() as u32;
+        words.extend_from_slice(bytemuck::cast_slice(vertices));
+        self.device.write(Buffer::Updates, &words)?;
+        let p = Params {
+            list_len: triangles.len() as u32,
+            mode: 0,
+            ..*params
+        };
+        self.device
+            .run(Kernel::UpdateTriangles, &p, p.list_len, Buffer::Dirty)?;
+        let p = Params {
+            list_len: vertices.len() as u32,
+            mode: vertex_offset,
+            ..*params
+        };
+        self.device
+            .run(Kernel::UpdateVertices, &p, p.list_len, Buffer::Dirty)
+    }
+
+    /// Step a for the `dirty` vertices; returns every vertex's current best.
+    pub fn best_edges(&mut self, params: &Params, dirty: &[u32]) -> Result<Vec<Best>, GpuError> {
+        if !dirty.is_empty() {
+            self.device.write(Buffer::Dirty, dirty)?;
+            let p = Params {
+                list_len: dirty.len() as u32,
+                mode: MODE_ALL,
+                ..*params
+            };
+            self.device
+                .run(Kernel::BestEdge, &p, p.list_len, Buffer::Dirty)?;
+        }
+        let words = self.device.read(Buffer::Best, 6 * self.vertex_count)?;
+        Ok(bytemuck::cast_slice(&words).to_vec())
+    }
+
+    /// The live vertices the selection walks.
+    pub fn set_live(&mut self, live: &[u32]) -> Result<(), GpuError> {
+        self.device.write(Buffer::Live, live)?;
+        self.live_len = live.len() as u32;
+        Ok(())
+    }
+
+    /// Steps b and c under `params.threshold`, `passes` times with re-picks
+    /// in between (see the encoder's `step_winners`). Winners in ascending
+    /// lower id.
+    pub fn select(&mut self, params: &Params, passes: usize) -> Result<Vec<Winner>, GpuError> {
+        let live = self.live_len;
+        self.device.zero(Buffer::Blocked)?;
+        self.device.zero(Buffer::Counter)?;
+        let walk = Params {
+            list_len: live,
+            mode: MODE_ALL,
+            ..*params
+        };
+        let mut done = 0u32;
+        for pass in 0..passes {
+            if pass > 0 {
+                let repick = Params {
+                    mode: MODE_REPICK,
+                    ..walk
+                };
+                self.device
+                    .run(Kernel::BestEdge, &repick, live, Buffer::Live)?;
+            }
+            self.device.run(Kernel::Admit, &walk, live, Buffer::Live)?;
+            self.device
+                .run(Kernel::LocalMin, &walk, live, Buffer::Live)?;
+            let count = self.device.read(Buffer::Counter, 1)?[0];
+            if count == done {
+                break;
+            }
+            let block = Params {
+                list_len: count - done,
+                mode: done,
+                ..*params
+            };
+            self.device
+                .run(Kernel::Block, &block, block.list_len, Buffer::Live)?;
+            done = count;
+        }
+        let words = self.device.read(Buffer::Winners, 7 * done as usize)?;
+        let mut winners: Vec<Winner> = bytemuck::cast_slice(&words).to_vec();
+        winners.sort_unstable_by_key(|w| w.v);
+        Ok(winners)
+    }
+}

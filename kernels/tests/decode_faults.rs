@@ -1,0 +1,244 @@
+//! The decoder kernels on real devices (lavapipe for WGSL, pocl for OpenCL
+//! C in CI): one valid split on an octahedron, and every fault the kernels
+//! detect, each with the SPEC §10.1 class the reference decoder gives it.
+//! Each API compiled in (features `wgpu`, `opencl`) is tested; without its
+//! device a test prints a skip note, except under `CI`, where it fails.
+#![cfg(any(feature = "wgpu", feature = "opencl"))]
+
+use splitstream_kernels::decode::adjacency::check_adjacency;
+use splitstream_kernels::decode::host::{BaseMesh, RoundInput, Snapshot};
+use splitstream_kernels::decode::layout::LEAF;
+use splitstream_kernels::decode::{GpuRecord, KernelFault};
+use splitstream_kernels::gpu::GpuError;
+
+/// An opened device of one API.
+enum Device {
+    #[cfg(feature = "wgpu")]
+    Wgpu(Box<splitstream_kernels::gpu::WgpuContext>),
+    #[cfg(feature = "opencl")]
+    OpenCl(splitstream_kernels::gpu::OclContext),
+}
+
+fn available<T>(opened: Result<T, GpuError>) -> Option<T> {
+    match opened {
+        Ok(ctx) => Some(ctx),
+        Err(e) if e.is_unavailable() && std::env::var_os("CI").is_none() => {
+            eprintln!(
+                "skipping {}: {e} (lavapipe: WGPU_BACKEND=vulkan; pocl: pocl-opencl-icd)",
+                e.api()
+            );
+            None
+        }
+        Err(e) => panic!("no device under CI: {e}"),
+    }
+}
+
+/// Every API compiled in whose device opens.
+fn devices() -> Vec<Device> {
+    // The tests run in parallel threads; the OpenCL ICD loader (pocl) can
+    // report no device when two threads enumerate at once.
+    static OPENING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one_at_a_time = OPENING.lock().unwrap_or_else(|e| e.into_inner());
+    let mut out = Vec::new();
+    #[cfg(feature = "wgpu")]
+    out.extend(available(splitstream_kernels::gpu::open_wgpu()).map(|c| Device::Wgpu(Box::new(c))));
+    #[cfg(feature = "opencl")]
+    out.extend(available(splitstream_kernels::gpu::open_opencl()).map(Device::OpenCl));
+    out
+}
+
+/// +x, -x, +y, -y, +z, -z; counter-clockwise seen from outside.
+const OCTAHEDRON: [[u32; 3]; 8] = [
+    [4, 0, 2],
+    [4, 2, 1],
+    [4, 1, 3],
+    [4, 3, 0],
+    [5, 2, 0],
+    [5, 1, 2],
+    [5, 3, 1],
+    [5, 0, 3],
+];
+const POSITIONS: [[u32; 3]; 6] = [
+    [200, 100, 100],
+    [0, 100, 100],
+    [100, 200, 100],
+    [100, 0, 100],
+    [100, 100, 200],
+    [100, 100, 0],
+];
+
+fn record(offset: u32, distance: u32) -> GpuRecord {
+    GpuRecord {
+        offset,
+        distance,
+        config: 0,
+        deficit_p: LEAF,
+        deficit_c: LEAF,
+        position_p: [190, 110, 100],
+        position_c: [190, 90, 100],
+        _pad: 0,
+    }
+}
+
+/// Runs one round on the octahedron with `deficits` and returns the state.
+fn run(
+    device: &Device,
+    deficits: [u8; 6],
+    candidates: u32,
+    flags: u32,
+    records: &[GpuRecord],
+    triangle_limit: u32,
+) -> Snapshot {
+    let base = BaseMesh {
+        positions: &POSITIONS,
+        triangles: &OCTAHEDRON,
+        deficits: &deficits,
+        bits: 8,
+    };
+    let round = RoundInput {
+        candidates,
+        flags: &[flags],
+        records,
+        triangle_limit,
+    };
+    match device {
+        #[cfg(feature = "wgpu")]
+        Device::Wgpu(ctx) => {
+            use splitstream_kernels::decode::refine::Refiner;
+            let mut refiner = Refiner::new(ctx, base, 16, 32).expect("refiner");
+            refiner.round(round).expect("round");
+            refiner.snapshot(true).expect("snapshot")
+        }
+        #[cfg(feature = "opencl")]
+        Device::OpenCl(ctx) => {
+            use splitstream_kernels::decode::ocl_refine::OclRefiner;
+            let mut refiner = OclRefiner::new(ctx, base, 16, 32).expect("refiner");
+            refiner.round(round).expect("round");
+            refiner.snapshot(true).expect("snapshot")
+        }
+    }
+}
+
+#[test]
+fn one_split_on_an_octahedron() {
+    for ctx in devices() {
+        one_split(&ctx);
+    }
+}
+
+fn one_split(ctx: &Device) {
+    // Vertex 0 (+x) is the only candidate; ring [2, 4, 3, 5] from its
+    // smallest neighbour; wings r_0 = 2 and r_2 = 3.
+    let s = run(ctx, [0, 1, 1, 1, 1, 1], 1, 1, &[record(0, 2)], 32);
+    assert_eq!(s.fault, None);
+    assert_eq!(s.positions.len(), 7);
+    assert_eq!(s.corners.len(), 30);
+    assert_eq!(s.positions[0], [190, 110, 100]);
+    assert_eq!(s.positions[6], [190, 90, 100]);
+    assert_eq!(s.deficits, vec![LEAF as u8, 1, 0, 0, 1, 1, LEAF as u8]);
+    // Both new triangles hold P (0) and C (6) and one wing each.
+    let new: Vec<&[u32]> = s.corners[24..].chunks(3).collect();
+    assert_eq!(new, vec![&[0, 6, 2][..], &[6, 0, 3][..]]);
+    check_adjacency(&s.corners, &s.opposite, &s.vertex_corner).expect("adjacency");
+    // Every triangle still has three distinct corners and each directed
+    // edge is used once (a consistently oriented 2-manifold).
+    let mut edges = std::collections::HashSet::new();
+    for t in s.corners.chunks(3) {
+        for i in 0..3 {
+            assert!(
+                edges.insert((t[i], t[(i + 1) % 3])),
+                "edge used twice in {t:?}"
+            );
+        }
+    }
+}
+
+#[test]
+fn kernel_faults_have_the_reference_classes() {
+    for ctx in devices() {
+        faults(&ctx);
+    }
+}
+
+fn faults(ctx: &Device) {
+    let lone = [0, 1, 1, 1, 1, 1];
+    let fault = |s: Snapshot| s.fault.map(KernelFault::class);
+    assert_eq!(
+        fault(run(ctx, lone, 1, 1, &[record(0, 0)], 32)),
+        Some("ring-offset-out-of-range")
+    );
+    assert_eq!(
+        fault(run(ctx, lone, 1, 1, &[record(2, 2)], 32)),
+        Some("ring-offset-out-of-range")
+    );
+    let mut far = record(0, 2);
+    far.position_c = [256, 0, 0];
+    assert_eq!(
+        fault(run(ctx, lone, 1, 1, &[far], 32)),
+        Some("position-out-of-range")
+    );
+    let mut heavy = record(0, 2);
+    heavy.deficit_p = 254;
+    assert_eq!(
+        fault(run(ctx, lone, 1, 1, &[heavy], 32)),
+        Some("valence-overflow")
+    );
+    // A wing (2) with deficit 0.
+    assert_eq!(
+        run(ctx, [0, 1, 0, 1, 1, 1], 2, 0b01, &[record(0, 2)], 32).fault,
+        Some(KernelFault::ValenceOverflow { split: 0 })
+    );
+    // The host says 2 candidates, the GPU finds 1; or 2 flags for 1 record.
+    assert_eq!(
+        run(ctx, lone, 2, 1, &[record(0, 2)], 32).fault,
+        Some(KernelFault::CountMismatch)
+    );
+    assert_eq!(
+        run(ctx, [0, 1, 0, 1, 1, 1], 2, 0b11, &[record(0, 2)], 32).fault,
+        Some(KernelFault::CountMismatch)
+    );
+    // Two new triangles would pass a level limit of 9.
+    assert_eq!(
+        run(ctx, lone, 1, 1, &[record(0, 2)], 9).fault,
+        Some(KernelFault::TriangleLimit { split: 0 })
+    );
+    // Adjacent flagged vertices 0 and 2: the first of them fails.
+    assert_eq!(
+        run(
+            ctx,
+            [0, 1, 0, 1, 1, 1],
+            2,
+            0b11,
+            &[record(0, 2), record(0, 2)],
+            32
+        )
+        .fault,
+        Some(KernelFault::DependentSplits { split: 0 })
+    );
+    // Poles 4 and 5 are independent but share their wings 0 and 1 (ring
+    // [0, 2, 1, 3] and [0, 3, 1, 2]), which can each lose one more neighbour.
+    assert_eq!(
+        fault(run(
+            ctx,
+            [1, 1, 1, 1, 0, 0],
+            2,
+            0b11,
+            &[record(0, 2), record(0, 2)],
+            32
+        )),
+        Some("valence-overflow")
+    );
+    // The same with room for both: no fault, 8 vertices, 12 triangles.
+    let s = run(
+        ctx,
+        [2, 2, 1, 1, 0, 0],
+        2,
+        0b11,
+        &[record(0, 2), record(0, 2)],
+        32,
+    );
+    assert_eq!(s.fault, None);
+    assert_eq!((s.positions.len(), s.corners.len() / 3), (8, 12));
+    assert_eq!(&s.deficits[..2], &[0, 0]);
+    check_adjacency(&s.corners, &s.opposite, &s.vertex_corner).expect("adjacency");
+}

@@ -1,0 +1,296 @@
+//! [`Session`]: a progressive decoder that owns everything it borrows, for
+//! callers that cannot hold Rust borrows across calls (C, JavaScript).
+//!
+//! decoder-core's [`Decoder`] borrows the stream head and its workspace, and
+//! a [`LevelDecoder`] borrows the decoder and the level's bytes. A C or JS
+//! handle must own all of that at once, which safe Rust cannot express (it
+//! is self-referential). This is the one place that does it, with raw
+//! pointers obtained from `Box::leak`: the pointees never move, are reached
+//! only through the borrows handed to decoder-core (never through the
+//! pointers while a borrow derived from them is in use), and are freed in
+//! `Drop`, borrowers first. Every borrower lives behind such a pointer too,
+//! so no reference is stored in the `Session` value itself: moving it
+//! (into `drop`, say) retags nothing that is freed while it is protected
+//! (`cargo +nightly miri test -p splitstream-sdk-native --test session`
+//! checks this under Stacked Borrows).
+
+use core::ops::Range;
+use core::ptr::NonNull;
+
+use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_decoder_core::{
+    Decoder, Error, Header, LevelDecoder, LevelInfo, MeshState, RoundInfo, head_len,
+};
+
+/// A progressive decoding session: created from the stream head (header and
+/// level table), fed level by level, decoded level by level or round by
+/// round. All memory is allocated once, at [`Session::open`], from the
+/// sizes the header declares.
+pub struct Session {
+    /// `Box<LevelDecoder>` of the level being decoded round by round;
+    /// borrows `*decoder` mutably and `*level_bytes`. Dropped before either.
+    level: Option<NonNull<LevelDecoder<'static, 'static, 'static>>>,
+    /// The bytes of the open level (`Box<[u8]>::into_raw`), if any.
+    level_bytes: Option<NonNull<[u8]>>,
+    /// `Box<Decoder>::into_raw`; borrows `*head` and `*workspace`.
+    decoder: NonNull<Decoder<'static, 'static>>,
+    /// `Box<OwnedWorkspace>::into_raw`.
+    workspace: NonNull<OwnedWorkspace>,
+    /// `Box<[u8]>::into_raw`: header and level table.
+    head: NonNull<[u8]>,
+    header: Header,
+    levels: Vec<LevelInfo>,
+    /// Levels done when the open level began (the decoder's own count is
+    /// out of reach while a level borrows it).
+    done_while_open: u16,
+}
+
+impl Session {
+    /// Parses the header and level table at the start of `head` (the whole
+    /// stream or just its first [`Session::head_len`] bytes, which are
+    /// copied) and allocates the workspace the whole stream needs.
+    pub fn open(head: &[u8]) -> Result<Session, Error> {
+        let header = Header::parse(head)?;
+        let len = head_len(header.level_count);
+        let head: Box<[u8]> = head.get(..len).ok_or(Error::Truncated)?.into();
+        // Checks the level table and the declared size, refuses absurd ones.
+        let workspace = Box::new(OwnedWorkspace::for_stream(&head)?);
+        let head = NonNull::from(Box::leak(head));
+        let workspace = NonNull::from(Box::leak(workspace));
+        // SAFETY: both pointers come from `Box::leak` just above, so they
+        // are valid, unique and never move; they are freed only in `Drop`,
+        // after the decoder built from them (and on the error path below).
+        // Nothing else reads or writes them while the decoder lives.
+        let built = unsafe { (*workspace.as_ptr()).decoder(&*head.as_ptr()) };
+        let decoder = match built {
+            Ok(d) => d,
+            Err(e) => {
+                // SAFETY: from `Box::leak` above; the failed decoder borrowed
+                // nothing beyond this point.
+                unsafe {
+                    drop(Box::from_raw(workspace.as_ptr()));
+                    drop(Box::from_raw(head.as_ptr()));
+                }
+                return Err(e);
+            }
+        };
+        let levels = (0..header.level_count)
+            .map(|k| decoder.level_table().get(k))
+            .collect();
+        let decoder = NonNull::from(Box::leak(Box::new(decoder)));
+        Ok(Session {
+            level: None,
+            level_bytes: None,
+            decoder,
+            workspace,
+            head,
+            header,
+            levels,
+            done_while_open: 0,
+        })
+    }
+
+    /// Bytes of header and level table, from the 96-byte header alone (so a
+    /// client knows how much to fetch before [`Session::open`]).
+    pub fn head_len(header: &[u8]) -> Result<usize, Error> {
+        Ok(head_len(Header::parse(header)?.level_count))
+    }
+
+    /// The decoder, while no level borrows it (callers check; the assert
+    /// turns a forgotten check into a panic rather than aliasing).
+    fn decoder(&self) -> &Decoder<'static, 'static> {
+        assert!(self.level.is_none(), "decoder borrowed by an open level");
+        // SAFETY: `decoder` is valid until `Drop`, and no level decoder
+        // holds its mutable borrow (checked above).
+        unsafe { self.decoder.as_ref() }
+    }
+
+    fn decoder_mut(&mut self) -> &mut Decoder<'static, 'static> {
+        assert!(self.level.is_none(), "decoder borrowed by an open level");
+        // SAFETY: as in `decoder`; `&mut self` makes this the only access.
+        unsafe { self.decoder.as_mut() }
+    }
+
+    pub fn header(&self) -> &Header {
+        &self.header
+    }
+
+    pub fn level_count(&self) -> u16 {
+        self.header.level_count
+    }
+
+    /// Level `k`'s table entry, `None` past the last level.
+    pub fn level_info(&self, k: u16) -> Option<LevelInfo> {
+        self.levels.get(k as usize).copied()
+    }
+
+    /// Level `k`'s byte range within the stream (an HTTP range request).
+    pub fn level_range(&self, k: u16) -> Option<Range<u64>> {
+        self.level_info(k)
+            .map(|e| e.offset..e.offset + e.length as u64)
+    }
+
+    /// Bytes of working memory the session holds (SPEC §9, with alignment).
+    pub fn workspace_bytes(&self) -> u64 {
+        self.header.workspace_bytes
+    }
+
+    /// The level to feed next; `None` when all are decoded, while a level
+    /// is being decoded round by round, or after an error.
+    pub fn next_level(&self) -> Option<u16> {
+        if self.level.is_some() {
+            return None;
+        }
+        self.decoder().next_level()
+    }
+
+    /// The level being decoded round by round, if any.
+    pub fn open_level(&self) -> Option<u16> {
+        self.level.as_ref().map(|_| self.levels_done())
+    }
+
+    /// Levels completely decoded (base included).
+    pub fn levels_done(&self) -> u16 {
+        match &self.level {
+            // The level decoder holds the count; the open one is not done.
+            Some(_) => self.done_while_open,
+            None => self.decoder().levels_done(),
+        }
+    }
+
+    /// Decodes level `k` whole from its bytes.
+    pub fn decode_level(&mut self, k: u16, bytes: &[u8]) -> Result<(), Error> {
+        if self.level.is_some() {
+            return Err(self.misuse(k));
+        }
+        self.decoder_mut().decode_level(k, bytes)
+    }
+
+    /// Starts level `k` (its bytes are copied); decode its rounds with
+    /// [`Session::next_round`]. Level 0's seed mesh is decoded here.
+    pub fn begin_level(&mut self, k: u16, bytes: &[u8]) -> Result<(), Error> {
+        if self.level.is_some() {
+            return Err(self.misuse(k));
+        }
+        let done = self.decoder().levels_done();
+        let bytes = NonNull::from(Box::leak(Box::<[u8]>::from(bytes)));
+        // SAFETY: `decoder` and `bytes` are valid and do not move until
+        // `Drop` / `close_level`, which drop the level decoder first; while
+        // it lives, the session reaches the decoder only through it (every
+        // method checks `self.level`).
+        let begun = unsafe { (*self.decoder.as_ptr()).begin_level(k, &*bytes.as_ptr()) };
+        match begun {
+            Ok(level) => {
+                self.level = Some(NonNull::from(Box::leak(Box::new(level))));
+                self.level_bytes = Some(bytes);
+                self.done_while_open = done;
+                Ok(())
+            }
+            Err(e) => {
+                // SAFETY: from `Box::leak` above and borrowed by nothing now.
+                unsafe { drop(Box::from_raw(bytes.as_ptr())) };
+                Err(e)
+            }
+        }
+    }
+
+    /// Decodes the next round of the open level. `Ok(None)` when the level
+    /// is complete (it is then closed and checked) or none is open.
+    pub fn next_round(&mut self) -> Result<Option<RoundInfo>, Error> {
+        let Some(mut level) = self.level else {
+            return Ok(None);
+        };
+        // SAFETY: from `Box::leak` in `begin_level`, alive until
+        // `close_level`; `&mut self` makes this the only access.
+        match unsafe { level.as_mut() }.next_round() {
+            Ok(Some(info)) => Ok(Some(info)),
+            Ok(None) => {
+                self.close_level();
+                Ok(None)
+            }
+            Err(e) => {
+                self.close_level();
+                Err(e)
+            }
+        }
+    }
+
+    /// Drops the level decoder, then the bytes it borrowed.
+    fn close_level(&mut self) {
+        if let Some(level) = self.level.take() {
+            // SAFETY: from `Box::leak` in `begin_level`, freed once; no
+            // reference derived from it outlives this call.
+            drop(unsafe { Box::from_raw(level.as_ptr()) });
+        }
+        if let Some(bytes) = self.level_bytes.take() {
+            // SAFETY: from `Box::leak` in `begin_level`; its only borrower,
+            // the level decoder, was dropped on the line above.
+            unsafe { drop(Box::from_raw(bytes.as_ptr())) };
+        }
+    }
+
+    fn misuse(&self, got: u16) -> Error {
+        Error::LevelOutOfOrder {
+            expected: self.levels_done(),
+            got,
+        }
+    }
+
+    /// The mesh as of the last level or round decoded.
+    fn state(&self) -> &MeshState<'static> {
+        match self.level {
+            // SAFETY: from `Box::leak` in `begin_level`, alive until
+            // `close_level`, which needs `&mut self`.
+            Some(level) => unsafe { level.as_ref() }.state(),
+            None => self.decoder().state(),
+        }
+    }
+
+    /// Quantized positions, one `[x, y, z]` per vertex.
+    pub fn positions(&self) -> &[[u32; 3]] {
+        self.state().positions()
+    }
+
+    /// Triangles, counter-clockwise vertex indices.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        self.state().triangles()
+    }
+
+    /// One deficit byte per vertex (SPEC §6.2).
+    pub fn deficits(&self) -> &[u8] {
+        self.state().deficits()
+    }
+
+    /// The state hash of SPEC §8.
+    pub fn state_hash(&self) -> u64 {
+        self.state().state_hash()
+    }
+
+    /// Real coordinates of a quantized position.
+    pub fn dequantize(&self, q: [u32; 3]) -> [f64; 3] {
+        self.header.dequantize(q)
+    }
+}
+
+impl Drop for Session {
+    fn drop(&mut self) {
+        self.close_level();
+        // SAFETY: all from `Box::leak` in `open`; freed once, borrowers
+        // first: the decoder borrows the workspace and the head.
+        unsafe {
+            drop(Box::from_raw(self.decoder.as_ptr()));
+            drop(Box::from_raw(self.workspace.as_ptr()));
+            drop(Box::from_raw(self.head.as_ptr()));
+        }
+    }
+}
+
+impl core::fmt::Debug for Session {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("Session")
+            .field("levels", &self.level_count())
+            .field("levels_done", &self.levels_done())
+            .field("open_level", &self.open_level())
+            .finish_non_exhaustive()
+    }
+}

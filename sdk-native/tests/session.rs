@@ -1,0 +1,144 @@
+//! `Session`, the owning progressive decoder: the conformance vectors'
+//! round hashes, level by level and round by round, dropped half way,
+//! misused. Small enough to run under Miri, which checks the unsafe
+//! self-borrowing in src/ffi/session.rs:
+//! `cargo +nightly miri test -p splitstream-sdk-native --test session`.
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+use splitstream_sdk_native::Session;
+
+fn newest_vectors() -> PathBuf {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../conformance/vectors");
+    let mut sets: Vec<PathBuf> = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.join("manifest.json").is_file())
+        .collect();
+    sets.sort_by_key(|p| {
+        p.file_name()
+            .unwrap()
+            .to_string_lossy()
+            .split('.')
+            .map(|n| n.parse::<u32>().unwrap_or(0))
+            .collect::<Vec<_>>()
+    });
+    sets.pop().expect("a vector set")
+}
+
+/// The valid vectors, smallest first (Miri is slow).
+fn valid_vectors(limit: usize) -> Vec<(String, Vec<u8>, Vec<String>)> {
+    let dir = newest_vectors();
+    let manifest: Value =
+        serde_json::from_slice(&std::fs::read(dir.join("manifest.json")).unwrap()).unwrap();
+    let mut out: Vec<(String, Vec<u8>, Vec<String>)> = manifest["vectors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|v| v["valid"].as_bool().unwrap())
+        .map(|v| {
+            let hashes = v["round_hashes"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|h| h.as_str().unwrap().to_string())
+                .collect();
+            let bytes = std::fs::read(dir.join(v["file"].as_str().unwrap())).unwrap();
+            (v["name"].as_str().unwrap().to_string(), bytes, hashes)
+        })
+        .collect();
+    out.sort_by_key(|(_, b, _)| b.len());
+    out.truncate(limit);
+    out
+}
+
+fn level<'a>(s: &Session, stream: &'a [u8], k: u16) -> &'a [u8] {
+    let r = s.level_range(k).unwrap();
+    &stream[r.start as usize..r.end as usize]
+}
+
+fn limit() -> usize {
+    if cfg!(miri) { 3 } else { usize::MAX }
+}
+
+#[test]
+fn round_by_round_gives_the_manifest_hashes() {
+    for (name, stream, expected) in valid_vectors(limit()) {
+        let head = Session::head_len(&stream).unwrap();
+        let mut s = Session::open(&stream[..head]).unwrap();
+        let mut hashes = Vec::new();
+        while let Some(k) = s.next_level() {
+            s.begin_level(k, level(&s, &stream, k)).unwrap();
+            assert_eq!(s.open_level(), Some(k));
+            assert_eq!(s.next_level(), None);
+            if k == 0 {
+                hashes.push(format!("{:016x}", s.state_hash()));
+            }
+            while s.next_round().unwrap().is_some() {
+                hashes.push(format!("{:016x}", s.state_hash()));
+            }
+            assert_eq!(s.open_level(), None);
+            assert_eq!(s.levels_done(), k + 1);
+        }
+        assert_eq!(hashes, expected, "{name}");
+        // Level by level: the same final state.
+        let mut whole = Session::open(&stream).unwrap();
+        while let Some(k) = whole.next_level() {
+            whole.decode_level(k, level(&whole, &stream, k)).unwrap();
+        }
+        assert_eq!(whole.state_hash(), s.state_hash(), "{name}");
+        assert_eq!(whole.positions(), s.positions());
+        assert_eq!(whole.triangles(), s.triangles());
+        assert_eq!(whole.deficits(), s.deficits());
+    }
+}
+
+#[test]
+fn dropped_half_way_and_misused() {
+    let (_, stream, _) = valid_vectors(usize::MAX)
+        .into_iter()
+        .find(|(_, b, _)| Session::open(b).unwrap().level_count() >= 2)
+        .expect("a vector with two levels");
+    // Dropped with a level open, after 0 or 1 rounds.
+    for rounds in 0..2 {
+        let mut s = Session::open(&stream).unwrap();
+        s.begin_level(0, level(&s, &stream, 0)).unwrap();
+        for _ in 0..rounds {
+            let _ = s.next_round().unwrap();
+        }
+        drop(s);
+    }
+    let mut s = Session::open(&stream).unwrap();
+    assert!(s.level_range(s.level_count()).is_none());
+    assert!(s.next_round().unwrap().is_none(), "no level open");
+    let l1 = level(&s, &stream, 1);
+    assert_eq!(s.decode_level(1, l1).unwrap_err().class(), "api-misuse");
+    s.begin_level(0, level(&s, &stream, 0)).unwrap();
+    // While a level is open, no other may start.
+    assert_eq!(s.begin_level(1, l1).unwrap_err().class(), "api-misuse");
+    while s.next_round().unwrap().is_some() {}
+    // A corrupted level fails and leaves the session spent.
+    let mut bad = level(&s, &stream, 1).to_vec();
+    let at = bad.len() / 2;
+    bad[at] ^= 0x10;
+    assert!(
+        s.begin_level(1, &bad)
+            .and_then(|()| {
+                while s.next_round()?.is_some() {}
+                Ok(())
+            })
+            .is_err()
+    );
+    assert_eq!(s.next_level(), None);
+    assert_eq!(s.decode_level(1, l1).unwrap_err().class(), "api-misuse");
+    // Garbage heads are typed errors.
+    assert_eq!(
+        Session::open(&stream[..10]).unwrap_err().class(),
+        "truncated"
+    );
+    assert_eq!(
+        Session::open(b"not a stream at all").unwrap_err().class(),
+        "bad-magic"
+    );
+}
