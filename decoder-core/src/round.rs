@@ -59,8 +59,22 @@ impl MeshState<'_> {
         // Step 2: one flag per candidate, in ascending order; a candidate
         // next to one flagged before it has no flag (it reads as 0).
         let mut result = Ok(());
+        let mut batch = [0u32; WARM_BATCH];
         'flags: for w in 0..words {
             let mut bits = self.bitmaps().0[w] & !self.bitmaps().2[w];
+            // Warm the fans of this word's candidates together: the fan walk
+            // of each flagged one (block_neighbours) then hits the cache
+            // instead of waiting for one miss after another.
+            let mut pending = bits;
+            while pending != 0 {
+                let mut len = 0;
+                while pending != 0 && len < WARM_BATCH {
+                    batch[len] = (w * 64) as u32 + pending.trailing_zeros();
+                    pending &= pending - 1;
+                    len += 1;
+                }
+                self.warm_fans(&batch[..len]);
+            }
             while bits != 0 {
                 let v = (w * 64) as u32 + bits.trailing_zeros();
                 bits &= bits - 1;
