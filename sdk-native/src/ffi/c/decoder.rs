@@ -221,17 +221,8 @@ pub unsafe extern "C" fn ss_decoder_decode_level(
     bytes: *const u8,
     len: usize,
 ) -> SsStatus {
-    guard(|| {
-        // SAFETY: per the contract.
-        let (s, b) = match unsafe { (session_mut(decoder), byte_slice(bytes, len)) } {
-            (Ok(s), Ok(b)) => (s, b),
-            (Err(e), _) | (_, Err(e)) => return e,
-        };
-        match s.decode_level(level, b) {
-            Ok(()) => SsStatus::Ok,
-            Err(e) => fail_decoder(e),
-        }
-    })
+    // SAFETY: the caller's contract is this function's.
+    unsafe { with_level_bytes(decoder, bytes, len, |s, b| s.decode_level(level, b)) }
 }
 
 /// Starts level `level` from its bytes (copied) for round-by-round
@@ -247,13 +238,28 @@ pub unsafe extern "C" fn ss_decoder_begin_level(
     bytes: *const u8,
     len: usize,
 ) -> SsStatus {
+    // SAFETY: the caller's contract is this function's.
+    unsafe { with_level_bytes(decoder, bytes, len, |s, b| s.begin_level(level, b)) }
+}
+
+/// Runs `f` on the session behind `decoder` and the level bytes
+/// `bytes[0 .. len]`, turning bad arguments and decoder errors into statuses.
+///
+/// # Safety
+/// `decoder` is a live handle; `bytes` points to `len` readable bytes.
+unsafe fn with_level_bytes(
+    decoder: *mut SsDecoder,
+    bytes: *const u8,
+    len: usize,
+    f: impl FnOnce(&mut Session, &[u8]) -> Result<(), splitstream_decoder_core::Error>,
+) -> SsStatus {
     guard(|| {
         // SAFETY: per the contract.
         let (s, b) = match unsafe { (session_mut(decoder), byte_slice(bytes, len)) } {
             (Ok(s), Ok(b)) => (s, b),
             (Err(e), _) | (_, Err(e)) => return e,
         };
-        match s.begin_level(level, b) {
+        match f(s, b) {
             Ok(()) => SsStatus::Ok,
             Err(e) => fail_decoder(e),
         }
