@@ -39,18 +39,26 @@ fn centroid(
     start: usize,
     len: usize,
 ) -> [i64; 3] {
-    let k = ring.len();
-    let mut sum = parent.map(|x| x as i64);
-    let mut count = 1i64;
-    for i in start..=start + len {
-        let v = ring.vertices()[i % k];
-        if v != NONE {
-            let p = positions[v as usize];
+    let vertices = ring.vertices();
+    let k = vertices.len();
+    // Coordinates are below 2^31 and a ring has at most 255 entries, so the
+    // sums stay far below 2^63 and are never negative: unsigned division is
+    // the floor division of SPEC §7.4.
+    let mut sum = parent.map(|x| x as u64);
+    let mut count = 1u64;
+    let mut i = if start >= k { start - k } else { start };
+    for _ in 0..=len {
+        let v = vertices.get(i).copied().unwrap_or(NONE);
+        if let Some(p) = positions.get(v as usize) {
             for a in 0..3 {
-                sum[a] += p[a] as i64;
+                sum[a] += p[a] as u64;
             }
             count += 1;
         }
+        i += 1;
+        if i == k {
+            i = 0;
+        }
     }
-    sum.map(|s| s.div_euclid(count))
+    sum.map(|s| (s / count) as i64)
 }

@@ -101,6 +101,8 @@ pub fn read_tables(
             cum += f;
         }
         t[1 + n] = cum;
+        // Entries past cum[n] read as "above every slot" (decode_value).
+        t[2 + n..].fill(PROB_SCALE);
     }
     Ok(())
 }
@@ -214,12 +216,20 @@ pub fn decode_value(
     }
     let x = lane[0];
     let slot = x & (PROB_SCALE - 1);
-    // cum[n] == PROB_SCALE > slot, so the search stops within the table.
-    let mut token = 0usize;
-    while t[2 + token] <= slot {
-        token += 1;
+    // The token t with cum[t] <= slot < cum[t + 1] is the number of
+    // cumulative frequencies cum[1..] at most slot (cum is non-decreasing,
+    // and `read_tables` sets the entries past cum[n] to PROB_SCALE > slot).
+    // Counting, rather than searching, has no branch to mispredict; the
+    // count runs over n rounded up to 4 entries.
+    let cum = &t[1..];
+    let counted = ((t[0] as usize + 3) & !3).min(TOKENS);
+    let mut token = 0u32;
+    for quad in cum[1..=counted].chunks_exact(4) {
+        token += quad.iter().map(|&c| (c <= slot) as u32).sum::<u32>();
     }
-    let (start, freq) = (t[1 + token], t[2 + token] - t[1 + token]);
+    let token = token as usize;
+    let token = token.min(TOKENS - 1);
+    let (start, freq) = (cum[token], cum[token + 1] - cum[token]);
     lane[0] = freq * (x >> PROB_BITS) + slot - start;
     renormalise(bytes, lane)?;
     let token = token as u32;

@@ -37,6 +37,11 @@ impl RecordSource for StreamSource<'_, '_, '_> {
         self.subs.bit(slot(substream::FLAGS), SINGLE)
     }
 
+    #[inline]
+    fn peek_flags(&mut self) -> (u64, u32) {
+        self.subs.peek_bits(slot(substream::FLAGS), SINGLE)
+    }
+
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let s = &mut *self.subs;
         let wing_offset = s.byte(slot(substream::WING_OFFSET), SINGLE)?;

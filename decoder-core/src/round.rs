@@ -6,10 +6,10 @@
 //! in a [`RecordSource`].
 
 use crate::Error;
-use crate::limits::{MAX_SPLIT_VALENCE, NONE};
+use crate::limits::NONE;
 use crate::ring::Ring;
 use crate::split::{SplitOutcome, SplitRecord};
-use crate::state::{MeshState, next, prev};
+use crate::state::{MeshState, next};
 
 /// Flagged vertices whose fans are warmed together (see `warm_fans`).
 const WARM_BATCH: usize = 32;
@@ -24,6 +24,13 @@ pub trait RecordSource {
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error>;
     /// Called after each applied split (the encoder tracks vertex identities).
     fn applied(&mut self, _r: u32, _c: u32, _outcome: &SplitOutcome) {}
+    /// The next flags [`RecordSource::flag`] will return, if known without
+    /// consuming them: `(bits, count)`, bit i for the i-th next flag read.
+    /// Only a hint for prefetching (a wrong hint costs speed, never
+    /// correctness); the default knows none.
+    fn peek_flags(&mut self) -> (u64, u32) {
+        (0, 0)
+    }
 }
 
 /// What one round did.
@@ -36,6 +43,17 @@ pub struct RoundStats {
 
 impl MeshState<'_> {
     /// Runs one round whose declared split count is `declared` (SPEC §7.3).
+    ///
+    /// SPEC §7.3 reads every flag before the first split. This does the same
+    /// work in one pass, batch by batch of candidates: a batch's flags, then
+    /// the batch's splits, then the next batch. That is the same result,
+    /// because a round's splits are independent (§7.2): a split touches only
+    /// its own ring, and every vertex of that ring is blocked (its flag is
+    /// inferred), so the flags, rings and candidacy of the later candidates
+    /// are what they were at the start of the round. It also reports the
+    /// same error: a failing split stops the splits but not the flags, and
+    /// the flag pass's own errors and the flag count come first. The gain is
+    /// speed: each flagged fan is walked while it is still in the cache.
     pub fn run_round<S: RecordSource>(
         &mut self,
         declared: u32,
@@ -56,141 +74,119 @@ impl MeshState<'_> {
                 .sum(),
             ..RoundStats::default()
         };
-        // Step 2: one flag per candidate, in ascending order; a candidate
-        // next to one flagged before it has no flag (it reads as 0).
-        let mut result = Ok(());
-        let mut batch = [0u32; WARM_BATCH];
-        'flags: for w in 0..words {
-            let mut bits = self.bitmaps().0[w] & !self.bitmaps().2[w];
-            // Warm the fans of this word's candidates together: the fan walk
-            // of each flagged one (block_neighbours) then hits the cache
-            // instead of waiting for one miss after another.
-            let mut pending = bits;
-            while pending != 0 {
-                let mut len = 0;
-                while pending != 0 && len < WARM_BATCH {
-                    batch[len] = (w * 64) as u32 + pending.trailing_zeros();
-                    pending &= pending - 1;
-                    len += 1;
-                }
-                self.warm_fans(&batch[..len]);
-            }
-            while bits != 0 {
-                let v = (w * 64) as u32 + bits.trailing_zeros();
-                bits &= bits - 1;
-                if self.bitmaps().2[w] & (1u64 << (v % 64)) != 0 {
-                    continue;
-                }
-                match source.flag(self, v) {
-                    Ok(false) => {}
-                    Ok(true) => {
-                        self.bitmaps().1[w] |= 1u64 << (v % 64);
-                        stats.splits += 1;
-                        if let Err(e) = self.block_neighbours(v) {
-                            result = Err(e);
-                            break 'flags;
-                        }
-                    }
-                    Err(e) => {
-                        result = Err(e);
-                        break 'flags;
-                    }
-                }
-            }
-        }
+        let result = self.flag_and_split(n, words, source, ring, &mut stats);
         self.bitmaps().2[..words].fill(0);
-        if result.is_ok() && stats.splits != declared {
-            result = Err(Error::FlagCountMismatch { round: 0 });
+        match result {
+            Err(e) => Err(e),
+            Ok(_) if stats.splits != declared => Err(Error::FlagCountMismatch { round: 0 }),
+            Ok(Some(split_error)) => Err(split_error),
+            Ok(None) => Ok(stats),
         }
-        if let Err(e) = result {
-            self.bitmaps().1[..words].fill(0);
-            return Err(e);
-        }
-        // Step 3: the splits, in ascending order of the split vertex.
-        let result = self.split_flagged(n, words, source, ring, &mut stats);
-        self.bitmaps().1[..words].fill(0);
-        result.map(|()| stats)
     }
 
-    /// Marks the neighbours of a flagged vertex: their flags are inferred
-    /// (SPEC §7.2), which makes every round's splits independent. Walks the
-    /// fan both ways and marks both outer corners of every wedge (order and
-    /// duplicates do not matter here, so no canonical ring is needed).
-    fn block_neighbours(&mut self, v: u32) -> Result<(), Error> {
-        let half = self.candidates.len() / 3;
-        let start = self.vertex_corner[v as usize];
-        let mark = |state: &mut Self, c: u32| {
-            for x in [
-                state.corners[next(c) as usize],
-                state.corners[prev(c) as usize],
-            ] {
-                state.candidates[2 * half + (x / 64) as usize] |= 1u64 << (x % 64);
-            }
-        };
-        let mut c = start;
-        for _ in 0..MAX_SPLIT_VALENCE {
-            mark(self, c);
-            let o = self.opposite[next(c) as usize];
-            if o == NONE {
-                // An open fan: the wedges clockwise of the start remain.
-                let mut c = start;
-                for _ in 0..MAX_SPLIT_VALENCE {
-                    let o = self.opposite[prev(c) as usize];
-                    if o == NONE {
-                        return Ok(());
-                    }
-                    c = prev(o);
-                    mark(self, c);
-                }
-                return Err(Error::ValenceOverflow);
-            }
-            c = next(o);
-            if c == start {
-                return Ok(());
-            }
-        }
-        Err(Error::ValenceOverflow)
-    }
-
-    fn split_flagged<S: RecordSource>(
+    /// Steps 2 and 3 of SPEC §7.3, fused (see [`MeshState::run_round`]).
+    /// Returns a flag-pass error as `Err`, the first split error as
+    /// `Ok(Some(_))`.
+    fn flag_and_split<S: RecordSource>(
         &mut self,
         n: u32,
         words: usize,
         source: &mut S,
         ring: &mut Ring,
         stats: &mut RoundStats,
-    ) -> Result<(), Error> {
-        let mut c = n;
+    ) -> Result<Option<Error>, Error> {
+        let mut split_error = None;
         let mut batch = [0u32; WARM_BATCH];
         for w in 0..words {
-            let mut bits = self.bitmaps().1[w];
+            // Candidates at round start: vertices below n with deficit 0.
+            // Splits of this round only change the bits of blocked vertices
+            // and of new vertices (n and above), so reading the word now is
+            // reading it as it was at the start.
+            let below_n = if (w + 1) * 64 <= n as usize {
+                u64::MAX
+            } else {
+                (1u64 << (n as usize - w * 64)) - 1
+            };
+            let mut bits = self.bitmaps().0[w] & !self.bitmaps().2[w] & below_n;
             while bits != 0 {
-                // Up to a batch of this word's flagged vertices: warm their
-                // fans' cache lines together, then split them in order.
                 let mut len = 0;
                 while bits != 0 && len < WARM_BATCH {
                     batch[len] = (w * 64) as u32 + bits.trailing_zeros();
                     bits &= bits - 1;
                     len += 1;
                 }
-                self.warm_fans(&batch[..len]);
-                for &r in &batch[..len] {
-                    self.ring(r, ring)?;
-                    let record = source.record(self, r, ring)?;
-                    let outcome = self.apply_split(r, ring, &record, c)?;
-                    source.applied(r, c, &outcome);
-                    stats.triangles_added += outcome.triangles_added;
-                    c += 1;
+                // Warm the fans of the batch's candidates that the next
+                // flags say will be flagged, together, so that their fan
+                // walks hit the cache instead of waiting for one miss after
+                // another. (Where the flags are not known yet, every
+                // candidate's fan is warmed.)
+                let (peeked, known) = source.peek_flags();
+                let mut warm = [0u32; WARM_BATCH];
+                let mut warm_len = 0;
+                let mut next_flag = 0;
+                for &v in &batch[..len] {
+                    if self.bitmaps().2[w] & (1u64 << (v % 64)) != 0 {
+                        continue;
+                    }
+                    let likely = next_flag >= known || peeked >> next_flag & 1 != 0;
+                    next_flag += 1;
+                    if likely {
+                        warm[warm_len] = v;
+                        warm_len += 1;
+                    }
+                }
+                self.warm_fans(&warm[..warm_len]);
+                for &v in &batch[..len] {
+                    if self.bitmaps().2[w] & (1u64 << (v % 64)) != 0 {
+                        continue;
+                    }
+                    if !source.flag(self, v)? {
+                        continue;
+                    }
+                    stats.splits += 1;
+                    // The ring is the one at round start (no neighbour of v
+                    // has split: they would have blocked v). Its vertices'
+                    // flags are inferred from now on (SPEC §7.2).
+                    self.ring(v, ring)?;
+                    self.block(ring);
+                    if split_error.is_some() {
+                        continue;
+                    }
+                    let c = self.vertex_count;
+                    let split = source.record(self, v, ring).and_then(|record| {
+                        let outcome = self.apply_split(v, ring, &record, c)?;
+                        source.applied(v, c, &outcome);
+                        Ok(outcome)
+                    });
+                    match split {
+                        Ok(outcome) => stats.triangles_added += outcome.triangles_added,
+                        Err(e) => split_error = Some(e),
+                    }
                 }
             }
         }
-        Ok(())
+        Ok(split_error)
     }
 
-    /// Walks the fans of `rs` in lockstep, reading what their splits will
-    /// read, so that the cache misses of independent fans overlap instead of
-    /// queueing one dependent load after another. Changes nothing: a pure
-    /// performance measure.
+    /// Marks the ring of a flagged vertex: those vertices' flags are
+    /// inferred (SPEC §7.2), which makes every round's splits independent.
+    #[inline]
+    fn block(&mut self, ring: &Ring) {
+        let third = self.candidates.len() / 3;
+        let blocked = &mut self.candidates[2 * third..];
+        for &x in ring.vertices() {
+            if x != NONE
+                && let Some(word) = blocked.get_mut((x / 64) as usize)
+            {
+                *word |= 1u64 << (x % 64);
+            }
+        }
+    }
+
+    /// Walks the fans of `rs` in lockstep, reading the corners, opposites,
+    /// positions and deficits their splits will read, so that the cache misses of
+    /// independent fans overlap instead of queueing one dependent load after
+    /// another. Changes nothing: a pure performance measure.
     fn warm_fans(&self, rs: &[u32]) {
         let mut corner = [NONE; WARM_BATCH];
         for (c, &r) in corner.iter_mut().zip(rs) {
@@ -206,7 +202,11 @@ impl MeshState<'_> {
                     continue;
                 }
                 let v = self.corners[next(c) as usize];
-                sum = sum.wrapping_add(self.positions[v as usize][0]);
+                if let (Some(p), Some(&d)) =
+                    (self.positions.get(v as usize), self.deficit.get(v as usize))
+                {
+                    sum = sum.wrapping_add(p[0]).wrapping_add(d as u32);
+                }
                 let o = self.opposite[next(c) as usize];
                 corner[i] = if o == NONE || next(o) == start[i] {
                     NONE

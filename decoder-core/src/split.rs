@@ -100,14 +100,14 @@ impl MeshState<'_> {
         }
         // P (index r) owns arc 1 (from a to b), C arc 2.
         let (x, y) = (r, c);
-        let c_arc_start = o + d;
-        for j in 0..len_c {
-            let corner = ring.corners()[(c_arc_start + j) % k];
+        // Arc 2 runs from wedge o + d around to wedge o - 1 (mod k).
+        let corners = ring.corners();
+        for &corner in corners[o + d..].iter().chain(&corners[..o]) {
             if corner != NONE {
                 self.corners[corner as usize] = c;
             }
         }
-        let wedge = |i: usize| ring.corners()[i % k];
+        let wedge = |i: usize| corners[if i >= k { i - k } else { i }];
         let before_a = wedge(o + k - 1);
         let after_a = wedge(o);
         let before_b = wedge(o + d - 1);

@@ -34,6 +34,13 @@ struct Reader<'b> {
     lane: usize,
     bit_byte: u8,
     bit_index: u8,
+    /// rANS bit substreams: values decoded ahead of the reader (bit i is
+    /// the i-th next value), so that [`Substreams::peek_bits`] can show
+    /// them; `ahead_error` is the error of the value after them, reported
+    /// only when the reader gets there.
+    ahead: u64,
+    ahead_len: u32,
+    ahead_error: Option<Error>,
 }
 
 /// The open substreams of one level.
@@ -88,6 +95,9 @@ impl<'l, 'b> Substreams<'l, 'b> {
                 lane: 0,
                 bit_byte: 0,
                 bit_index: 8,
+                ahead: 0,
+                ahead_len: 0,
+                ahead_error: None,
             }
         });
         // Chunks are ordered by substream id (validated), so each substream's
@@ -208,11 +218,25 @@ impl<'l, 'b> Substreams<'l, 'b> {
     #[inline]
     pub fn bit(&mut self, slot: usize, context: u8) -> Result<bool, Error> {
         if self.is_rans(slot) {
-            return match self.rans_value(slot, context)? {
-                0 => Ok(false),
-                1 => Ok(true),
-                _ => Err(Error::ValueOutOfRange(self.readers[slot].id)),
-            };
+            if self.readers[slot].ahead_len == 0 {
+                if let Some(e) = self.readers[slot].ahead_error {
+                    return Err(e);
+                }
+                if self.readers[slot].pos == self.readers[slot].len {
+                    self.refill(slot)?;
+                }
+                self.decode_bits_ahead(slot, context);
+                let r = &self.readers[slot];
+                if r.ahead_len == 0 {
+                    // The very next value failed: its error is due now.
+                    return Err(r.ahead_error.unwrap_or(Error::RecordCountMismatch(r.id)));
+                }
+            }
+            let r = &mut self.readers[slot];
+            let bit = r.ahead & 1 != 0;
+            r.ahead >>= 1;
+            r.ahead_len -= 1;
+            return Ok(bit);
         }
         if self.readers[slot].bit_index == 8 {
             let b = self.raw_byte(slot)?;
@@ -224,6 +248,61 @@ impl<'l, 'b> Substreams<'l, 'b> {
         let bit = (r.bit_byte >> r.bit_index) & 1 != 0;
         r.bit_index += 1;
         Ok(bit)
+    }
+
+    /// Decodes values of the current rANS chunk of bit substream `slot`
+    /// ahead of the reader, up to 64 (SPEC §5.5: the values and the errors
+    /// are the same as when read one by one; an error is kept until the
+    /// reader reaches its value). Never loads a chunk: that happens when the
+    /// reader needs one (§5.2). All of a bit substream's values share one
+    /// context (the flags: context 0, §5.5.5), so decoding them early in
+    /// `context` decodes them as the reader would.
+    fn decode_bits_ahead(&mut self, slot: usize, context: u8) {
+        while self.readers[slot].ahead_len < 64
+            && self.readers[slot].ahead_error.is_none()
+            && self.readers[slot].pos < self.readers[slot].len
+        {
+            let value = match self.rans_value(slot, context) {
+                Ok(0) => 0u64,
+                Ok(1) => 1,
+                Ok(_) => {
+                    self.readers[slot].ahead_error =
+                        Some(Error::ValueOutOfRange(self.readers[slot].id));
+                    break;
+                }
+                Err(e) => {
+                    self.readers[slot].ahead_error = Some(e);
+                    break;
+                }
+            };
+            let r = &mut self.readers[slot];
+            r.ahead |= value << r.ahead_len;
+            r.ahead_len += 1;
+        }
+    }
+
+    /// The next bits of bit substream `slot` as [`Substreams::bit`] will
+    /// return them, without consuming them: `(bits, count)`, bit i of `bits`
+    /// being the i-th next one, `count` at most 64. Only what the current
+    /// chunk holds is shown (and nothing past a value that fails), so
+    /// `count` may be 0. A decoder uses it to look ahead, never to decide.
+    pub fn peek_bits(&mut self, slot: usize, context: u8) -> (u64, u32) {
+        if self.is_rans(slot) {
+            self.decode_bits_ahead(slot, context);
+            let r = &self.readers[slot];
+            return (r.ahead, r.ahead_len);
+        }
+        let r = &self.readers[slot];
+        let (mut bits, mut count) = if r.bit_index < 8 {
+            ((r.bit_byte >> r.bit_index) as u64, 8 - r.bit_index as u32)
+        } else {
+            (0, 0)
+        };
+        for &b in r.buf.get(r.pos..r.len.min(r.pos + 7)).unwrap_or(&[]) {
+            bits |= (b as u64) << count;
+            count += 8;
+        }
+        (bits, count)
     }
 
     /// Next LEB128 varint of `slot`: at most 5 bytes, at most 32 bits,
@@ -264,7 +343,8 @@ impl<'l, 'b> Substreams<'l, 'b> {
     pub fn finish(&self) -> Result<(), Error> {
         for r in &self.readers {
             let padding_clear = r.bit_index == 8 || (r.bit_byte >> r.bit_index) == 0;
-            if r.pos != r.len || r.next_chunk != r.end_chunk || !padding_clear {
+            let all_read = r.pos == r.len && r.ahead_len == 0 && r.ahead_error.is_none();
+            if !all_read || r.next_chunk != r.end_chunk || !padding_clear {
                 return Err(Error::RecordCountMismatch(r.id));
             }
         }
@@ -290,4 +370,144 @@ fn open_rans_chunk(
     rans::open_lanes(level, at, end, values, lanes)?;
     r.lane = 0;
     Ok(())
+}
+
+#[cfg(all(test, feature = "alloc"))]
+mod tests {
+    use super::*;
+    use crate::context::SINGLE;
+    use crate::header::PositionMode;
+    use crate::limits::rans::TABLE_WORDS;
+    use crate::writer::{ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, frame_level};
+    use alloc::vec;
+    use alloc::vec::Vec;
+    use proptest::prelude::*;
+
+    /// A refinement level whose flags substream holds `bits` (the other
+    /// substreams empty), framed with `codec` in chunks of `chunk` bytes
+    /// or values.
+    fn level(bits: &[bool], codec: ChunkCodec, chunk: u32) -> Vec<u8> {
+        let mut substreams = vec![SubstreamWriter::default(); SLOTS];
+        for &b in bits {
+            substreams[0].bit_in(SINGLE, b);
+        }
+        let payload = LevelPayload {
+            round_splits: vec![1],
+            substreams,
+            ..LevelPayload::default()
+        };
+        let params = StreamParams {
+            position_mode: PositionMode::Optimal,
+            bits: 14,
+            origin: [0.0; 3],
+            scale: [1.0; 3],
+            codec,
+            chunk_limit: chunk,
+        };
+        frame_level(&payload, None, &params).0
+    }
+
+    /// Reads every flag of `bytes`, peeking before each read when `peek`
+    /// says so; returns what was read, up to and including the first error,
+    /// and whether the peeks always showed the bits that followed.
+    fn read_all(bytes: &[u8], lanes: u8, peeks: &[bool]) -> (Vec<Result<bool, Error>>, bool) {
+        let header = LevelHeader::parse(bytes, false, 1 << 16).expect("level header");
+        let words = TABLE_WORDS + LANE_WORDS * lanes as usize;
+        let mut memory = vec![0u32; SLOTS * words.max(1 << 14)];
+        let mut inflater = Inflater::new();
+        let mut rest: &mut [u32] = &mut memory;
+        let buffers: [&mut [u8]; SLOTS] = core::array::from_fn(|_| {
+            let (mine, tail) = core::mem::take(&mut rest).split_at_mut(words.max(1 << 14));
+            rest = tail;
+            bytemuck::cast_slice_mut(mine)
+        });
+        let mut subs = Substreams::open(bytes, header, 1, buffers, &mut inflater, lanes);
+        let mut out = Vec::new();
+        let mut shown: Vec<bool> = Vec::new();
+        let mut consistent = true;
+        for i in 0.. {
+            if peeks.get(i % peeks.len().max(1)).copied().unwrap_or(false) {
+                let (bits, count) = subs.peek_bits(0, SINGLE);
+                let fresh: Vec<bool> = (0..count).map(|k| bits >> k & 1 != 0).collect();
+                // A peek may show more than the last one, never other bits.
+                let common = fresh.len().min(shown.len());
+                consistent &= fresh[..common] == shown[..common];
+                if fresh.len() > shown.len() {
+                    shown = fresh;
+                }
+            }
+            let got = subs.bit(0, SINGLE);
+            if let (Ok(b), Some(&s)) = (&got, shown.first()) {
+                consistent &= *b == s;
+            }
+            if !shown.is_empty() {
+                shown.remove(0);
+            }
+            let stop = got.is_err();
+            out.push(got);
+            if stop {
+                break;
+            }
+        }
+        (out, consistent)
+    }
+
+    fn codec_of(which: u8, lanes: u8) -> ChunkCodec {
+        match which % 3 {
+            0 => ChunkCodec::Stored,
+            1 => ChunkCodec::Deflate(6),
+            _ => ChunkCodec::RansAlways { lanes },
+        }
+    }
+
+    proptest! {
+        /// Peeking changes nothing: the same bits and the same first error
+        /// (here: running out, then a corrupted byte) as reading without
+        /// peeks, and every peek shows exactly the bits that follow.
+        #[test]
+        fn peeking_never_changes_what_is_read(
+            bits in proptest::collection::vec(any::<bool>(), 1..300),
+            which in 0u8..3,
+            lanes in 1u8..6,
+            chunk in 1u32..40,
+            peeks in proptest::collection::vec(any::<bool>(), 1..8),
+            corrupt in any::<Option<(usize, u8)>>(),
+        ) {
+            let lanes = if which % 3 == 2 { lanes } else { 1 };
+            let mut bytes = level(&bits, codec_of(which, lanes), chunk);
+            if let Some((at, x)) = corrupt {
+                // Corrupt a payload byte and refresh its chunk's CRC, so that
+                // the damage reaches the decoders rather than the CRC check.
+                let copy = bytes.clone();
+                let header = LevelHeader::parse(&copy, false, 1 << 16).expect("header");
+                let start = header.payload_start;
+                if bytes.len() > start {
+                    let at = start + at % (bytes.len() - start);
+                    bytes[at] ^= x | 1;
+                    let mut offset = start;
+                    for k in 0..header.chunk_count {
+                        let e = header.chunk(k).expect("entry");
+                        let end = offset + e.stored_len as usize;
+                        if (offset..end).contains(&at) {
+                            let crc = crate::bytes::crc32(&bytes[offset..end]);
+                            let entry_at = header.payload_start - 4 - 16 * (header.chunk_count - k) as usize;
+                            bytes[entry_at + 12..entry_at + 16].copy_from_slice(&crc.to_le_bytes());
+                        }
+                        offset = end;
+                    }
+                    let head_len = header.payload_start - 4;
+                    let crc = crate::bytes::crc32(&bytes[..head_len]);
+                    bytes[head_len..head_len + 4].copy_from_slice(&crc.to_le_bytes());
+                }
+            }
+            let (plain, _) = read_all(&bytes, lanes, &[false]);
+            let (peeked, consistent) = read_all(&bytes, lanes, &peeks);
+            prop_assert_eq!(&plain, &peeked);
+            prop_assert!(consistent);
+            if corrupt.is_none() {
+                let read: Vec<bool> = plain.iter().filter_map(|r| r.ok()).collect();
+                prop_assert_eq!(&read[..bits.len()], &bits[..]);
+            }
+        }
+    }
 }
