@@ -3,17 +3,19 @@
 //! The base mesh arrives as plain triangles; this checks that it is a
 //! consistently oriented 2-manifold (possibly with boundary) and builds the
 //! opposite-corner table without allocating: a counting sort of the corners
-//! by vertex runs in the scratch tail of the opposite table.
+//! by vertex runs in the opposite table's memory, used as `u32` scratch, and
+//! the opposites found there are packed into references at the end.
 
 use crate::Error;
 use crate::limits::{LEAF, MAX_SPLIT_VALENCE, NONE};
 use crate::state::{MeshState, next, prev};
 
 impl MeshState<'_> {
-    /// Scratch `u32`s the base build needs past `3 * triangles` in the
-    /// opposite table (SPEC §9).
+    /// `u32`s of scratch the base build needs in the opposite table's
+    /// memory: the opposites, the corners sorted by vertex and the start of
+    /// each vertex's run (SPEC §9: `6 T0 + V0 + 1`).
     pub fn base_scratch_len(vertices: u32, triangles: u32) -> usize {
-        3 * triangles as usize + vertices as usize + 1
+        6 * triangles as usize + vertices as usize + 1
     }
 
     /// Starts the state as a base mesh whose positions, triangles and
@@ -25,7 +27,7 @@ impl MeshState<'_> {
         let nc = 3 * nt;
         if vertices > self.vertex_capacity()
             || triangles > self.triangle_capacity()
-            || self.opposite.len() < nc + Self::base_scratch_len(vertices, triangles)
+            || self.opposite.scratch().len() < Self::base_scratch_len(vertices, triangles)
         {
             return Err(Error::CapacityExceeded);
         }
@@ -37,7 +39,7 @@ impl MeshState<'_> {
                 return Err(Error::NonManifold("degenerate triangle"));
             }
         }
-        let (opposite, scratch) = self.opposite.split_at_mut(nc);
+        let (opposite, scratch) = self.opposite.scratch().split_at_mut(nc);
         let (list, start) = scratch.split_at_mut(nc);
         let start = &mut start[..nv + 1];
         let corners = &self.corners[..nc];
@@ -79,7 +81,7 @@ impl MeshState<'_> {
                     "an edge is used twice in the same direction (non-manifold or inconsistently oriented)",
                 ));
             }
-            self.vertex_corner[v] = fan[0];
+            self.vertex_corner.set(v as u32, fan[0]);
         }
         // The triangle facing corner c across edge b -> d holds d -> b.
         for c in 0..nc as u32 {
@@ -95,13 +97,14 @@ impl MeshState<'_> {
         // Every vertex must have one fan: a full disk or a single open fan.
         for v in 0..nv {
             let count = start[v + 1] - start[v];
-            let valence = fan_valence(opposite, self.vertex_corner[v], count)
+            let valence = fan_valence(opposite, self.vertex_corner.get(v as u32), count)
                 .ok_or(Error::NonManifold("a vertex has more than one fan"))?;
             let deficit = self.deficit[v];
             if deficit != LEAF && valence + deficit as usize > MAX_SPLIT_VALENCE {
                 return Err(Error::ValenceOverflow);
             }
         }
+        self.opposite.pack(nc);
         self.vertex_count = vertices;
         self.triangle_count = triangles;
         self.candidates.fill(0);

@@ -4,6 +4,7 @@
 //! no allocation, and one number for the caller to size.
 
 use crate::Error;
+use crate::corner_refs::{self, CornerRefs};
 use crate::limits::rans::{MAX_LANES, TABLE_WORDS};
 use crate::limits::substream::SLOTS;
 use crate::rans::LANE_WORDS;
@@ -24,6 +25,9 @@ pub struct Layout {
     pub max_chunk_len: u32,
     ranges: [(u64, u64); 7],
     chunk_buffer_len: u64,
+    /// Bytes per corner reference (opposites, a corner per vertex): 3 when
+    /// every corner index fits in 24 bits, else 4 (SPEC §9).
+    pub corner_ref_width: usize,
     /// Total bytes, from an 8-aligned start.
     pub total: u64,
 }
@@ -45,17 +49,15 @@ impl Layout {
     ) -> Layout {
         let v = vertex_capacity as u64;
         let t = triangle_capacity as u64;
-        let opposite_len = (3 * t).max(
-            3 * base_triangles as u64
-                + MeshState::base_scratch_len(base_vertices, base_triangles) as u64,
-        );
+        let width = corner_refs::width_for(3 * t);
+        let base_scratch = 4 * MeshState::base_scratch_len(base_vertices, base_triangles) as u64;
         // A slot holds a byte-codec chunk, or a rANS chunk's tables and lanes.
         let chunk_buffer_len = round_up((max_chunk_len as u64).max(RANS_SLOT_BYTES));
         let sizes = [
             12 * v,
             12 * t,
-            4 * opposite_len,
-            4 * v,
+            corner_refs::bytes_for(3 * t, width).max(base_scratch),
+            corner_refs::bytes_for(v, width),
             v,
             3 * 8 * v.div_ceil(64),
             SLOTS as u64 * chunk_buffer_len,
@@ -72,6 +74,7 @@ impl Layout {
             max_chunk_len,
             ranges,
             chunk_buffer_len,
+            corner_ref_width: width,
             total: at,
         }
     }
@@ -123,8 +126,8 @@ impl Layout {
         let memory = StateMemory {
             positions: cast(positions)?,
             corners: cast(corners)?,
-            opposite: cast(opposite)?,
-            vertex_corner: cast(vertex_corner)?,
+            opposite: CornerRefs::new(opposite, self.corner_ref_width),
+            vertex_corner: CornerRefs::new(vertex_corner, self.corner_ref_width),
             deficit,
             candidates: cast(candidates)?,
         };

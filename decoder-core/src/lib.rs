@@ -25,6 +25,7 @@ extern crate alloc;
 mod base;
 mod bytes;
 pub mod context;
+pub mod corner_refs;
 mod decoder;
 mod error;
 mod hash;
@@ -50,6 +51,7 @@ pub mod substream;
 pub mod writer;
 
 pub use bytes::crc32;
+pub use corner_refs::CornerRefs;
 pub use decoder::{Decoder, LevelDecoder, RoundInfo, declared_layout, layout_for};
 pub use error::{ChecksumScope, Error};
 pub use hash::Fnv1a;

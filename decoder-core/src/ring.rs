@@ -65,7 +65,7 @@ impl MeshState<'_> {
         if r >= self.vertex_count {
             return Err(Error::NoSuchVertex);
         }
-        let start = self.vertex_corner[r as usize];
+        let start = self.vertex_corner.get(r);
         let mut c = start;
         let mut n = 0usize;
         loop {
@@ -75,7 +75,7 @@ impl MeshState<'_> {
             ring.corners[n] = c;
             ring.vertices[n] = self.vertex_at(next(c));
             n += 1;
-            let o = self.opposite[next(c) as usize];
+            let o = self.opposite.get(next(c));
             if o == NONE {
                 return self.boundary_ring(start, ring);
             }
@@ -96,7 +96,7 @@ impl MeshState<'_> {
         let mut first = start;
         let mut steps = 0;
         loop {
-            let o = self.opposite[prev(first) as usize];
+            let o = self.opposite.get(prev(first));
             if o == NONE {
                 break;
             }
@@ -117,7 +117,7 @@ impl MeshState<'_> {
             }
             ring.corners[m] = c;
             ring.vertices[m] = self.vertex_at(next(c));
-            let o = self.opposite[next(c) as usize];
+            let o = self.opposite.get(next(c));
             if o == NONE {
                 ring.vertices[m + 1] = self.vertex_at(prev(c));
                 ring.corners[m + 1] = NONE;

@@ -190,7 +190,7 @@ impl MeshState<'_> {
     fn warm_fans(&self, rs: &[u32]) {
         let mut corner = [NONE; WARM_BATCH];
         for (c, &r) in corner.iter_mut().zip(rs) {
-            *c = self.vertex_corner[r as usize];
+            *c = self.vertex_corner.get(r);
         }
         let start = corner;
         let mut sum = 0u32;
@@ -207,7 +207,7 @@ impl MeshState<'_> {
                 {
                     sum = sum.wrapping_add(p[0]).wrapping_add(d as u32);
                 }
-                let o = self.opposite[next(c) as usize];
+                let o = self.opposite.get(next(c));
                 corner[i] = if o == NONE || next(o) == start[i] {
                     NONE
                 } else {

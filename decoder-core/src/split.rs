@@ -138,8 +138,8 @@ impl MeshState<'_> {
         }
         match (ta, tb) {
             (Some(ta), Some(tb)) => self.link(3 * ta + 2, 3 * tb + 2),
-            (Some(ta), None) => self.opposite[3 * ta as usize + 2] = NONE,
-            (None, Some(tb)) => self.opposite[3 * tb as usize + 2] = NONE,
+            (Some(ta), None) => self.opposite.set(3 * ta + 2, NONE),
+            (None, Some(tb)) => self.opposite.set(3 * tb + 2, NONE),
             (None, None) => {}
         }
         let (corner_x, corner_y) = match (ta, tb) {
@@ -147,8 +147,8 @@ impl MeshState<'_> {
             (None, Some(tb)) => (3 * tb + 1, 3 * tb),
             (None, None) => return Err(Error::RingOffsetOutOfRange),
         };
-        self.vertex_corner[x as usize] = corner_x;
-        self.vertex_corner[y as usize] = corner_y;
+        self.vertex_corner.set(x, corner_x);
+        self.vertex_corner.set(y, corner_y);
         self.positions[r as usize] = rec.position_p;
         self.positions[c as usize] = rec.position_c;
         self.deficit[r as usize] = rec.deficit_p;

@@ -2,10 +2,12 @@
 //!
 //! Triangles are stored as a corner table: corner `c` is slot `c % 3` of
 //! triangle `c / 3`. `opposite[c]` is the corner facing `c` across the edge
-//! opposite `c` ([`NONE`] on a boundary), `vertex_corner[v]` any corner of `v`.
-//! Only the positions, triangles and deficits are normative; the adjacency is
-//! this decoder's way of walking rings quickly.
+//! opposite `c` ([`NONE`] on a boundary), `vertex_corner[v]` any corner of `v`,
+//! both packed in 3 or 4 bytes per entry ([`CornerRefs`]). Only the
+//! positions, triangles and deficits are normative; the adjacency is this
+//! decoder's way of walking rings quickly.
 
+use crate::corner_refs::CornerRefs;
 use crate::limits::{LEAF, NONE};
 
 /// Next corner of the same triangle (counter-clockwise).
@@ -24,8 +26,8 @@ pub fn prev(c: u32) -> u32 {
 pub struct MeshState<'ws> {
     pub(crate) positions: &'ws mut [[u32; 3]],
     pub(crate) corners: &'ws mut [u32],
-    pub(crate) opposite: &'ws mut [u32],
-    pub(crate) vertex_corner: &'ws mut [u32],
+    pub(crate) opposite: CornerRefs<'ws>,
+    pub(crate) vertex_corner: CornerRefs<'ws>,
     pub(crate) deficit: &'ws mut [u8],
     pub(crate) candidates: &'ws mut [u64],
     pub(crate) vertex_count: u32,
@@ -40,9 +42,10 @@ pub struct StateMemory<'ws> {
     pub positions: &'ws mut [[u32; 3]],
     /// 3 per triangle.
     pub corners: &'ws mut [u32],
-    /// At least 3 per triangle; [`crate::Layout`] sizes it for base-mesh scratch too.
-    pub opposite: &'ws mut [u32],
-    pub vertex_corner: &'ws mut [u32],
+    /// At least 3 per triangle; [`crate::Layout`] sizes it for base-mesh
+    /// scratch too (SPEC §9: `4 × (6 T0 + V0 + 1)` bytes).
+    pub opposite: CornerRefs<'ws>,
+    pub vertex_corner: CornerRefs<'ws>,
     pub deficit: &'ws mut [u8],
     /// Three bitmaps of one bit per vertex, one after the other: the current
     /// candidates (deficit 0), the vertices flagged in the current round, and
@@ -164,9 +167,9 @@ impl<'ws> MeshState<'ws> {
 
     #[inline]
     pub(crate) fn link(&mut self, a: u32, b: u32) {
-        self.opposite[a as usize] = b;
+        self.opposite.set(a, b);
         if b != NONE {
-            self.opposite[b as usize] = a;
+            self.opposite.set(b, a);
         }
     }
 }

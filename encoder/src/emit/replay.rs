@@ -1,11 +1,12 @@
 //! Replays the refinement with decoder-core's round procedure, writing each
 //! flag and split record as the decoder will read it (SPEC §7).
 
+use splitstream_decoder_core::corner_refs;
 use splitstream_decoder_core::limits::{LEAF, NONE, substream};
 use splitstream_decoder_core::writer::{LevelPayload, SeedPayload, SubstreamWriter};
 use splitstream_decoder_core::{
-    Error, MeshState, PositionMode, RecordSource, Ring, SplitOutcome, SplitRecord, StateMemory,
-    context, predict_split, refine_c,
+    CornerRefs, Error, MeshState, PositionMode, RecordSource, Ring, SplitOutcome, SplitRecord,
+    StateMemory, context, predict_split, refine_c,
 };
 
 use super::levels::LevelPlan;
@@ -42,19 +43,26 @@ pub struct Replayed {
 struct Memory {
     positions: Vec<[u32; 3]>,
     corners: Vec<u32>,
+    /// Corner references as 4-byte words (aligned for the base build's
+    /// scratch), viewed as bytes by [`CornerRefs`].
     opposite: Vec<u32>,
     vertex_corner: Vec<u32>,
+    width: usize,
     deficit: Vec<u8>,
     candidates: Vec<u64>,
 }
 
 impl Memory {
     fn new(v: usize, t: usize, base_v: usize, base_t: usize) -> Memory {
+        let width = corner_refs::width_for(3 * t as u64);
+        let words = |bytes: u64| (bytes as usize).div_ceil(4);
+        let base_scratch = 4 * MeshState::base_scratch_len(base_v as u32, base_t as u32) as u64;
         Memory {
             positions: vec![[0; 3]; v],
             corners: vec![0; 3 * t],
-            opposite: vec![0; (3 * t).max(6 * base_t + base_v + 1)],
-            vertex_corner: vec![0; v],
+            opposite: vec![0; words(corner_refs::bytes_for(3 * t as u64, width).max(base_scratch))],
+            vertex_corner: vec![0; words(corner_refs::bytes_for(v as u64, width))],
+            width,
             deficit: vec![0; v],
             candidates: vec![0; 3 * v.div_ceil(64)],
         }
@@ -65,8 +73,11 @@ impl Memory {
             StateMemory {
                 positions: &mut self.positions,
                 corners: &mut self.corners,
-                opposite: &mut self.opposite,
-                vertex_corner: &mut self.vertex_corner,
+                opposite: CornerRefs::new(bytemuck::cast_slice_mut(&mut self.opposite), self.width),
+                vertex_corner: CornerRefs::new(
+                    bytemuck::cast_slice_mut(&mut self.vertex_corner),
+                    self.width,
+                ),
                 deficit: &mut self.deficit,
                 candidates: &mut self.candidates,
             },
