@@ -202,7 +202,8 @@ fn faults(ctx: &Device) {
         run(ctx, lone, 1, 1, &[record(0, 2)], 9).fault,
         Some(KernelFault::TriangleLimit { split: 0 })
     );
-    // Adjacent flagged vertices 0 and 2: the first of them fails.
+    // Adjacent flagged vertices 0 and 2 (flags no stream can give, SPEC
+    // §7.2): the first of them fails.
     assert_eq!(
         run(
             ctx,
@@ -213,7 +214,7 @@ fn faults(ctx: &Device) {
             32
         )
         .fault,
-        Some(KernelFault::DependentSplits { split: 0 })
+        Some(KernelFault::AdjacentFlags { split: 0 })
     );
     // Poles 4 and 5 are independent but share their wings 0 and 1 (ring
     // [0, 2, 1, 3] and [0, 3, 1, 2]), which can each lose one more neighbour.

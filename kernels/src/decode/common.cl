@@ -16,7 +16,7 @@
 
 #define ERR_COUNT 0u
 #define ERR_RING_TOO_LONG 1u
-#define ERR_DEPENDENT 2u
+#define ERR_ADJACENT_FLAGS 2u
 #define ERR_RING_OFFSET 3u
 #define ERR_POSITION 4u
 #define ERR_VALENCE 5u

@@ -18,7 +18,7 @@ const COUNT_ERROR: u32 = 3u;
 // of the key (round-level faults) uses code ERR_COUNT.
 const ERR_COUNT: u32 = 0u;
 const ERR_RING_TOO_LONG: u32 = 1u;
-const ERR_DEPENDENT: u32 = 2u;
+const ERR_ADJACENT_FLAGS: u32 = 2u;
 const ERR_RING_OFFSET: u32 = 3u;
 const ERR_POSITION: u32 = 4u;
 const ERR_VALENCE: u32 = 5u;

@@ -67,8 +67,11 @@ pub enum KernelFault {
     CountMismatch,
     /// A ring longer than 255 (valence-overflow).
     RingTooLong { split: u32 },
-    /// A flagged neighbour (dependent-splits).
-    DependentSplits { split: u32 },
+    /// A flagged vertex with a flagged neighbour. No stream can cause it
+    /// (SPEC §7.2: a neighbour of a flagged vertex has no flag), so it
+    /// means the host handed the kernels flags it did not read by §7.3: a
+    /// driver bug, reported as the reference decoder's `api-misuse`.
+    AdjacentFlags { split: u32 },
     /// `d == 0` or `o + d >= k` (ring-offset-out-of-range).
     RingOffsetOutOfRange { split: u32 },
     /// P or C outside `0 .. 2^bits` (position-out-of-range).
@@ -90,7 +93,7 @@ impl KernelFault {
         Some(match (key / 8, key % 8) {
             (0, _) => KernelFault::CountMismatch,
             (_, 1) => KernelFault::RingTooLong { split },
-            (_, 2) => KernelFault::DependentSplits { split },
+            (_, 2) => KernelFault::AdjacentFlags { split },
             (_, 3) => KernelFault::RingOffsetOutOfRange { split },
             (_, 4) => KernelFault::PositionOutOfRange { split },
             (_, 5) => KernelFault::ValenceOverflow { split },
@@ -105,7 +108,7 @@ impl KernelFault {
             KernelFault::RingTooLong { .. } | KernelFault::ValenceOverflow { .. } => {
                 "valence-overflow"
             }
-            KernelFault::DependentSplits { .. } => "dependent-splits",
+            KernelFault::AdjacentFlags { .. } => "api-misuse",
             KernelFault::RingOffsetOutOfRange { .. } => "ring-offset-out-of-range",
             KernelFault::PositionOutOfRange { .. } => "position-out-of-range",
         }
@@ -117,7 +120,7 @@ impl core::fmt::Display for KernelFault {
         match self {
             KernelFault::CountMismatch => write!(f, "{}: candidate or flag count", self.class()),
             KernelFault::RingTooLong { split }
-            | KernelFault::DependentSplits { split }
+            | KernelFault::AdjacentFlags { split }
             | KernelFault::RingOffsetOutOfRange { split }
             | KernelFault::PositionOutOfRange { split }
             | KernelFault::ValenceOverflow { split }
@@ -145,7 +148,7 @@ mod tests {
         assert_eq!(KernelFault::from_key(0), Some(KernelFault::CountMismatch));
         assert_eq!(
             KernelFault::from_key(3 * 8 + 2),
-            Some(KernelFault::DependentSplits { split: 2 })
+            Some(KernelFault::AdjacentFlags { split: 2 })
         );
         assert_eq!(
             KernelFault::from_key(8 + 3).map(KernelFault::class),

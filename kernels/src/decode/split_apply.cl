@@ -79,7 +79,7 @@ __kernel void ring_check(DECODE_ARGS) {
         if (i == o) a = v;
         if (i == o + d) b = v;
     }
-    if (dependent) { report(counts, key, ERR_DEPENDENT); return; }
+    if (dependent) { report(counts, key, ERR_ADJACENT_FLAGS); return; }
     if (d == 0u || o + d >= k) { report(counts, key, ERR_RING_OFFSET); return; }
     if (PARAMS.pos_limit != 0u) {
         uint hi = max(max(max(rec.px, rec.py), max(rec.pz, rec.cx)), max(rec.cy, rec.cz));

@@ -192,7 +192,7 @@ fn ring_check(@builtin(global_invocation_id) gid: vec3<u32>) {
         }
     }
     if dependent {
-        report(key, ERR_DEPENDENT);
+        report(key, ERR_ADJACENT_FLAGS);
         return;
     }
     if d == 0u || o + d >= k {
