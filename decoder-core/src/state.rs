@@ -34,6 +34,10 @@ pub struct MeshState<'ws> {
     pub(crate) triangle_count: u32,
     /// Triangle count the current level may reach (SPEC §7.6).
     pub(crate) triangle_limit: u32,
+    /// What the memory holds, fixed when the state is made (a split checks
+    /// them, so they are not recomputed from the array lengths each time).
+    vertex_capacity: u32,
+    triangle_capacity: u32,
     pub(crate) bits: u8,
 }
 
@@ -64,6 +68,18 @@ impl<'ws> MeshState<'ws> {
             deficit,
             candidates,
         } = memory;
+        let vertex_capacity = {
+            let by_bits = (candidates.len() as u64 / 3) * 64;
+            let n = positions
+                .len()
+                .min(vertex_corner.len())
+                .min(deficit.len()) as u64;
+            n.min(by_bits).min(u32::MAX as u64 - 1) as u32
+        };
+        let triangle_capacity = {
+            let n = (corners.len().min(opposite.len()) / 3) as u64;
+            n.min(crate::limits::MAX_TRIANGLES as u64) as u32
+        };
         MeshState {
             positions,
             corners,
@@ -74,6 +90,8 @@ impl<'ws> MeshState<'ws> {
             vertex_count: 0,
             triangle_count: 0,
             triangle_limit: u32::MAX,
+            vertex_capacity,
+            triangle_capacity,
             bits,
         }
     }
@@ -87,20 +105,15 @@ impl<'ws> MeshState<'ws> {
     }
 
     /// Largest vertex count the memory holds.
+    #[inline]
     pub fn vertex_capacity(&self) -> u32 {
-        let by_bits = (self.candidates.len() as u64 / 2) * 64;
-        let n = self
-            .positions
-            .len()
-            .min(self.vertex_corner.len())
-            .min(self.deficit.len()) as u64;
-        n.min(by_bits).min(u32::MAX as u64 - 1) as u32
+        self.vertex_capacity
     }
 
     /// Largest triangle count the memory holds.
+    #[inline]
     pub fn triangle_capacity(&self) -> u32 {
-        let n = (self.corners.len().min(self.opposite.len()) / 3) as u64;
-        n.min(crate::limits::MAX_TRIANGLES as u64) as u32
+        self.triangle_capacity
     }
 
     /// Bounds the triangle count of the level being decoded: a split that
