@@ -117,6 +117,10 @@ impl<S: RecordSource> RecordSource for SwapPositions<S> {
         self.0.flag(state, v)
     }
 
+    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+        self.0.likely_flags(state, upcoming)
+    }
+
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let mut record = self.0.record(state, r, ring)?;
         core::mem::swap(&mut record.position_p, &mut record.position_c);

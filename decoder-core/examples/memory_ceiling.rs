@@ -44,7 +44,9 @@ fn main() {
         let mut sum = 0u64;
         let mut i = 1u64;
         for _ in 0..steps {
-            i = i.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            i = i
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             sum = sum.wrapping_add(next[(i >> 20) as usize % n]);
         }
         std::hint::black_box(sum);

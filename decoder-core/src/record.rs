@@ -6,7 +6,7 @@ use crate::header::PositionMode;
 use crate::limits::substream::{self, SLOTS};
 use crate::predict::{predict_split, refine_c};
 use crate::ring::Ring;
-use crate::round::RecordSource;
+use crate::round::{RecordSource, all_ones};
 use crate::split::SplitRecord;
 use crate::state::MeshState;
 use crate::substream::Substreams;
@@ -38,8 +38,11 @@ impl RecordSource for StreamSource<'_, '_, '_> {
     }
 
     #[inline]
-    fn peek_flags(&mut self) -> (u64, u32) {
-        self.subs.peek_bits(slot(substream::FLAGS), SINGLE)
+    fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+        // The next flags of the stream, as far as the loaded chunk shows
+        // them; the candidates past them are all taken as likely.
+        let (bits, known) = self.subs.peek_bits(slot(substream::FLAGS), SINGLE);
+        bits & all_ones(known as usize) | !all_ones(known as usize) & all_ones(upcoming.len())
     }
 
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {

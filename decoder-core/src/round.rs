@@ -24,13 +24,20 @@ pub trait RecordSource {
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error>;
     /// Called after each applied split (the encoder tracks vertex identities).
     fn applied(&mut self, _r: u32, _c: u32, _outcome: &SplitOutcome) {}
-    /// The next flags [`RecordSource::flag`] will return, if known without
-    /// consuming them: `(bits, count)`, bit i for the i-th next flag read.
-    /// Only a hint for prefetching (a wrong hint costs speed, never
-    /// correctness); the default knows none.
-    fn peek_flags(&mut self) -> (u64, u32) {
-        (0, 0)
+    /// Which of `upcoming`, the next candidates whose flags will be read
+    /// (in order, as if none of them blocked another), are likely to be
+    /// flagged: bit i for `upcoming[i]` (at most 64). Only a hint for
+    /// prefetching (a wrong hint costs speed, never correctness); the
+    /// default says all of them.
+    fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+        all_ones(upcoming.len())
     }
+}
+
+/// The low `n` bits set (n at most 64).
+#[inline]
+pub fn all_ones(n: usize) -> u64 {
+    if n >= 64 { u64::MAX } else { (1u64 << n) - 1 }
 }
 
 /// What one round did.
@@ -120,17 +127,19 @@ impl MeshState<'_> {
                 // walks hit the cache instead of waiting for one miss after
                 // another. (Where the flags are not known yet, every
                 // candidate's fan is warmed.)
-                let (peeked, known) = source.peek_flags();
+                let mut upcoming = [0u32; WARM_BATCH];
+                let mut upcoming_len = 0;
+                for &v in &batch[..len] {
+                    if self.bitmaps().2[w] & (1u64 << (v % 64)) == 0 {
+                        upcoming[upcoming_len] = v;
+                        upcoming_len += 1;
+                    }
+                }
+                let likely = source.likely_flags(self, &upcoming[..upcoming_len]);
                 let mut warm = [0u32; WARM_BATCH];
                 let mut warm_len = 0;
-                let mut next_flag = 0;
-                for &v in &batch[..len] {
-                    if self.bitmaps().2[w] & (1u64 << (v % 64)) != 0 {
-                        continue;
-                    }
-                    let likely = next_flag >= known || peeked >> next_flag & 1 != 0;
-                    next_flag += 1;
-                    if likely {
+                for (i, &v) in upcoming[..upcoming_len].iter().enumerate() {
+                    if likely >> i & 1 != 0 {
                         warm[warm_len] = v;
                         warm_len += 1;
                     }

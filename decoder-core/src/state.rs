@@ -70,10 +70,7 @@ impl<'ws> MeshState<'ws> {
         } = memory;
         let vertex_capacity = {
             let by_bits = (candidates.len() as u64 / 3) * 64;
-            let n = positions
-                .len()
-                .min(vertex_corner.len())
-                .min(deficit.len()) as u64;
+            let n = positions.len().min(vertex_corner.len()).min(deficit.len()) as u64;
             n.min(by_bits).min(u32::MAX as u64 - 1) as u32
         };
         let triangle_capacity = {

@@ -222,13 +222,28 @@ pub fn write_stream_seeded(
     seed: &SeedPayload,
     levels: &[LevelPayload],
 ) -> Vec<u8> {
-    let mut framed: Vec<Vec<u8>> = Vec::with_capacity(levels.len());
-    let mut max_chunk = 0u32;
-    for (k, level) in levels.iter().enumerate() {
-        let (bytes, largest) = frame_level(level, (k == 0).then_some(seed), params);
-        max_chunk = max_chunk.max(largest);
-        framed.push(bytes);
-    }
+    let framed: Vec<(Vec<u8>, u32)> = levels
+        .iter()
+        .enumerate()
+        .map(|(k, level)| frame_level(level, (k == 0).then_some(seed), params))
+        .collect();
+    assemble_stream(params, levels, framed)
+}
+
+/// The stream of `levels`, already framed by [`frame_level`] (level 0 with
+/// its seed): header, level table, levels. Lets a caller frame the levels
+/// in parallel.
+pub fn assemble_stream(
+    params: &StreamParams,
+    levels: &[LevelPayload],
+    framed: Vec<(Vec<u8>, u32)>,
+) -> Vec<u8> {
+    let max_chunk = framed
+        .iter()
+        .map(|(_, largest)| *largest)
+        .max()
+        .unwrap_or(0);
+    let framed: Vec<Vec<u8>> = framed.into_iter().map(|(bytes, _)| bytes).collect();
     let level_count = levels.len() as u16;
     let mut offset = head_len(level_count) as u64;
     let mut entries = Vec::with_capacity(levels.len());

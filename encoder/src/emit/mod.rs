@@ -5,9 +5,10 @@
 mod levels;
 mod replay;
 
+use rayon::prelude::*;
 use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, StreamParams, write_stream_seeded,
+    ChunkCodec, LevelPayload, StreamParams, assemble_stream, frame_level,
 };
 
 use crate::mesh::Mesh;
@@ -157,7 +158,22 @@ pub fn encode_quantized(
         .map(|l: &LevelPayload| l.vertex_count)
         .collect();
     let rounds = replayed.levels.iter().map(|l| l.round_splits.len()).sum();
-    let stream = write_stream_seeded(&params, &replayed.seed, &replayed.levels);
+    let replay_seconds = started.elapsed().as_secs_f64();
+    // Levels are framed (entropy coded, chunked) independently: in parallel.
+    let framed = replayed
+        .levels
+        .par_iter()
+        .enumerate()
+        .map(|(k, level)| frame_level(level, (k == 0).then_some(&replayed.seed), &params))
+        .collect();
+    let stream = assemble_stream(&params, &replayed.levels, framed);
+    if std::env::var_os("SPLITSTREAM_DEBUG").is_some() {
+        eprintln!(
+            "emit: replay {:.3} s, framing (entropy coding, chunks) {:.3} s",
+            replay_seconds,
+            started.elapsed().as_secs_f64() - replay_seconds
+        );
+    }
     Ok(Encoded {
         stream,
         permutation: replayed.permutation,

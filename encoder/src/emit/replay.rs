@@ -120,6 +120,15 @@ impl RecordSource for StepSource<'_> {
         Ok(flagged)
     }
 
+    fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+        // Exactly the flags flag() will give: the candidates that collapse
+        // in this step.
+        upcoming.iter().enumerate().fold(0, |bits, (i, &v)| {
+            let id = self.dec2enc[v as usize];
+            bits | ((self.current[id as usize] != NONE) as u64) << i
+        })
+    }
+
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let id = self.dec2enc[r as usize];
         let index = self.current[id as usize] as usize;

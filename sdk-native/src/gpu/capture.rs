@@ -102,6 +102,10 @@ impl<S: RecordSource> RecordSource for Capture<S> {
         Ok(flag)
     }
 
+    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+        self.inner.likely_flags(state, upcoming)
+    }
+
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let rec = self.inner.record(state, r, ring)?;
         self.round.records.push(gpu_record(&rec));
