@@ -45,8 +45,9 @@ pub struct StateMemory<'ws> {
     pub vertex_corner: &'ws mut [u32],
     pub deficit: &'ws mut [u8],
     /// Three bitmaps of one bit per vertex, one after the other: the current
-    /// candidates (deficit 0), the vertices flagged in the current round, and
-    /// the candidates whose flag is inferred because a neighbour was flagged.
+    /// candidates (deficit 0), the candidates at the start of the current
+    /// round, and the candidates whose flag is inferred because a neighbour
+    /// was flagged.
     pub candidates: &'ws mut [u64],
 }
 
@@ -85,7 +86,7 @@ impl<'ws> MeshState<'ws> {
 
     /// Largest vertex count the memory holds.
     pub fn vertex_capacity(&self) -> u32 {
-        let by_bits = (self.candidates.len() as u64 / 2) * 64;
+        let by_bits = (self.candidates.len() as u64 / 3) * 64;
         let n = self
             .positions
             .len()
@@ -137,7 +138,7 @@ impl<'ws> MeshState<'ws> {
         v < self.vertex_count && self.deficit[v as usize] == LEAF
     }
 
-    /// The candidate, flagged and blocked bitmaps (SPEC §7.3).
+    /// The candidate, round-start candidate and blocked bitmaps (SPEC §7.3, §7.4).
     pub(crate) fn bitmaps(&mut self) -> (&mut [u64], &mut [u64], &mut [u64]) {
         let third = self.candidates.len() / 3;
         let (candidates, rest) = self.candidates.split_at_mut(third);

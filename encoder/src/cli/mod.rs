@@ -36,6 +36,33 @@ pub enum Position {
     Constrained,
 }
 
+/// Which axis of each position residual the split's plane predicts (SPEC §7.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum PlaneArg {
+    /// Per level, the policy whose residuals take fewest bytes.
+    #[default]
+    Auto,
+    Off,
+    Dominant,
+    X,
+    Y,
+    Z,
+}
+
+impl PlaneArg {
+    pub fn policy(self) -> Option<splitstream_decoder_core::PlanePolicy> {
+        use splitstream_decoder_core::PlanePolicy;
+        match self {
+            PlaneArg::Auto => None,
+            PlaneArg::Off => Some(PlanePolicy::Off),
+            PlaneArg::Dominant => Some(PlanePolicy::Dominant),
+            PlaneArg::X => Some(PlanePolicy::Axis(0)),
+            PlaneArg::Y => Some(PlanePolicy::Axis(1)),
+            PlaneArg::Z => Some(PlanePolicy::Axis(2)),
+        }
+    }
+}
+
 /// Where the simplifier's data-parallel passes run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {

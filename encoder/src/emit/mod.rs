@@ -5,10 +5,10 @@
 mod levels;
 mod replay;
 
-use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, write_stream_seeded,
 };
+use splitstream_decoder_core::{PlanePolicy, PositionMode};
 
 use crate::mesh::Mesh;
 use crate::quantize::{QuantizedMesh, Units, quantize};
@@ -41,6 +41,9 @@ pub struct EncodeOptions {
     pub units: Units,
     /// Where the simplification's data-parallel passes run.
     pub backend: Backend,
+    /// The plane policy of every level (SPEC §7.4); `None`: per level, the
+    /// one whose residuals take fewest bytes.
+    pub plane: Option<PlanePolicy>,
 }
 
 impl Default for EncodeOptions {
@@ -57,6 +60,7 @@ impl Default for EncodeOptions {
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,
             backend: Backend::Cpu,
+            plane: None,
         }
     }
 }
@@ -141,8 +145,6 @@ pub fn encode_quantized(
     let simplify_seconds = started.elapsed().as_secs_f64();
     let started = std::time::Instant::now();
     let plan = plan_levels(&simplification, options.levels, base);
-    let replayed =
-        replay(mesh, &simplification, &plan, options.position_mode).map_err(EncodeError::Replay)?;
     let params = StreamParams {
         position_mode: options.position_mode,
         bits: mesh.bits,
@@ -151,6 +153,8 @@ pub fn encode_quantized(
         codec: options.codec,
         chunk_limit: options.chunk_limit,
     };
+    let replayed = replay(mesh, &simplification, &plan, &params, options.plane)
+        .map_err(EncodeError::Replay)?;
     let level_vertex_counts = replayed
         .levels
         .iter()
