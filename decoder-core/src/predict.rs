@@ -345,24 +345,47 @@ impl Plane {
     }
 
     /// The residual vector from the values read (decoder): the predicted
-    /// axis gets the plane's offset added.
+    /// axis gets the plane's offset added, modulo 2^32 ([`wrap`]).
     #[inline]
     pub fn decode(&self, coded: [i64; 3]) -> [i64; 3] {
         let mut r = coded;
         if let Some(j) = self.axis {
-            r[j] += self.offset(&coded);
+            r[j] = wrap(coded[j] + self.offset(&coded));
         }
         r
     }
 
-    /// The values to write for the residual vector `r` (encoder).
+    /// The values to write for the residual vector `r` (encoder; every
+    /// component a 32-bit value, as [`residual`] gives them).
     pub fn encode(&self, r: [i64; 3]) -> [i64; 3] {
         let mut coded = r;
         if let Some(j) = self.axis {
-            coded[j] -= self.offset(&r);
+            coded[j] = wrap(r[j] - self.offset(&r));
         }
         coded
     }
+}
+
+/// `x` modulo 2^32 as a signed 32-bit value (two's complement): the
+/// residual additions of SPEC §7.4 wrap, so that any position of the grid
+/// can be coded whatever its prediction.
+#[inline]
+pub fn wrap(x: i64) -> i64 {
+    x as i32 as i64
+}
+
+/// The decoded vector: the prediction plus the residual, modulo 2^32
+/// (SPEC §7.4).
+#[inline]
+pub fn add_residual(prediction: [i64; 3], r: [i64; 3]) -> [i64; 3] {
+    core::array::from_fn(|k| wrap(prediction[k] + r[k]))
+}
+
+/// The residual that [`add_residual`] turns back into `x` (encoder), for a
+/// vector `x` of magnitude below 2^31.
+#[inline]
+pub fn residual(x: [i64; 3], prediction: [i64; 3]) -> [i64; 3] {
+    core::array::from_fn(|k| wrap(x[k] - prediction[k]))
 }
 
 /// `round(p / q)`, halves rounded up: with the signs flipped so that
@@ -524,6 +547,18 @@ mod tests {
             ..ArcMeans::default()
         };
         assert_eq!(normal(&small), [-100, 0, -100]);
+    }
+
+    #[test]
+    fn wrapped_residuals_code_every_vector() {
+        let big = (1i64 << 31) - 1;
+        for x in [0, 1, -1, big, -big] {
+            for prediction in [0, big, -big, 10 * big, -10 * big, 12345] {
+                let r = residual([x; 3], [prediction; 3]);
+                assert!(r.iter().all(|v| i32::try_from(*v).is_ok()));
+                assert_eq!(add_residual([prediction; 3], r), [x; 3]);
+            }
+        }
     }
 
     #[test]

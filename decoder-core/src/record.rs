@@ -4,7 +4,9 @@ use crate::Error;
 use crate::context::{self, SINGLE};
 use crate::header::PositionMode;
 use crate::limits::substream::{self, SLOTS};
-use crate::predict::{Plane, PlanePolicy, Target, arc_means, constrained_positions, predict};
+use crate::predict::{
+    Plane, PlanePolicy, Target, add_residual, arc_means, constrained_positions, predict,
+};
 use crate::ring::Ring;
 use crate::round::RecordSource;
 use crate::split::SplitRecord;
@@ -95,7 +97,7 @@ impl RecordSource for StreamSource<'_, '_, '_> {
                 let code = s.byte(slot(substream::PLACEMENT), context::placement(&means))?;
                 let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
                 let prediction = predict(&means, self.mode, target);
-                let x = add(prediction, read_vector(s, slot(substream::EDGE), &plane)?);
+                let x = add_residual(prediction, read_vector(s, slot(substream::EDGE), &plane)?);
                 constrained_positions(parent, code, x)
             }
             PositionMode::Optimal => {
@@ -104,8 +106,8 @@ impl RecordSource for StreamSource<'_, '_, '_> {
                 let s_vec = read_vector(s, slot(substream::EDGE), &plane)?;
                 let t_vec = read_vector(s, slot(substream::PLACEMENT), &plane)?;
                 (
-                    add(origin, add(p_hat, s_vec)),
-                    add(origin, add(c_hat, t_vec)),
+                    add(origin, add_residual(p_hat, s_vec)),
+                    add(origin, add_residual(c_hat, t_vec)),
                 )
             }
         };

@@ -581,6 +581,40 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             );
         }
         s.valid(
+            &format!("bits-31-icosphere-{what}-x"),
+            &format!(
+                "Icosphere (162 vertices), {what} positions, 31 bits per axis, plane policy `x` in every level: residuals and plane offsets wrap modulo 2^32 (SPEC §7.4)."
+            ),
+            &["encoded", "bits-31", "plane-policy", "wrapped-residuals"],
+            encoded(
+                &sphere2,
+                EncodeOptions {
+                    position_mode: mode,
+                    bits: 31,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Axis(0)),
+                    ..opts()
+                },
+            ),
+        );
+        s.valid(
+            &format!("bits-31-icosphere-{what}-off"),
+            &format!(
+                "Icosphere (162 vertices), {what} positions, 31 bits per axis, plane policy `off` (no plane offsets: the residuals are read x, y, z)."
+            ),
+            &["encoded", "bits-31", "plane-policy"],
+            encoded(
+                &sphere2,
+                EncodeOptions {
+                    position_mode: mode,
+                    bits: 31,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Off),
+                    ..opts()
+                },
+            ),
+        );
+        s.valid(
             &format!("bits-31-grid-hole-{what}-dominant"),
             &format!(
                 "Small height field with a hole, {what} positions, 31 bits per axis, plane policy `dominant` in every level."

@@ -28,7 +28,8 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Decoder, Error, Inflater, Layout, MeshState, Plane, PlanePolicy, PositionMode, RecordSource,
-    Ring, SplitRecord, Target, arc_means, constrained_positions, context, predict, workspace_len,
+    Ring, SplitRecord, Target, add_residual, arc_means, constrained_positions, context, predict,
+    residual, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -304,8 +305,6 @@ impl RecordSource for GenSource<'_, '_> {
         let parent64 = parent.map(|x| x as i64);
         let means = arc_means(state.positions(), parent, ring, o, d);
         let plane = Plane::new(self.plane, &means);
-        let fits = |v: &[i64; 3]| v.iter().all(|&x| i32::try_from(x).is_ok());
-        let wide = |v: [i64; 3]| v.map(|x| x.clamp(i32::MIN as i64, i32::MAX as i64));
         let write = |w: &mut SubstreamWriter, coded: [i64; 3]| {
             for axis in plane.order() {
                 w.signed_in(plane.context(axis), coded[axis] as i32);
@@ -314,9 +313,8 @@ impl RecordSource for GenSource<'_, '_> {
         let sub = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|k| a[k] - b[k]) };
         let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|k| a[k] + b[k]) };
         // The positions are what the decoder computes from the values
-        // written (SPEC §7.4). Chosen positions whose coded residuals do not
-        // fit in 32 bits (wide grids, where the plane offset can amplify a
-        // residual) are replaced by the predictions, clamped into the grid.
+        // written (SPEC §7.4); residuals wrap modulo 2^32, so every chosen
+        // position of the grid can be coded.
         let (p, q) = match self.mode {
             PositionMode::Optimal => {
                 let mut p = [0i64; 3];
@@ -327,23 +325,13 @@ impl RecordSource for GenSource<'_, '_> {
                 }
                 let p_hat = predict(&means, self.mode, Target::P);
                 let c_hat = predict(&means, self.mode, Target::C);
-                let coded = |p: [i64; 3], q: [i64; 3]| {
-                    (
-                        plane.encode(sub(sub(p, parent64), p_hat)),
-                        plane.encode(sub(sub(q, parent64), c_hat)),
-                    )
-                };
-                let (mut cs, mut ct) = coded(p, q);
-                if !fits(&cs) || !fits(&ct) {
-                    let at = |hat: [i64; 3]| add(parent64, hat).map(clamp);
-                    (cs, ct) = coded(at(p_hat), at(c_hat));
-                }
-                let (cs, ct) = (wide(cs), wide(ct));
+                let cs = plane.encode(residual(sub(p, parent64), p_hat));
+                let ct = plane.encode(residual(sub(q, parent64), c_hat));
                 write(&mut self.subs[5], cs);
                 write(&mut self.subs[6], ct);
                 (
-                    add(parent64, add(p_hat, plane.decode(cs))),
-                    add(parent64, add(c_hat, plane.decode(ct))),
+                    add(parent64, add_residual(p_hat, plane.decode(cs))),
+                    add(parent64, add_residual(c_hat, plane.decode(ct))),
                 )
             }
             PositionMode::Constrained => {
@@ -351,14 +339,12 @@ impl RecordSource for GenSource<'_, '_> {
                 if self.allow_invalid && c.byte() == 0xFC {
                     code = 3 + c.byte() % 253;
                 }
+                self.subs[6].byte_in(context::placement(&means), code);
+                let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
                 let mut edge = [0i64; 3];
                 for e in &mut edge {
                     *e = small(c.byte());
                 }
-                let Some(mut target) = Target::of_code(code) else {
-                    self.subs[6].byte_in(context::placement(&means), code);
-                    return Err(Error::InvalidPlacement);
-                };
                 let vector = |code: u8, e: &[i64; 3]| -> [i64; 3] {
                     match code {
                         // R sits on P: the vector is C - R.
@@ -373,21 +359,10 @@ impl RecordSource for GenSource<'_, '_> {
                 if !in_grid(&p) || !in_grid(&q) {
                     edge = [0; 3];
                 }
-                let mut x = vector(code, &edge);
-                let mut coded = plane.encode(sub(x, predict(&means, self.mode, target)));
-                if !fits(&coded) {
-                    // R on P, C at its prediction clamped into the grid.
-                    code = 0;
-                    target = Target::C;
-                    let prediction = predict(&means, self.mode, target);
-                    x = sub(add(parent64, prediction).map(clamp), parent64);
-                    coded = plane.encode(sub(x, prediction));
-                }
-                let coded = wide(coded);
-                self.subs[6].byte_in(context::placement(&means), code);
-                write(&mut self.subs[5], coded);
                 let prediction = predict(&means, self.mode, target);
-                constrained_positions(parent, code, add(prediction, plane.decode(coded)))
+                let coded = plane.encode(residual(vector(code, &edge), prediction));
+                write(&mut self.subs[5], coded);
+                constrained_positions(parent, code, add_residual(prediction, plane.decode(coded)))
             }
         };
         if !in_grid(&p) || !in_grid(&q) {
@@ -483,16 +458,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         let mut subs = vec![SubstreamWriter::default(); 7];
         let mut round_splits = Vec::new();
         let level_start_v = state.vertex_count();
-        // The fixed-axis policies can amplify a residual by up to 2^16
-        // (SPEC §7.4): on wide grids valid records would need values
-        // beyond 32 bits, so those grids get `off` or `dominant` (the
-        // generator still checks every record, see `record`).
-        let policies = if bits <= 10 || allow_invalid {
-            &PlanePolicy::ALL[..]
-        } else {
-            &PlanePolicy::ALL[..2]
-        };
-        let plane = policies[choices.below(policies.len())];
+        let plane = PlanePolicy::ALL[choices.below(PlanePolicy::ALL.len())];
         let rounds = 3 - choices.below(3);
         for _ in 0..rounds {
             let n = state.vertex_count();

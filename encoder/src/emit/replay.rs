@@ -8,7 +8,8 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource, Ring, SplitOutcome,
-    SplitRecord, StateMemory, Target, arc_means, constrained_positions, context, predict,
+    SplitRecord, StateMemory, Target, add_residual, arc_means, constrained_positions, context,
+    predict, residual,
 };
 
 use super::levels::LevelPlan;
@@ -229,14 +230,14 @@ impl RecordSource for StepSource<'_> {
             PositionMode::Optimal => {
                 let p_hat = predict(&means, mode, Target::P);
                 let c_hat = predict(&means, mode, Target::C);
-                let rs = sub(sub(p_wide, origin), p_hat);
-                let rt = sub(sub(c_wide, origin), c_hat);
+                let rs = residual(sub(p_wide, origin), p_hat);
+                let rt = residual(sub(c_wide, origin), c_hat);
                 for (policy, out) in PlanePolicy::ALL.iter().zip(self.residuals.iter_mut()) {
                     let plane = Plane::new(*policy, &means);
                     let (cs, ct) = (plane.encode(rs), plane.encode(rt));
                     // What the decoder will compute from the coded values.
-                    consistent &= add(origin, add(p_hat, plane.decode(cs))) == p_wide
-                        && add(origin, add(c_hat, plane.decode(ct))) == c_wide;
+                    consistent &= add(origin, add_residual(p_hat, plane.decode(cs))) == p_wide
+                        && add(origin, add_residual(c_hat, plane.decode(ct))) == c_wide;
                     out.usable &= write_vector(&mut out.edge, &plane, cs);
                     out.usable &= write_vector(&mut out.placement, &plane, ct);
                 }
@@ -258,11 +259,11 @@ impl RecordSource for StepSource<'_> {
                 s[slot(substream::PLACEMENT)].byte_in(context::placement(&means), code);
                 let target = Target::of_code(code).expect("codes 0..=2");
                 let prediction = predict(&means, mode, target);
-                let residual = sub(x, prediction);
+                let r = residual(x, prediction);
                 for (policy, out) in PlanePolicy::ALL.iter().zip(self.residuals.iter_mut()) {
                     let plane = Plane::new(*policy, &means);
-                    let coded = plane.encode(residual);
-                    let decoded = add(prediction, plane.decode(coded));
+                    let coded = plane.encode(r);
+                    let decoded = add_residual(prediction, plane.decode(coded));
                     consistent &= constrained_positions(parent, code, decoded) == (p_wide, c_wide);
                     out.usable &= write_vector(&mut out.edge, &plane, coded);
                 }
