@@ -11,7 +11,7 @@ use splitstream_decoder_core::writer::{
 use splitstream_decoder_core::{PlanePolicy, PositionMode};
 
 use crate::mesh::Mesh;
-use crate::quantize::{QuantizedMesh, Units, quantize};
+use crate::quantize::{Quantization, QuantizedMesh, Units, quantize_with};
 use crate::simplify::{Backend, GpuError, SimplifyOptions, simplify_on};
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
@@ -39,6 +39,8 @@ pub struct EncodeOptions {
     pub admit_quantile: f64,
     /// Units of the input coordinates, for the error metric.
     pub units: Units,
+    /// One quantization step per axis (default) or one for all axes.
+    pub quantization: Quantization,
     /// Where the simplification's data-parallel passes run.
     pub backend: Backend,
     /// The plane policy of every level (SPEC §7.4); `None`: per level, the
@@ -59,6 +61,7 @@ impl Default for EncodeOptions {
             lock_boundary: false,
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,
+            quantization: Quantization::PerAxis,
             backend: Backend::Cpu,
             plane: None,
         }
@@ -112,7 +115,7 @@ pub fn encode(
     if options.levels == 0 {
         return Err(EncodeError::BadOption("--levels must be at least 1".into()));
     }
-    let quantized = quantize(mesh, options.bits, options.units);
+    let quantized = quantize_with(mesh, options.bits, options.units, options.quantization);
     encode_quantized(&quantized, options, progress)
 }
 
