@@ -215,10 +215,7 @@ fn pieces(stream: &[u8], broken: bool, hashes: &mut Vec<u64>) -> Result<(), Erro
         );
         for r in 0..rounds {
             let declared = level_header.split_count(r);
-            let source = StreamSource {
-                subs: &mut subs,
-                mode: header.position_mode,
-            };
+            let source = StreamSource::new(&mut subs, header.position_mode);
             let result = if broken {
                 state.run_round(declared, &mut SwapPositions(source), &mut ring)
             } else {

@@ -20,7 +20,7 @@ use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{PositionMode, context};
+use splitstream_decoder_core::{PlanePolicy, PositionMode, context};
 use streams::{BaseMesh, Choices};
 
 fn params(codec: ChunkCodec) -> StreamParams {
@@ -34,23 +34,27 @@ fn params(codec: ChunkCodec) -> StreamParams {
     }
 }
 
-/// One optimal-mode split record level (as in tests/handmade.rs).
+/// One optimal-mode split record level (as in tests/handmade.rs): wing
+/// ranks `o`, `d` among 3 eligible ring entries, P and C leaves, residuals
+/// `e` and `m` under the plane policy `off`.
 fn one_split(o: u8, d: u8, e: [i32; 3], m: [i32; 3], v: u32, t: u32) -> LevelPayload {
-    // Rings of 3 here: the rANS contexts follow (SPEC §5.5.5).
+    // Rings of 3 leaves here, C of valence 4: the rANS contexts follow
+    // (SPEC §5.5.5).
     let mut s = vec![SubstreamWriter::default(); 7];
     s[0].bit(true);
-    s[1].byte(o);
-    s[2].byte_in(context::wing_distance(3), d);
-    s[3].byte(LEAF);
-    s[4].byte_in(context::deficit_c(LEAF), LEAF);
+    s[1].byte_in(context::wing(3), o);
+    s[2].byte_in(context::wing(3), d);
+    s[3].byte(0);
+    s[4].byte_in(context::deficit_c(LEAF, 4), 0);
     for (k, &x) in e.iter().enumerate() {
-        s[5].signed_in(context::axis(k), x);
+        s[5].signed_in(k as u8, x);
     }
     for (k, &x) in m.iter().enumerate() {
-        s[6].signed_in(context::axis(k), x);
+        s[6].signed_in(k as u8, x);
     }
     LevelPayload {
         round_splits: vec![1],
+        plane: PlanePolicy::Off,
         substreams: s,
         vertex_count: v,
         triangle_count: t,

@@ -3,25 +3,46 @@
 //! the same functions, so both sides agree by construction.
 
 use crate::limits::LEAF;
+use crate::predict::{ArcMeans, PlanePolicy, placement_context};
 
-/// Wing distance, by ring length: rings of 3..=9 each, then 10 and above.
+/// Wing offset and wing distance, by the number `m` of ring entries that
+/// may be wings (SPEC §7.4): 2 or fewer, 3, …, 8, then 9 and more.
 #[inline]
-pub fn wing_distance(ring_len: usize) -> u8 {
-    (ring_len.clamp(3, 10) - 3) as u8
+pub fn wing(eligible: usize) -> u8 {
+    (eligible.clamp(2, 9) - 2) as u8
 }
 
-/// Deficit of C, by the deficit of P just read: 0, 1, 2, or 3 and above
-/// (a leaf counts as 3).
+/// C's split valence, by P's deficit and C's valence right after the split:
+/// 4 when P is a leaf, otherwise C's valence 3 (or less), 4, 5, or 6 and
+/// more as 0..=3.
 #[inline]
-pub fn deficit_c(deficit_p: u8) -> u8 {
+pub fn deficit_c(deficit_p: u8, valence_c: usize) -> u8 {
     if deficit_p == LEAF {
-        3
+        4
     } else {
-        deficit_p.min(3)
+        (valence_c.clamp(3, 6) - 3) as u8
     }
 }
 
-/// Position residuals and seed positions: the axis (0 x, 1 y, 2 z).
+/// Constrained mode's placement code, by where R lies between the two arcs
+/// (SPEC §7.4): 0..=4.
+#[inline]
+pub fn placement(means: &ArcMeans) -> u8 {
+    placement_context(means)
+}
+
+/// Position residuals: under the `dominant` plane policy 1 for the
+/// predicted axis and 0 for the two others; otherwise the axis (0 x, 1 y,
+/// 2 z).
+#[inline]
+pub fn residual(policy: PlanePolicy, axis: usize, predicted: Option<usize>) -> u8 {
+    match policy {
+        PlanePolicy::Dominant => (predicted == Some(axis)) as u8,
+        _ => axis as u8,
+    }
+}
+
+/// Seed positions: the axis (0 x, 1 y, 2 z).
 #[inline]
 pub fn axis(k: usize) -> u8 {
     k as u8

@@ -326,10 +326,7 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
             };
         }
         let declared = self.header.split_count(self.round);
-        let mut source = StreamSource {
-            subs: &mut self.subs,
-            mode: self.mode,
-        };
+        let mut source = StreamSource::new(&mut self.subs, self.mode);
         match self.state.run_round(declared, &mut source, self.ring) {
             Ok(stats) => {
                 let info = RoundInfo {

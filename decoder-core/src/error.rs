@@ -10,7 +10,7 @@ use core::fmt;
 pub enum Error {
     /// §3.1: the first 8 bytes are not the splitstream signature.
     BadMagic,
-    /// §3.1: a major version other than 1.
+    /// §3.1: a major version other than 3.
     UnsupportedVersion { major: u8, minor: u8 },
     /// §3.2: a header field out of its allowed range or a reserved field not zero.
     InvalidHeader(&'static str),
@@ -44,10 +44,15 @@ pub enum Error {
     /// §5.5: a rANS-coded value too large for its field (a bit above 1, a
     /// byte above 255), in the substream with this id.
     ValueOutOfRange(u8),
-    /// §7.4: a wing offset or distance outside the ring of the split vertex.
+    /// §7.4, §7.5: wing ranks naming no pair of ring entries that may be
+    /// wings (`d' = 0` or `o' + d' >= m`), or a wing offset or distance
+    /// outside the ring of the split vertex.
     RingOffsetOutOfRange,
     /// §6.2, §7.5: a valence above its split valence or above 255.
     ValenceOverflow,
+    /// §7.4: a coded split valence of P or C below that vertex's valence
+    /// right after the split, or above 255.
+    SplitValenceOutOfRange,
     /// §6.3: the base mesh is not a consistently oriented 2-manifold.
     NonManifold(&'static str),
     /// §6.3, §7.4: a decoded coordinate outside `0 .. 2^bits`.
@@ -93,7 +98,7 @@ impl Error {
             | Error::RecordCountMismatch(_)
             | Error::LevelCountMismatch => "count-mismatch",
             Error::RingOffsetOutOfRange => "ring-offset-out-of-range",
-            Error::ValenceOverflow => "valence-overflow",
+            Error::ValenceOverflow | Error::SplitValenceOutOfRange => "valence-overflow",
             Error::NonManifold(_) => "non-manifold",
             Error::PositionOutOfRange => "position-out-of-range",
             Error::LevelOutOfOrder { .. } | Error::Poisoned | Error::NoSuchVertex => "api-misuse",
@@ -115,7 +120,7 @@ impl fmt::Display for Error {
             Error::UnsupportedVersion { major, minor } => {
                 write!(
                     f,
-                    "unsupported format version {major}.{minor} (this decoder reads 2.x)"
+                    "unsupported format version {major}.{minor} (this decoder reads 3.x)"
                 )
             }
             Error::InvalidHeader(what) => write!(f, "invalid header: {what}"),
@@ -167,6 +172,10 @@ impl fmt::Display for Error {
                 write!(f, "wing offset outside the ring of the split vertex")
             }
             Error::ValenceOverflow => write!(f, "a valence exceeds its split valence or 255"),
+            Error::SplitValenceOutOfRange => write!(
+                f,
+                "a split valence below the vertex's valence after the split, or above 255"
+            ),
             Error::NonManifold(what) => write!(f, "base mesh is not a 2-manifold: {what}"),
             Error::PositionOutOfRange => {
                 write!(f, "decoded position outside the quantization grid")

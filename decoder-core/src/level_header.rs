@@ -1,8 +1,19 @@
-//! A level's own header: rounds, split counts and the chunk directory (SPEC §5.1, §5.2).
+//! A level's own header: rounds, the plane policy, split counts and the
+//! chunk directory (SPEC §5.1, §5.2).
 
 use crate::bytes::{crc32, u8_at, u16_at, u32_at};
 use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
+use crate::predict::PlanePolicy;
 use crate::{ChecksumScope, Error};
+
+/// Offset of the plane policy byte (SPEC §5.1), followed by 3 reserved bytes.
+const PLANE_AT: usize = 8;
+/// Offset of level 0's seed counts (SPEC §5.1).
+const SEED_AT: usize = 12;
+/// Offset of the split counts: `H` of SPEC §5.1.
+const fn split_counts_at(is_base: bool) -> usize {
+    if is_base { 20 } else { 12 }
+}
 
 /// One chunk-directory entry (SPEC §5.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -18,6 +29,11 @@ pub struct ChunkEntry {
 #[derive(Clone, Copy, Debug)]
 pub struct LevelHeader<'l> {
     pub round_count: u32,
+    /// How this level's position residuals use the split's plane (SPEC
+    /// §5.1, §7.4); the raw byte is checked by [`LevelHeader::parse`].
+    pub plane_policy: PlanePolicy,
+    plane_byte: u8,
+    reserved: [u8; 3],
     /// Level 0 only: vertex and triangle counts of the seed mesh its rounds
     /// start from (SPEC §5.1, §6.3); `(0, 0)` for other levels.
     pub seed_vertices: u32,
@@ -35,11 +51,21 @@ impl<'l> LevelHeader<'l> {
     pub fn parse(level: &'l [u8], is_base: bool, max_chunk_len: u32) -> Result<Self, Error> {
         let round_count = u32_at(level, 0)?;
         let chunk_count = u32_at(level, 4)?;
-        let (seed_vertices, seed_triangles, counts_at) = if is_base {
-            (u32_at(level, 8)?, u32_at(level, 12)?, 16usize)
+        let counts_at = split_counts_at(is_base);
+        if level.len() < counts_at {
+            return Err(Error::Truncated);
+        }
+        let (seed_vertices, seed_triangles) = if is_base {
+            (u32_at(level, SEED_AT)?, u32_at(level, SEED_AT + 4)?)
         } else {
-            (0, 0, 8usize)
+            (0, 0)
         };
+        let plane_byte = u8_at(level, PLANE_AT)?;
+        let reserved = [
+            u8_at(level, PLANE_AT + 1)?,
+            u8_at(level, PLANE_AT + 2)?,
+            u8_at(level, PLANE_AT + 3)?,
+        ];
         let splits_len = (round_count as usize)
             .checked_mul(4)
             .ok_or(Error::Truncated)?;
@@ -57,6 +83,9 @@ impl<'l> LevelHeader<'l> {
         }
         let header = LevelHeader {
             round_count,
+            plane_policy: PlanePolicy::from_byte(plane_byte).unwrap_or(PlanePolicy::Off),
+            plane_byte,
+            reserved,
             seed_vertices,
             seed_triangles,
             split_counts: &level[counts_at..dir_start],
@@ -69,6 +98,14 @@ impl<'l> LevelHeader<'l> {
     }
 
     fn validate(&self, level_len: usize, is_base: bool, max_chunk_len: u32) -> Result<(), Error> {
+        if PlanePolicy::from_byte(self.plane_byte).is_none() {
+            return Err(Error::InvalidLevelHeader("unknown plane policy"));
+        }
+        if self.reserved != [0; 3] {
+            return Err(Error::InvalidLevelHeader(
+                "reserved level header bytes not zero",
+            ));
+        }
         if is_base && (self.seed_vertices == 0 || self.seed_triangles == 0) {
             return Err(Error::InvalidLevelHeader("empty seed mesh"));
         }

@@ -37,7 +37,7 @@ mod level_table;
 pub mod limits;
 #[cfg(feature = "alloc")]
 pub mod owned;
-mod predict;
+pub mod predict;
 mod rans;
 #[cfg(feature = "alloc")]
 mod rans_writer;
@@ -47,6 +47,7 @@ mod round;
 mod split;
 mod state;
 pub mod substream;
+pub mod symbols;
 #[cfg(feature = "alloc")]
 pub mod writer;
 
@@ -60,12 +61,16 @@ pub use inflate::Inflater;
 pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader};
 pub use level_table::{LevelInfo, LevelTable, head_len, write_level_table};
-pub use predict::{predict_split, refine_c};
+pub use predict::{
+    ArcMeans, Plane, PlanePolicy, Target, add_residual, arc_means, constrained_positions, predict,
+    residual,
+};
 pub use rans::token_of;
 pub use ring::Ring;
 pub use round::{RecordSource, RoundStats};
 pub use split::{SplitOutcome, SplitRecord};
 pub use state::{MeshState, StateMemory, next, prev};
+pub use symbols::WingCandidates;
 
 /// Bytes of workspace (with alignment slack) needed to decode all of
 /// `stream`, from its header and level table alone (SPEC §9).

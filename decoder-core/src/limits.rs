@@ -5,7 +5,7 @@
 pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 
 /// Format version this crate reads and writes (SPEC §1).
-pub const VERSION_MAJOR: u8 = 2;
+pub const VERSION_MAJOR: u8 = 3;
 pub const VERSION_MINOR: u8 = 0;
 
 /// Size of the fixed header in bytes (SPEC §3).
@@ -65,7 +65,24 @@ pub mod substream {
         "base-deficits",
     ];
     /// Contexts of each substream under the rANS codec (SPEC §5.5), by id.
-    pub const CONTEXTS: [u8; 11] = [0, 1, 1, 8, 1, 4, 3, 3, 3, 1, 1];
+    pub const CONTEXTS: [u8; 11] = [0, 1, 8, 8, 1, 5, 3, 5, 3, 1, 1];
+}
+
+/// The plane policy byte of a level header (SPEC §5.1, §7.4): which axis of
+/// each position residual is predicted from the other two.
+pub mod plane {
+    /// No plane prediction.
+    pub const OFF: u8 = 0;
+    /// The axis along which the split's normal is largest.
+    pub const DOMINANT: u8 = 1;
+    /// Always x, y or z.
+    pub const X: u8 = 2;
+    pub const Y: u8 = 3;
+    pub const Z: u8 = 4;
+    /// Number of policies; bytes from here on are reserved.
+    pub const COUNT: u8 = 5;
+    /// The normal is shifted to at most this many significant bits.
+    pub const NORMAL_BITS: u32 = 15;
 }
 
 /// Chunk codecs (SPEC §5.2).

@@ -1,64 +1,644 @@
 //! Position prediction for a split (SPEC §7.4).
 //!
-//! Once the ring partition is known, P's neighbours are C and the vertices
-//! of P's arc; on a smooth surface P lies near the centroid of its
-//! neighbours. C is not decoded yet, so R stands in for it. The stream then
-//! codes only the residuals, which are much smaller than the edge vector.
+//! Once the wings are known, so are the ring entries P and C will have as
+//! neighbours: P's arc (arc 1) and C's arc (arc 2), which share the wings.
+//! Each vector the stream codes (C − R, P − R or the edge C − P in
+//! constrained mode; P − R and C − R in optimal mode) is predicted by a fixed
+//! linear combination of three means relative to R: of the real wings, of
+//! the real interior entries of arc 1 and of those of arc 2. The residual
+//! left is then predicted once more, on one axis, from the plane the split
+//! spans (the wing edge crossed with the direction from arc 1 to arc 2), as
+//! the level's plane policy says. Everything is exact integer arithmetic;
+//! the encoder calls the same functions, so both sides agree by construction.
 
-use crate::limits::NONE;
+use crate::header::PositionMode;
+use crate::limits::plane;
 use crate::ring::Ring;
 
-/// Predicted positions of P and C: for each, the floor of the mean of R and
-/// the real vertices of its arc (wings included), per axis, in i64. P owns
-/// arc 1 (`offset ..= offset + distance`), C arc 2.
-pub fn predict_split(
+/// A level's plane policy (SPEC §5.1, §7.4): which axis of each residual
+/// vector is predicted from the other two and the split's plane.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum PlanePolicy {
+    /// No plane prediction: axes read x, y, z in contexts 0, 1, 2.
+    #[default]
+    Off,
+    /// The axis along which the normal is largest; tangent axes in context
+    /// 0, the predicted axis in context 1.
+    Dominant,
+    /// Always this axis (0 x, 1 y, 2 z); contexts by axis.
+    Axis(u8),
+}
+
+impl PlanePolicy {
+    /// Every policy, in the order of their bytes.
+    pub const ALL: [PlanePolicy; plane::COUNT as usize] = [
+        PlanePolicy::Off,
+        PlanePolicy::Dominant,
+        PlanePolicy::Axis(0),
+        PlanePolicy::Axis(1),
+        PlanePolicy::Axis(2),
+    ];
+
+    /// The policy of a level header's byte (SPEC §5.1); `None` for the
+    /// reserved values 5..=255.
+    pub fn from_byte(b: u8) -> Option<PlanePolicy> {
+        match b {
+            plane::OFF => Some(PlanePolicy::Off),
+            plane::DOMINANT => Some(PlanePolicy::Dominant),
+            plane::X..=plane::Z => Some(PlanePolicy::Axis(b - plane::X)),
+            _ => None,
+        }
+    }
+
+    /// The level header byte of this policy.
+    pub fn to_byte(self) -> u8 {
+        match self {
+            PlanePolicy::Off => plane::OFF,
+            PlanePolicy::Dominant => plane::DOMINANT,
+            PlanePolicy::Axis(a) => plane::X + a.min(2),
+        }
+    }
+
+    /// Its name on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            PlanePolicy::Off => "off",
+            PlanePolicy::Dominant => "dominant",
+            PlanePolicy::Axis(0) => "x",
+            PlanePolicy::Axis(1) => "y",
+            PlanePolicy::Axis(_) => "z",
+        }
+    }
+}
+
+/// The ring statistics a split's predictions use (SPEC §7.4), per axis,
+/// relative to R: floor means of the real wings (`W`), of the real interior
+/// entries of arc 1 (`I1`) and of arc 2 (`I2`), 0 for an empty set; the sum
+/// `G` of every real ring entry and their number `nG`; and the wing edge
+/// `pos[b] − pos[a]` when neither wing is the ghost.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct ArcMeans {
+    pub wings: [i64; 3],
+    pub arc_1: [i64; 3],
+    pub arc_2: [i64; 3],
+    pub sum: [i64; 3],
+    pub count: i64,
+    pub wing_edge: Option<[i64; 3]>,
+}
+
+/// `ceil(2^48 / n)` for `n` in 1..=255 (0 unused): floor division by a
+/// set size as a multiplication, see [`floor_div`].
+const RECIPROCALS: [u64; 256] = {
+    let mut t = [0u64; 256];
+    let mut n = 1;
+    while n < 256 {
+        t[n] = (1u128 << 48).div_ceil(n as u128) as u64;
+        n += 1;
+    }
+    t
+};
+
+/// `floor(s / n)` for `1 <= n <= 255` and `|s| < 2^40`. With
+/// `m = ceil(2^48 / n)`, `floor(x m / 2^48) = floor(x / n)` for every
+/// `0 <= x < 2^40` (Granlund and Montgomery 1994, Theorem 4.2: `n <= 2^8`),
+/// so the division is one multiplication; negative sums are rounded
+/// towards minus infinity through `-floor((-s + n - 1) / n)`.
+#[inline]
+pub fn floor_div(s: i64, n: i64) -> i64 {
+    match RECIPROCALS.get(n as usize) {
+        Some(&m) if n > 0 && s.unsigned_abs() < 1 << 40 => {
+            let q = |x: u64| ((x as u128 * m as u128) >> 48) as i64;
+            if s >= 0 {
+                q(s as u64)
+            } else {
+                -q(s.unsigned_abs() + n as u64 - 1)
+            }
+        }
+        _ if n > 0 => s.div_euclid(n),
+        _ => 0,
+    }
+}
+
+/// The statistics of SPEC §7.4 for the split of a vertex at `parent` whose
+/// ring is `ring`, with wings at ring positions `offset` and
+/// `offset + distance` (`1 <= distance`, `offset + distance < ring.len()`).
+pub fn arc_means(
     positions: &[[u32; 3]],
     parent: [u32; 3],
     ring: &Ring,
     offset: usize,
     distance: usize,
-) -> ([i64; 3], [i64; 3]) {
-    let k = ring.len();
-    let arc_1 = centroid(positions, parent, ring, offset, distance);
-    let arc_2 = centroid(positions, parent, ring, offset + distance, k - distance);
-    (arc_1, arc_2)
-}
-
-/// Optimal mode's prediction of C once P is known (SPEC §7.4): the floor of
-/// the mean of C's arc centroid and the reflection `2R - P` of P through R
-/// (an edge collapse puts R between P and C).
-pub fn refine_c(c_hat: [i64; 3], parent: [u32; 3], p: [i64; 3]) -> [i64; 3] {
-    core::array::from_fn(|k| (c_hat[k] + 2 * parent[k] as i64 - p[k]).div_euclid(2))
-}
-
-/// Mean of `parent` and the real ring vertices `start ..= start + len` (mod k).
-fn centroid(
-    positions: &[[u32; 3]],
-    parent: [u32; 3],
-    ring: &Ring,
-    start: usize,
-    len: usize,
-) -> [i64; 3] {
+) -> ArcMeans {
     let vertices = ring.vertices();
-    let k = vertices.len();
-    // Coordinates are below 2^31 and a ring has at most 255 entries, so the
-    // sums stay far below 2^63 and are never negative: unsigned division is
-    // the floor division of SPEC §7.4.
-    let mut sum = parent.map(|x| x as u64);
-    let mut count = 1u64;
-    let mut i = if start >= k { start - k } else { start };
-    for _ in 0..=len {
-        let v = vertices.get(i).copied().unwrap_or(NONE);
-        if let Some(p) = positions.get(v as usize) {
-            for a in 0..3 {
-                sum[a] += p[a] as u64;
+    let b_at = offset + distance;
+    let origin = parent.map(|x| x as i64);
+    // Sums relative to R and counts of the real entries of each set (the
+    // ghost, NONE, has no position). Coordinates are below 2^31 and a ring
+    // has at most 255 entries: every sum stays below 2^39 in magnitude.
+    let add = |entries: &[u32], sum: &mut [i64; 3]| -> i64 {
+        let mut n = 0;
+        for &v in entries {
+            if let Some(p) = positions.get(v as usize) {
+                sum[0] += p[0] as i64 - origin[0];
+                sum[1] += p[1] as i64 - origin[1];
+                sum[2] += p[2] as i64 - origin[2];
+                n += 1;
             }
-            count += 1;
         }
-        i += 1;
-        if i == k {
-            i = 0;
+        n
+    };
+    let (mut arc_1, mut arc_2) = ([0i64; 3], [0i64; 3]);
+    let (n_1, n_2) = match (
+        vertices.get(offset + 1..b_at),
+        vertices.get(b_at + 1..),
+        vertices.get(..offset),
+    ) {
+        (Some(inner), Some(after), Some(before)) => (
+            add(inner, &mut arc_1),
+            add(after, &mut arc_2) + add(before, &mut arc_2),
+        ),
+        _ => (0, 0),
+    };
+    let wing = |at: usize| {
+        vertices
+            .get(at)
+            .and_then(|&v| positions.get(v as usize))
+            .map(|p| [p[0] as i64, p[1] as i64, p[2] as i64])
+    };
+    let (a, b) = (wing(offset), wing(b_at));
+    let relative = |p: &[i64; 3]| -> [i64; 3] { core::array::from_fn(|k| p[k] - origin[k]) };
+    let (wings, n_wings) = match (&a, &b) {
+        (Some(a), Some(b)) => {
+            let sum: [i64; 3] = core::array::from_fn(|k| a[k] + b[k] - 2 * origin[k]);
+            (sum, 2)
+        }
+        (Some(w), None) | (None, Some(w)) => (relative(w), 1),
+        (None, None) => ([0; 3], 0),
+    };
+    let mean = |sum: &[i64; 3], n: i64| -> [i64; 3] {
+        match n {
+            0 => [0; 3],
+            1 => *sum,
+            2 => sum.map(|s| s >> 1),
+            _ => sum.map(|s| floor_div(s, n)),
+        }
+    };
+    let wing_edge = match (a, b) {
+        (Some(a), Some(b)) => Some(core::array::from_fn(|k| b[k] - a[k])),
+        _ => None,
+    };
+    ArcMeans {
+        wings: mean(&wings, n_wings),
+        arc_1: mean(&arc_1, n_1),
+        arc_2: mean(&arc_2, n_2),
+        sum: core::array::from_fn(|k| wings[k] + arc_1[k] + arc_2[k]),
+        count: n_wings + n_1 + n_2,
+        wing_edge,
+    }
+}
+
+/// Which vector of a split the stream codes (SPEC §7.4).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Target {
+    /// P − R: constrained code 1 (R sits on C), optimal mode's first vector.
+    P,
+    /// C − R: constrained code 0 (R sits on P), optimal mode's second vector.
+    C,
+    /// The edge C − P: constrained code 2 (R is the floor midpoint).
+    Edge,
+}
+
+impl Target {
+    /// The vector coded after the constrained-mode placement code `code`.
+    pub fn of_code(code: u8) -> Option<Target> {
+        match code {
+            0 => Some(Target::C),
+            1 => Some(Target::P),
+            2 => Some(Target::Edge),
+            _ => None,
         }
     }
-    sum.map(|s| (s / count) as i64)
+}
+
+/// Weights (wings, own arc, other arc) of SPEC §7.4's linear predictor, in
+/// sixteenths: constrained mode's P or C, its edge, optimal mode's P or C.
+pub const CONSTRAINED_VERTEX_WEIGHTS: [i64; 3] = [1, 7, -2];
+pub const CONSTRAINED_EDGE_WEIGHTS: [i64; 3] = [0, 5, -5];
+pub const OPTIMAL_WEIGHTS: [i64; 3] = [1, 4, -1];
+
+/// The prediction of `target` (relative to R for P and C, SPEC §7.4):
+/// `(w_W m_W + w_own m_own + w_other m_other) >> 4` per axis, where the own
+/// arc is arc 1 for P and arc 2 for C and for the edge.
+pub fn predict(means: &ArcMeans, mode: PositionMode, target: Target) -> [i64; 3] {
+    let weights = match (mode, target) {
+        (PositionMode::Constrained, Target::Edge) => CONSTRAINED_EDGE_WEIGHTS,
+        (PositionMode::Constrained, _) => CONSTRAINED_VERTEX_WEIGHTS,
+        (PositionMode::Optimal, _) => OPTIMAL_WEIGHTS,
+    };
+    let (own, other) = match target {
+        Target::P => (&means.arc_1, &means.arc_2),
+        Target::C | Target::Edge => (&means.arc_2, &means.arc_1),
+    };
+    // Means are below 2^31 in magnitude: the sum is below 2^35.
+    core::array::from_fn(|k| {
+        (weights[0] * means.wings[k] + weights[1] * own[k] + weights[2] * other[k]) >> 4
+    })
+}
+
+/// Constrained mode's positions of P and C (SPEC §7.4) from R and the
+/// decoded vector `x` of the placement code's target.
+pub fn constrained_positions(parent: [u32; 3], code: u8, x: [i64; 3]) -> ([i64; 3], [i64; 3]) {
+    let r = parent.map(|v| v as i64);
+    match code {
+        // R sits on P: x = C - R.
+        0 => (r, core::array::from_fn(|k| r[k] + x[k])),
+        // R sits on C: x = P - R.
+        1 => (core::array::from_fn(|k| r[k] + x[k]), r),
+        // R is the floor midpoint P + (e >> 1): x = e = C - P.
+        _ => {
+            let p: [i64; 3] = core::array::from_fn(|k| r[k] - (x[k] >> 1));
+            (p, core::array::from_fn(|k| p[k] + x[k]))
+        }
+    }
+}
+
+/// The plane prediction of one split (SPEC §7.4): the shifted normal and
+/// the predicted axis, or nothing under the policy `off`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Plane {
+    pub policy: PlanePolicy,
+    /// `n`, at most [`plane::NORMAL_BITS`] significant bits per component.
+    pub normal: [i64; 3],
+    /// The predicted axis j; `None` under the policy `off`.
+    pub axis: Option<usize>,
+    order: [usize; 3],
+    contexts: [u8; 3],
+}
+
+impl Plane {
+    /// The plane of a split with statistics `means` under `policy`.
+    pub fn new(policy: PlanePolicy, means: &ArcMeans) -> Plane {
+        let (normal, axis) = match policy {
+            PlanePolicy::Off => {
+                return Plane {
+                    policy,
+                    normal: [0; 3],
+                    axis: None,
+                    order: [0, 1, 2],
+                    contexts: [0, 1, 2],
+                };
+            }
+            PlanePolicy::Dominant => {
+                let n = normal(means);
+                let m = n.map(|x| x.unsigned_abs());
+                // The largest component, the lowest axis on ties.
+                let j = if m[1] > m[0] {
+                    if m[2] > m[1] { 2 } else { 1 }
+                } else if m[2] > m[0] {
+                    2
+                } else {
+                    0
+                };
+                (n, j)
+            }
+            PlanePolicy::Axis(a) => (normal(means), (a as usize).min(2)),
+        };
+        let order = [(axis + 1) % 3, (axis + 2) % 3, axis];
+        let contexts = match policy {
+            PlanePolicy::Dominant => core::array::from_fn(|k| (k == axis) as u8),
+            _ => [0, 1, 2],
+        };
+        Plane {
+            policy,
+            normal,
+            axis: Some(axis),
+            order,
+            contexts,
+        }
+    }
+
+    /// The axes in the order the stream holds them: x, y, z, or under a
+    /// plane policy j + 1, j + 2 (mod 3), then the predicted axis j.
+    #[inline]
+    pub fn order(&self) -> [usize; 3] {
+        self.order
+    }
+
+    /// The rANS context of `axis` (SPEC §5.5.5).
+    #[inline]
+    pub fn context(&self, axis: usize) -> u8 {
+        self.contexts.get(axis).copied().unwrap_or(0)
+    }
+
+    /// The plane's prediction of the residual on the predicted axis j from
+    /// the two others: `round(-(n_{j+1} r_{j+1} + n_{j+2} r_{j+2}) / n_j)`,
+    /// 0 when `n_j = 0` or without a plane.
+    #[inline]
+    pub fn offset(&self, r: &[i64; 3]) -> i64 {
+        let Some(j) = self.axis else {
+            return 0;
+        };
+        let n = &self.normal;
+        let (j1, j2) = (self.order[0], self.order[1]);
+        // |n| <= 2^15 and the residuals read are i32: far inside i64.
+        round_div(-(n[j1] * r[j1] + n[j2] * r[j2]), n[j])
+    }
+
+    /// The residual vector from the values read (decoder): the predicted
+    /// axis gets the plane's offset added, modulo 2^32 ([`wrap`]).
+    #[inline]
+    pub fn decode(&self, coded: [i64; 3]) -> [i64; 3] {
+        let mut r = coded;
+        if let Some(j) = self.axis {
+            r[j] = wrap(coded[j] + self.offset(&coded));
+        }
+        r
+    }
+
+    /// The values to write for the residual vector `r` (encoder; every
+    /// component a 32-bit value, as [`residual`] gives them).
+    pub fn encode(&self, r: [i64; 3]) -> [i64; 3] {
+        let mut coded = r;
+        if let Some(j) = self.axis {
+            coded[j] = wrap(r[j] - self.offset(&r));
+        }
+        coded
+    }
+}
+
+/// `x` modulo 2^32 as a signed 32-bit value (two's complement): the
+/// residual additions of SPEC §7.4 wrap, so that any position of the grid
+/// can be coded whatever its prediction.
+#[inline]
+pub fn wrap(x: i64) -> i64 {
+    x as i32 as i64
+}
+
+/// The decoded vector: the prediction plus the residual, modulo 2^32
+/// (SPEC §7.4).
+#[inline]
+pub fn add_residual(prediction: [i64; 3], r: [i64; 3]) -> [i64; 3] {
+    core::array::from_fn(|k| wrap(prediction[k] + r[k]))
+}
+
+/// The residual that [`add_residual`] turns back into `x` (encoder), for a
+/// vector `x` of magnitude below 2^31.
+#[inline]
+pub fn residual(x: [i64; 3], prediction: [i64; 3]) -> [i64; 3] {
+    core::array::from_fn(|k| wrap(x[k] - prediction[k]))
+}
+
+/// `round(p / q)`, halves rounded up: with the signs flipped so that
+/// `q > 0`, `floor((2p + q) / (2q))`; 0 when `q = 0`.
+#[inline]
+pub fn round_div(p: i64, q: i64) -> i64 {
+    if q == 0 || p == 0 {
+        return 0;
+    }
+    let (p, q) = if q < 0 { (-p, -q) } else { (p, q) };
+    // floor(x / d) with d = 2q > 0, through unsigned magnitudes (cheaper
+    // than a signed division when both fit in 32 bits, as they usually do).
+    let (x, d) = (2 * p + q, (2 * q) as u64);
+    if x >= 0 {
+        (x as u64 / d) as i64
+    } else {
+        -(x.unsigned_abs().div_ceil(d) as i64)
+    }
+}
+
+/// The split's normal (SPEC §7.4): `N = (pos[b] − pos[a]) × (m_I2 − m_I1)`,
+/// 0 when a wing is the ghost, shifted right (arithmetic shift) by
+/// `max(0, bitlen(max |N_i|) − 15)`.
+///
+/// Exact in 64 bits: positions lie in `0 .. 2^31`, so `|pos[b] − pos[a]|`
+/// and `|m_I2 − m_I1|` (two floor means of positions relative to the same R)
+/// are at most `2^31 − 1`; each product is below `2^62` and each component
+/// below `2^63`.
+pub fn normal(means: &ArcMeans) -> [i64; 3] {
+    let Some(a) = means.wing_edge else {
+        return [0; 3];
+    };
+    let b: [i64; 3] = core::array::from_fn(|k| means.arc_2[k] - means.arc_1[k]);
+    let n = cross(a, b);
+    let largest = n.iter().map(|x| x.unsigned_abs()).max().unwrap_or(0);
+    let shift = (u64::BITS - largest.leading_zeros()).saturating_sub(plane::NORMAL_BITS);
+    n.map(|x| x >> shift)
+}
+
+#[inline]
+fn cross(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+/// Constrained mode's context of the placement code (SPEC §5.5.5): where
+/// R lies along the direction `a = m_I2 − m_I1` from arc 1 to arc 2, from
+/// `T = −G·a` against `Q = nG |a|²`, in 128-bit arithmetic.
+pub fn placement_context(means: &ArcMeans) -> u8 {
+    let a: [i64; 3] = core::array::from_fn(|k| means.arc_2[k] - means.arc_1[k]);
+    let g = means.sum;
+    // With |a| < 2^24 and |G| < 2^32 (any grid of up to 23 bits), 10 |T|
+    // and 5 Q stay below 2^62: 64 bits suffice. Otherwise |a| < 2^32,
+    // |G| < 2^39, nG <= 255: 10 T and 5 Q stay below 2^78.
+    let small = a.iter().all(|x| x.unsigned_abs() < 1 << 24)
+        && g.iter().all(|x| x.unsigned_abs() < 1 << 32);
+    let (t, q) = if small {
+        let t = -(g[0] * a[0] + g[1] * a[1] + g[2] * a[2]);
+        let q = means.count * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        (t as i128, q as i128)
+    } else {
+        let a = a.map(|x| x as i128);
+        let g = g.map(|x| x as i128);
+        let t = -(g[0] * a[0] + g[1] * a[1] + g[2] * a[2]);
+        let q = means.count as i128 * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        (t, q)
+    };
+    bucket(t, q)
+}
+
+/// The placement context of `T` against `Q` (SPEC §5.5.5).
+#[inline]
+fn bucket(t: i128, q: i128) -> u8 {
+    let t10 = 10 * t;
+    if t10 < -5 * q {
+        0
+    } else if t10 < -q {
+        1
+    } else if t10 <= q {
+        2
+    } else if t10 <= 5 * q {
+        3
+    } else {
+        4
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn reciprocal_division_is_floor_division() {
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        for n in 1..=255i64 {
+            for s in [0, 1, -1, n, -n, n - 1, 1 - n, (1 << 40) - 1, 1 - (1 << 40)] {
+                assert_eq!(floor_div(s, n), s.div_euclid(n), "{s} / {n}");
+            }
+            for _ in 0..2000 {
+                let r = next();
+                let s = (r >> 23) as i64 * if r & 1 == 0 { 1 } else { -1 };
+                assert_eq!(floor_div(s, n), s.div_euclid(n), "{s} / {n}");
+            }
+        }
+        assert_eq!(floor_div(1 << 50, 3), (1i64 << 50) / 3);
+        assert_eq!(floor_div(-7, 300), -1);
+        assert_eq!(floor_div(7, 0), 0);
+    }
+
+    #[test]
+    fn rounding_division() {
+        assert_eq!(round_div(3, 2), 2);
+        assert_eq!(round_div(-3, 2), -1);
+        assert_eq!(round_div(3, -2), -1);
+        assert_eq!(round_div(-3, -2), 2);
+        assert_eq!(round_div(5, 3), 2);
+        assert_eq!(round_div(4, 3), 1);
+        assert_eq!(round_div(-4, 3), -1);
+        assert_eq!(round_div(-5, 3), -2);
+        assert_eq!(round_div(7, 0), 0);
+    }
+
+    #[test]
+    fn policies_round_trip_their_bytes() {
+        for (i, p) in PlanePolicy::ALL.iter().enumerate() {
+            assert_eq!(p.to_byte(), i as u8);
+            assert_eq!(PlanePolicy::from_byte(i as u8), Some(*p));
+        }
+        assert_eq!(PlanePolicy::from_byte(5), None);
+        assert_eq!(PlanePolicy::from_byte(255), None);
+    }
+
+    #[test]
+    fn normal_is_exact_then_shifted() {
+        // The largest differences a 31-bit grid allows.
+        let big = (1i64 << 31) - 1;
+        let means = ArcMeans {
+            arc_1: [-big, -big, 0],
+            arc_2: [0, 0, big],
+            wing_edge: Some([big, -big, big]),
+            ..ArcMeans::default()
+        };
+        let n = normal(&means);
+        assert!(n.iter().all(|x| x.abs() <= 1 << 15));
+        assert!(n.iter().any(|x| x.abs() >= 1 << 14));
+        // Small normals are not shifted.
+        let small = ArcMeans {
+            arc_2: [0, 10, 0],
+            wing_edge: Some([-10, 0, 10]),
+            ..ArcMeans::default()
+        };
+        assert_eq!(normal(&small), [-100, 0, -100]);
+    }
+
+    #[test]
+    fn wrapped_residuals_code_every_vector() {
+        let big = (1i64 << 31) - 1;
+        for x in [0, 1, -1, big, -big] {
+            for prediction in [0, big, -big, 10 * big, -10 * big, 12345] {
+                let r = residual([x; 3], [prediction; 3]);
+                assert!(r.iter().all(|v| i32::try_from(*v).is_ok()));
+                assert_eq!(add_residual([prediction; 3], r), [x; 3]);
+            }
+        }
+    }
+
+    #[test]
+    fn plane_encode_inverts_decode() {
+        let means = ArcMeans {
+            arc_1: [3, -7, 1],
+            arc_2: [-5, 9, 4],
+            wing_edge: Some([12, 3, -8]),
+            ..ArcMeans::default()
+        };
+        for policy in PlanePolicy::ALL {
+            let plane = Plane::new(policy, &means);
+            for r in [
+                [0, 0, 0],
+                [5, -3, 7],
+                [-100, 40, 2],
+                [1 << 30, -(1 << 30), 5],
+            ] {
+                assert_eq!(plane.decode(plane.encode(r)), r, "{policy:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn plane_orders_and_contexts_follow_the_spec() {
+        for (wing_edge, arc_2) in [
+            (Some([3, -9, 2]), [1, 1, 7]),
+            (Some([5, 0, 0]), [0, 5, 0]),
+            (None, [4, 4, 4]),
+        ] {
+            let means = ArcMeans {
+                arc_2,
+                wing_edge,
+                ..ArcMeans::default()
+            };
+            for policy in PlanePolicy::ALL {
+                let plane = Plane::new(policy, &means);
+                let n = normal(&means).map(|x| x.abs());
+                let expected_axis = match policy {
+                    PlanePolicy::Off => None,
+                    PlanePolicy::Dominant => {
+                        Some((0..3).find(|&i| n[i] == *n.iter().max().unwrap()).unwrap())
+                    }
+                    PlanePolicy::Axis(a) => Some(a as usize),
+                };
+                assert_eq!(plane.axis, expected_axis, "{policy:?}");
+                for axis in 0..3 {
+                    assert_eq!(
+                        plane.context(axis),
+                        crate::context::residual(policy, axis, plane.axis)
+                    );
+                }
+                let order = plane.order();
+                if let Some(j) = plane.axis {
+                    assert_eq!(order, [(j + 1) % 3, (j + 2) % 3, j]);
+                } else {
+                    assert_eq!(order, [0, 1, 2]);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn placement_context_survives_31_bits() {
+        let big = (1i64 << 31) - 1;
+        let means = ArcMeans {
+            arc_1: [-big; 3],
+            arc_2: [big; 3],
+            sum: [-255 * big; 3],
+            count: 255,
+            ..ArcMeans::default()
+        };
+        assert_eq!(placement_context(&means), 3);
+        let means = ArcMeans {
+            sum: [255 * big; 3],
+            ..means
+        };
+        assert_eq!(placement_context(&means), 1);
+        let means = ArcMeans { count: 1, ..means };
+        assert_eq!(placement_context(&means), 0);
+        assert_eq!(placement_context(&ArcMeans::default()), 2);
+    }
 }

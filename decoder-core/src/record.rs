@@ -1,15 +1,18 @@
-//! Reading split records and the base mesh from substreams (SPEC §6.3, §7.4, §7.5).
+//! Reading split records and the base mesh from substreams (SPEC §6.3, §7.4).
 
 use crate::Error;
 use crate::context::{self, SINGLE};
 use crate::header::PositionMode;
 use crate::limits::substream::{self, SLOTS};
-use crate::predict::{predict_split, refine_c};
+use crate::predict::{
+    Plane, PlanePolicy, Target, add_residual, arc_means, constrained_positions, predict,
+};
 use crate::ring::Ring;
 use crate::round::{RecordSource, all_ones};
 use crate::split::SplitRecord;
 use crate::state::MeshState;
 use crate::substream::Substreams;
+use crate::symbols::deficit_of;
 
 /// Substream slot of a refinement substream id (ids 1..=7 use slots 0..=6).
 const fn slot(id: u8) -> usize {
@@ -29,6 +32,28 @@ const _: () = assert!(slot(substream::PLACEMENT) < SLOTS);
 pub struct StreamSource<'s, 'l, 'b> {
     pub subs: &'s mut Substreams<'l, 'b>,
     pub mode: PositionMode,
+    /// The level's plane policy (SPEC §5.1).
+    pub plane: PlanePolicy,
+}
+
+impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
+    /// Reads the rounds of the level whose substreams `subs` are open, in
+    /// position mode `mode`, with the plane policy of the level's header.
+    pub fn new(subs: &'s mut Substreams<'l, 'b>, mode: PositionMode) -> Self {
+        let plane = subs.level_header().plane_policy;
+        StreamSource { subs, mode, plane }
+    }
+}
+
+/// Reads one residual vector from `slot` (SPEC §7.4): the axes in the
+/// plane's order and contexts, then the plane's offset on its axis.
+#[inline]
+fn read_vector(s: &mut Substreams<'_, '_>, slot: usize, plane: &Plane) -> Result<[i64; 3], Error> {
+    let mut coded = [0i64; 3];
+    for axis in plane.order() {
+        coded[axis] = s.signed(slot, plane.context(axis))? as i64;
+    }
+    Ok(plane.decode(coded))
 }
 
 impl RecordSource for StreamSource<'_, '_, '_> {
@@ -45,57 +70,54 @@ impl RecordSource for StreamSource<'_, '_, '_> {
         bits & all_ones(known as usize) | !all_ones(known as usize) & all_ones(upcoming.len())
     }
 
+    /// SPEC §7.4, fields in order: wing ranks, split valences of P and C,
+    /// then (constrained) the placement code and one residual vector, or
+    /// (optimal) two residual vectors.
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let s = &mut *self.subs;
-        let wing_offset = s.byte(slot(substream::WING_OFFSET), SINGLE)?;
-        let wing_distance = s.byte(
-            slot(substream::WING_DISTANCE),
-            context::wing_distance(ring.len()),
+        let k = ring.len();
+        let eligible = state.wing_candidates(ring);
+        let wing_context = context::wing(eligible.count());
+        let o_rank = s.byte(slot(substream::WING_OFFSET), wing_context)?;
+        let d_rank = s.byte(slot(substream::WING_DISTANCE), wing_context)?;
+        let (o, d) = eligible.wings(o_rank, d_rank)?;
+        let (valence_p, valence_c) = (d + 2, k - d + 2);
+        let deficit_p = deficit_of(s.byte(slot(substream::DEFICIT_P), SINGLE)?, valence_p)?;
+        let deficit_c = deficit_of(
+            s.byte(
+                slot(substream::DEFICIT_C),
+                context::deficit_c(deficit_p, valence_c),
+            )?,
+            valence_c,
         )?;
-        let (o, d) = (wing_offset as usize, wing_distance as usize);
-        if d == 0 || o + d >= ring.len() {
-            return Err(Error::RingOffsetOutOfRange);
-        }
-        let deficit_p = s.byte(slot(substream::DEFICIT_P), SINGLE)?;
-        let deficit_c = s.byte(slot(substream::DEFICIT_C), context::deficit_c(deficit_p))?;
         let parent = state.positions()[r as usize];
-        let (p_hat, c_hat) = predict_split(state.positions(), parent, ring, o, d);
-        let mut first = [0i64; 3];
-        for (k, x) in first.iter_mut().enumerate() {
-            *x = s.signed(slot(substream::EDGE), context::axis(k))? as i64;
-        }
+        let means = arc_means(state.positions(), parent, ring, o, d);
+        let plane = Plane::new(self.plane, &means);
+        let origin = parent.map(|x| x as i64);
+        let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|i| a[i] + b[i]) };
         let (p, c) = match self.mode {
-            PositionMode::Optimal => {
-                let p: [i64; 3] = core::array::from_fn(|k| p_hat[k] + first[k]);
-                let c_hat = refine_c(c_hat, parent, p);
-                let mut c = [0i64; 3];
-                for k in 0..3 {
-                    c[k] =
-                        c_hat[k] + s.signed(slot(substream::PLACEMENT), context::axis(k))? as i64;
-                }
-                (p, c)
-            }
             PositionMode::Constrained => {
-                let parent = parent.map(|x| x as i64);
-                match s.byte(slot(substream::PLACEMENT), SINGLE)? {
-                    // R sits on P: C is coded.
-                    0 => (parent, core::array::from_fn(|k| c_hat[k] + first[k])),
-                    // R sits on C: P is coded.
-                    1 => (core::array::from_fn(|k| p_hat[k] + first[k]), parent),
-                    // R is the midpoint P + (e >> 1): the edge e is coded.
-                    2 => {
-                        let e: [i64; 3] = core::array::from_fn(|k| c_hat[k] - p_hat[k] + first[k]);
-                        let p: [i64; 3] = core::array::from_fn(|k| parent[k] - (e[k] >> 1));
-                        (p, core::array::from_fn(|k| p[k] + e[k]))
-                    }
-                    _ => return Err(Error::InvalidPlacement),
-                }
+                let code = s.byte(slot(substream::PLACEMENT), context::placement(&means))?;
+                let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
+                let prediction = predict(&means, self.mode, target);
+                let x = add_residual(prediction, read_vector(s, slot(substream::EDGE), &plane)?);
+                constrained_positions(parent, code, x)
+            }
+            PositionMode::Optimal => {
+                let p_hat = predict(&means, self.mode, Target::P);
+                let c_hat = predict(&means, self.mode, Target::C);
+                let s_vec = read_vector(s, slot(substream::EDGE), &plane)?;
+                let t_vec = read_vector(s, slot(substream::PLACEMENT), &plane)?;
+                (
+                    add(origin, add_residual(p_hat, s_vec)),
+                    add(origin, add_residual(c_hat, t_vec)),
+                )
             }
         };
         let bits = state.bits();
         Ok(SplitRecord {
-            wing_offset,
-            wing_distance,
+            wing_offset: o as u8,
+            wing_distance: d as u8,
             deficit_p,
             deficit_c,
             position_p: to_grid(p, bits)?,

@@ -1,5 +1,7 @@
 //! One refinement round (SPEC §7.2, §7.3): find candidates, read one flag per
-//! candidate, apply the flagged splits in ascending vertex order.
+//! candidate, apply the flagged splits in ascending vertex order. The
+//! round's candidate set is kept for its whole duration: it says which ring
+//! entries may be wings (SPEC §7.4).
 //!
 //! The procedure is shared by the stream decoder and by the encoder, which
 //! replays it to write streams that are correct by construction: both plug
@@ -73,16 +75,20 @@ impl MeshState<'_> {
         }
         let words = (n as usize).div_ceil(64);
         // Step 1: the candidates are the vertices below n with deficit 0;
-        // the bitmap is kept up to date by every split (SPEC §7.3).
+        // the bitmap is kept up to date by every split (SPEC §7.3). A copy
+        // of it as it is now says which ring entries may be wings during
+        // the round (SPEC §7.4, symbols.rs): splits change the live bitmap.
+        let (candidates, round_start, _) = self.bitmaps();
+        let words = words.min(candidates.len()).min(round_start.len());
+        round_start[..words].copy_from_slice(&candidates[..words]);
         let mut stats = RoundStats {
-            candidates: self.bitmaps().0[..words]
-                .iter()
-                .map(|w| w.count_ones())
-                .sum(),
+            candidates: candidates[..words].iter().map(|w| w.count_ones()).sum(),
             ..RoundStats::default()
         };
         let result = self.flag_and_split(n, words, source, ring, &mut stats);
-        self.bitmaps().2[..words].fill(0);
+        let (_, round_start, blocked) = self.bitmaps();
+        round_start[..words].fill(0);
+        blocked[..words].fill(0);
         match result {
             Err(e) => Err(e),
             Ok(_) if stats.splits != declared => Err(Error::FlagCountMismatch { round: 0 }),

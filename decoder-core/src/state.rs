@@ -52,8 +52,9 @@ pub struct StateMemory<'ws> {
     pub vertex_corner: CornerRefs<'ws>,
     pub deficit: &'ws mut [u8],
     /// Three bitmaps of one bit per vertex, one after the other: the current
-    /// candidates (deficit 0), the vertices flagged in the current round, and
-    /// the candidates whose flag is inferred because a neighbour was flagged.
+    /// candidates (deficit 0), the candidates at the start of the current
+    /// round, and the candidates whose flag is inferred because a neighbour
+    /// was flagged.
     pub candidates: &'ws mut [u64],
 }
 
@@ -150,7 +151,7 @@ impl<'ws> MeshState<'ws> {
         v < self.vertex_count && self.deficit[v as usize] == LEAF
     }
 
-    /// The candidate, flagged and blocked bitmaps (SPEC §7.3).
+    /// The candidate, round-start candidate and blocked bitmaps (SPEC §7.3, §7.4).
     pub(crate) fn bitmaps(&mut self) -> (&mut [u64], &mut [u64], &mut [u64]) {
         let third = self.candidates.len() / 3;
         let (candidates, rest) = self.candidates.split_at_mut(third);

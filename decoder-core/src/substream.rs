@@ -126,6 +126,11 @@ impl<'l, 'b> Substreams<'l, 'b> {
         }
     }
 
+    /// The header of the level these substreams belong to (SPEC §5.1).
+    pub fn level_header(&self) -> &LevelHeader<'l> {
+        &self.header
+    }
+
     fn refill(&mut self, slot: usize) -> Result<(), Error> {
         let r = &mut self.readers[slot];
         if r.next_chunk >= r.end_chunk {

@@ -10,6 +10,7 @@ use crate::header::{Header, PositionMode};
 use crate::layout::Layout;
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, codec, substream};
+use crate::predict::PlanePolicy;
 use crate::rans_writer::{Symbol, encode_chunk};
 
 /// A growing substream: bytes, bits (least significant first) or varints
@@ -134,6 +135,8 @@ impl ChunkCodec {
 pub struct LevelPayload {
     /// Declared split count of each round.
     pub round_splits: Vec<u32>,
+    /// The level's plane policy (SPEC §5.1, §7.4).
+    pub plane: PlanePolicy,
     /// Substreams in id order: ids 1..=7 for rounds (index 0 is id 1), or
     /// ids 8..=10 for a base level given to [`write_stream`].
     pub substreams: Vec<SubstreamWriter>,
@@ -193,6 +196,7 @@ impl SeedPayload {
     pub fn into_level(self, geometric_error: f32) -> LevelPayload {
         LevelPayload {
             round_splits: Vec::new(),
+            plane: PlanePolicy::Off,
             vertex_count: self.vertices,
             triangle_count: self.triangles,
             substreams: self.substreams,
@@ -312,23 +316,7 @@ pub fn frame_level(
         .flat_map(|s| s.substreams.iter().enumerate())
         .map(|(i, s)| (substream::BASE_POSITIONS + i as u8, s));
     for (id, sub) in rounds.chain(base) {
-        let chunks = match params.codec {
-            ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None),
-            ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l)),
-            ChunkCodec::Rans { lanes } => {
-                let rans = rans_chunks(sub.symbols(), limit, id, lanes as usize);
-                let deflate = byte_chunks(sub.as_bytes(), limit, Some(10));
-                let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
-                if size(&rans) < size(&deflate) {
-                    rans
-                } else {
-                    deflate
-                }
-            }
-            ChunkCodec::RansAlways { lanes } => {
-                rans_chunks(sub.symbols(), limit, id, lanes as usize)
-            }
-        };
+        let chunks = substream_chunks(sub, id, limit, params.codec);
         for chunk in chunks {
             let mut entry = [0u8; CHUNK_ENTRY_LEN];
             entry[0] = id;
@@ -344,6 +332,7 @@ pub fn frame_level(
     let mut out = Vec::new();
     out.extend_from_slice(&(level.round_splits.len() as u32).to_le_bytes());
     out.extend_from_slice(&(directory.len() as u32).to_le_bytes());
+    out.extend_from_slice(&[level.plane.to_byte(), 0, 0, 0]);
     if let Some(seed) = seed {
         out.extend_from_slice(&seed.vertices.to_le_bytes());
         out.extend_from_slice(&seed.triangles.to_le_bytes());
@@ -358,6 +347,41 @@ pub fn frame_level(
     out.extend_from_slice(&crc.to_le_bytes());
     out.extend_from_slice(&payload);
     (out, largest)
+}
+
+/// The chunks of substream `id` as `frame_level` codes them.
+fn substream_chunks(
+    sub: &SubstreamWriter,
+    id: u8,
+    limit: usize,
+    chunk_codec: ChunkCodec,
+) -> Vec<Chunk> {
+    match chunk_codec {
+        ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None),
+        ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l)),
+        ChunkCodec::Rans { lanes } => {
+            let rans = rans_chunks(sub.symbols(), limit, id, lanes as usize);
+            let deflate = byte_chunks(sub.as_bytes(), limit, Some(10));
+            let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
+            if size(&rans) < size(&deflate) {
+                rans
+            } else {
+                deflate
+            }
+        }
+        ChunkCodec::RansAlways { lanes } => rans_chunks(sub.symbols(), limit, id, lanes as usize),
+    }
+}
+
+/// Bytes substream `id` takes in a level framed with `params`: its chunk
+/// payloads and directory entries. Lets an encoder compare alternatives
+/// (the plane policies of SPEC §7.4) by their real cost.
+pub fn coded_len(sub: &SubstreamWriter, id: u8, params: &StreamParams) -> usize {
+    let limit = params.chunk_limit.max(1) as usize;
+    substream_chunks(sub, id, limit, params.codec)
+        .iter()
+        .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)
+        .sum()
 }
 
 /// One coded chunk before framing.

@@ -6,7 +6,7 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{Error, PositionMode, context};
+use splitstream_decoder_core::{Error, PlanePolicy, PositionMode, context};
 
 fn params(codec: ChunkCodec) -> StreamParams {
     StreamParams {
@@ -23,36 +23,43 @@ fn base(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> Leve
     SeedPayload::new(positions, triangles, deficits).into_level(1.0)
 }
 
-/// One optimal-mode split record: o, d, deficits, and the residuals of P and C.
+/// One optimal-mode split record as coded (SPEC §7.4), under the plane
+/// policy `off`: the wing ranks `o`, `d` among the `m` ring entries that may
+/// be wings, the split-valence symbols of P and C (0: leaf), and the
+/// residuals of P and C. `valence_c` (C's valence after the split) only
+/// selects a rANS context (SPEC §5.5.5).
 struct Rec {
+    m: usize,
     o: u8,
     d: u8,
-    dp: u8,
-    dc: u8,
+    sp: u8,
+    sc: u8,
+    valence_c: usize,
     e: [i32; 3],
-    m: [i32; 3],
+    t: [i32; 3],
 }
 
 fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> LevelPayload {
-    // Every split here has a ring of 3: the rANS contexts follow (SPEC §5.5).
     let mut s = vec![SubstreamWriter::default(); 7];
     for &f in flags {
         s[0].bit(f);
     }
     for r in recs {
-        s[1].byte(r.o);
-        s[2].byte_in(context::wing_distance(3), r.d);
-        s[3].byte(r.dp);
-        s[4].byte_in(context::deficit_c(r.dp), r.dc);
+        s[1].byte_in(context::wing(r.m), r.o);
+        s[2].byte_in(context::wing(r.m), r.d);
+        s[3].byte(r.sp);
+        let deficit_p = if r.sp == 0 { LEAF } else { 0 };
+        s[4].byte_in(context::deficit_c(deficit_p, r.valence_c), r.sc);
         for k in 0..3 {
-            s[5].signed_in(context::axis(k), r.e[k]);
+            s[5].signed_in(k as u8, r.e[k]);
         }
         for k in 0..3 {
-            s[6].signed_in(context::axis(k), r.m[k]);
+            s[6].signed_in(k as u8, r.t[k]);
         }
     }
     LevelPayload {
         round_splits: rounds,
+        plane: PlanePolicy::Off,
         substreams: s,
         vertex_count: v,
         triangle_count: t,
@@ -70,16 +77,20 @@ fn tetrahedron() -> LevelPayload {
 
 /// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge (0,1,3).
 fn tetra_split() -> Rec {
-    // Predictions (SPEC §7.4): P̂ = mean(R, 1, 3) = (3, 0, 3), so P = (0, 0, 0)
-    // takes e = (-3, 0, -3); Ĉ = mean(R, 3, 2, 1) = (2, 2, 2), refined with
-    // 2R - P = (0, 0, 0) to (1, 1, 1), so C = (2, 2, 2) takes m = (1, 1, 1).
+    // Predictions (SPEC §7.4), relative to R = (0, 0, 0): wing mean
+    // m_W = (5, 0, 5), arc 1 has no interior entry (m_I1 = 0), arc 2 holds
+    // vertex 2 (m_I2 = (0, 10, 0)). P̂ = (m_W + 4 m_I1 - m_I2) >> 4 =
+    // (0, -1, 0), so P = (0, 0, 0) takes e = (0, 1, 0); Ĉ = (m_W + 4 m_I2 -
+    // m_I1) >> 4 = (0, 2, 0), so C = (2, 2, 2) takes t = (2, 0, 2).
     Rec {
+        m: 3,
         o: 0,
         d: 1,
-        dp: LEAF,
-        dc: LEAF,
-        e: [-3, 0, -3],
-        m: [1; 3],
+        sp: 0,
+        sc: 0,
+        valence_c: 4,
+        e: [0, 1, 0],
+        t: [2, 0, 2],
     }
 }
 
@@ -142,14 +153,11 @@ fn boundary_split_with_a_ghost_wing() {
         &[0, LEAF, LEAF],
     );
     let rec = Rec {
-        o: 0,
-        d: 1,
-        dp: LEAF,
-        dc: LEAF,
-        // P̂ = mean(R, 1) = (5, 0, 0); Ĉ = mean(R, 1, 2) = (3, 3, 0), refined
-        // with 2R - P = (0, 0, 0) to (1, 1, 0): P = (0, 0, 0), C = (0, 4, 0).
-        e: [-5, 0, 0],
-        m: [-1, 3, 0],
+        // m_W = (10, 0, 0) (the ghost is no real wing), m_I1 = 0, m_I2 =
+        // (0, 10, 0): P̂ = (0, -1, 0), Ĉ = (0, 2, 0); P = (0, 0, 0), C = (0, 4, 0).
+        e: [0, 1, 0],
+        t: [0, 2, 0],
+        ..tetra_split()
     };
     let stream = write_stream(
         &params(ChunkCodec::Stored),
@@ -170,9 +178,79 @@ fn decode_err(levels: &[LevelPayload]) -> Error {
 #[test]
 fn ring_offset_out_of_range() {
     let mut rec = tetra_split();
-    rec.o = 2; // o + d = 3 = ring length
+    rec.o = 2; // o' + d' = 3 = m
     let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
     assert_eq!(err, Error::RingOffsetOutOfRange);
+    let mut rec = tetra_split();
+    rec.d = 0;
+    let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
+    assert_eq!(err, Error::RingOffsetOutOfRange);
+}
+
+#[test]
+fn a_round_start_candidate_is_no_wing() {
+    // Vertices 0 and 1 are adjacent candidates: 1's flag is inferred once 0
+    // is flagged, and 1 may not be a wing (SPEC §7.4). Vertex 0's ring
+    // (1, 3, 2) has m = 2 entries that may be wings: ranks 0 and 2 name none.
+    let b = base(
+        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
+        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        &[0, 0, LEAF, LEAF],
+    );
+    let rec = Rec {
+        m: 2,
+        d: 2,
+        ..tetra_split()
+    };
+    let err = decode_err(&[b.clone(), level(&[true], vec![1], &[rec], 5, 6)]);
+    assert_eq!(err, Error::RingOffsetOutOfRange);
+    // Ranks 0 and 1 name vertices 3 and 2: P gets the wedge (0, 3, 2).
+    // m_W = (0, 5, 5), m_I2 = (10, 0, 0): P̂ = (-1, 0, 0), Ĉ = (2, 0, 0).
+    let rec = Rec {
+        m: 2,
+        e: [1, 0, 0],
+        ..tetra_split()
+    };
+    let stream = write_stream(
+        &params(ChunkCodec::RansAlways { lanes: 1 }),
+        &[b, level(&[true], vec![1], &[rec], 5, 6)],
+    );
+    let mesh = decode_all(&stream, true).unwrap();
+    assert_eq!(mesh.triangles[4], [0, 4, 3]);
+    assert_eq!(mesh.triangles[5], [4, 0, 2]);
+    assert_eq!(mesh.deficits[1], 0, "vertex 1 is still a candidate");
+}
+
+#[test]
+fn split_valences_out_of_range() {
+    // C's valence after the split is 4: symbol 1 (split valence 3) is below it.
+    let rec = Rec {
+        sc: 1,
+        ..tetra_split()
+    };
+    let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
+    assert_eq!(err, Error::SplitValenceOutOfRange);
+    assert_eq!(err.class(), "valence-overflow");
+    // Symbols 254 and 255 are split valences above 255.
+    for sp in [254, 255] {
+        let rec = Rec {
+            sp,
+            ..tetra_split()
+        };
+        let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
+        assert_eq!(err, Error::SplitValenceOutOfRange);
+    }
+    // Symbol 253 is split valence 255: deficit 252 for P of valence 3.
+    let rec = Rec {
+        sp: 253,
+        ..tetra_split()
+    };
+    let stream = write_stream(
+        &params(ChunkCodec::Stored),
+        &[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)],
+    );
+    let mesh = decode_all(&stream, true).unwrap();
+    assert_eq!(mesh.deficits[0], 252);
 }
 
 #[test]
@@ -216,10 +294,16 @@ fn inferred_flag_leaves_the_neighbour_a_candidate() {
         &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
         &[0, LEAF, 0, LEAF],
     );
+    // Vertex 2 was a candidate at round start: it may not be a wing, so
+    // m = 2 (it still counts in the arc means).
+    let rec = || Rec {
+        m: 2,
+        ..tetra_split()
+    };
     for codec in [ChunkCodec::Stored, ChunkCodec::RansAlways { lanes: 2 }] {
         let stream = write_stream(
             &params(codec),
-            &[b.clone(), level(&[true], vec![1], &[tetra_split()], 5, 6)],
+            &[b.clone(), level(&[true], vec![1], &[rec()], 5, 6)],
         );
         let mesh = decode_all(&stream, true).unwrap();
         assert_eq!(mesh.positions.len(), 5);
@@ -227,15 +311,47 @@ fn inferred_flag_leaves_the_neighbour_a_candidate() {
     }
 }
 
+/// The octahedron: 0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z.
+fn octahedron(deficits: &[u8]) -> LevelPayload {
+    base(
+        &[
+            [20, 10, 10],
+            [0, 10, 10],
+            [10, 20, 10],
+            [10, 0, 10],
+            [10, 10, 20],
+            [10, 10, 0],
+        ],
+        &[
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ],
+        deficits,
+    )
+}
+
 #[test]
 fn valence_overflow_on_a_wing() {
-    // Vertex 1 is a pending candidate that is not split but is a wing.
-    let b = base(
-        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
-        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        &[0, 0, LEAF, LEAF],
-    );
-    let err = decode_err(&[b, level(&[true], vec![1], &[tetra_split()], 5, 6)]);
+    // Vertices 0 and 1 are candidates that are not adjacent; vertex 2 (deficit
+    // 1) is next to both. Both split in one round with 2 as a wing: after the
+    // first split its deficit is 0, so the second split would take it past
+    // its split valence. Both rings are (2, 4, 3, 5) in some rotation, every
+    // entry eligible (m = 4): ranks (0, 1) name 2 and its successor.
+    let b = octahedron(&[0, 0, 1, LEAF, LEAF, LEAF]);
+    let rec = |valence_c| Rec {
+        m: 4,
+        valence_c,
+        e: [0; 3],
+        t: [0; 3],
+        ..tetra_split()
+    };
+    let err = decode_err(&[b, level(&[true, true], vec![2], &[rec(5), rec(5)], 8, 12)]);
     assert_eq!(err, Error::ValenceOverflow);
 }
 

@@ -55,6 +55,7 @@ fn huge_stream() -> Vec<u8> {
     }
     let base = LevelPayload {
         round_splits: vec![],
+        plane: Default::default(),
         substreams: base,
         vertex_count: 4,
         triangle_count: 4,
@@ -64,6 +65,7 @@ fn huge_stream() -> Vec<u8> {
     flags.bit(true);
     let level = LevelPayload {
         round_splits: vec![1],
+        plane: Default::default(),
         substreams: vec![flags],
         vertex_count: V,
         triangle_count: T,

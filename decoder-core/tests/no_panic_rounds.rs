@@ -46,20 +46,22 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
     let nv = w * w;
     let base = LevelPayload {
         round_splits: vec![],
+        plane: Default::default(),
         substreams: subs,
         vertex_count: nv,
         triangle_count: nt,
         geometric_error: 1.0,
     };
     // Each round: the centre is the only candidate; it splits with wings
-    // r_0, r_1, keeps one wedge (valence 3) and deficit 0; C is a leaf.
+    // r_0, r_1 (every ring entry is a leaf, so ranks are ring positions),
+    // keeps one wedge (valence 3) and deficit 0; C is a leaf.
     let mut s = vec![SubstreamWriter::default(); 7];
     for _ in 0..rounds {
         s[0].bit(true);
         s[1].byte(0);
         s[2].byte(1);
-        s[3].byte(0);
-        s[4].byte(LEAF);
+        s[3].byte(1); // split valence 3: deficit 0 at valence 3 (SPEC §7.4)
+        s[4].byte(0); // a leaf
         for _ in 0..3 {
             s[5].signed(0);
         }
@@ -69,6 +71,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
     }
     let level = LevelPayload {
         round_splits: vec![1; rounds as usize],
+        plane: Default::default(),
         substreams: s,
         vertex_count: nv + rounds,
         triangle_count: nt + 2 * rounds,

@@ -18,12 +18,12 @@ mod streams;
 
 use mesh_check::check_oriented_manifold;
 use proptest::prelude::*;
-use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
+use splitstream_decoder_core::{PlanePolicy, PositionMode};
 use streams::{Choices, bases};
 
 fn base_euler(base: &str) -> i64 {
@@ -75,6 +75,7 @@ proptest! {
         subs in proptest::collection::vec(proptest::collection::vec(any::<u8>(), 0..24), 8),
         constrained in any::<bool>(),
         extra_triangles in 0u32..8,
+        plane in 0u8..5,
     ) {
         let b = &bases()[base];
         let nv = b.positions.len();
@@ -82,6 +83,7 @@ proptest! {
         let splits: u32 = rounds.iter().sum();
         let level = LevelPayload {
             round_splits: rounds,
+            plane: PlanePolicy::from_byte(plane).unwrap(),
             substreams: subs
                 .iter()
                 .map(|s| {

@@ -5,7 +5,7 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{Fnv1a, PositionMode, crc32};
+use splitstream_decoder_core::{Fnv1a, PlanePolicy, PositionMode, crc32};
 
 fn params() -> StreamParams {
     StreamParams {
@@ -40,6 +40,7 @@ fn tetra_stream() -> Vec<u8> {
     }
     let base = LevelPayload {
         round_splits: vec![],
+        plane: PlanePolicy::Off,
         substreams: b,
         vertex_count: 4,
         triangle_count: 4,
@@ -47,18 +48,20 @@ fn tetra_stream() -> Vec<u8> {
     };
     let mut s = vec![SubstreamWriter::default(); 7];
     s[0].bit(true); // flags
-    s[1].byte(0); // o
-    s[2].byte(1); // d
-    s[3].byte(LEAF); // deficit P
-    s[4].byte(LEAF); // deficit C
-    for x in [-3, 0, -3] {
-        s[5].signed(x); // residual of P against P̂ = (3, 0, 3)
+    s[1].byte(0); // o' = 0
+    s[2].byte(1); // d' = 1
+    s[3].byte(0); // P is a leaf
+    s[4].byte(0); // C is a leaf
+    // The dominant axis is x (n = (-100, 0, -100)): y, z, then x.
+    for x in [1, 0, 0] {
+        s[5].signed(x); // s' for P̂ = (0, -1, 0): P = (0, 0, 0)
     }
-    for _ in 0..3 {
-        s[6].signed(1); // residual of C against Ĉ = (1, 1, 1)
+    for x in [0, 2, 4] {
+        s[6].signed(x); // t' for Ĉ = (0, 2, 0): C = (2, 2, 2)
     }
     let l1 = LevelPayload {
         round_splits: vec![1],
+        plane: PlanePolicy::Dominant,
         substreams: s,
         vertex_count: 5,
         triangle_count: 6,
@@ -84,7 +87,15 @@ const SPEC: &str = include_str!("../SPEC.md");
 #[test]
 fn appendix_a_tetrahedron() {
     let stream = tetra_stream();
-    assert_eq!(stream.len(), 463);
+    assert_eq!(stream.len(), 471);
+    if std::env::var("DUMP").is_ok() {
+        let mesh = decode_all(&stream, true).unwrap();
+        println!(
+            "{:?} {:x?} {:?}",
+            mesh.positions, mesh.round_hashes, mesh.triangles
+        );
+        println!("{}", hex(&stream));
+    }
     // The complete hex dump of Appendix A is the stream, byte for byte.
     assert!(
         SPEC.contains(&hex(&stream)),
@@ -110,7 +121,11 @@ fn appendix_a_tetrahedron() {
             [4, 0, 3]
         ]
     );
+    assert_eq!(mesh.positions[0], [0, 0, 0]);
     assert_eq!(mesh.positions[4], [2, 2, 2]);
+    // The level headers of Appendix A: level 0's plane policy 0, level 1's 1.
+    assert_eq!(&stream[0xac..0xb0], &[0, 0, 0, 0]);
+    assert_eq!(&stream[0x150..0x154], &[1, 0, 0, 0]);
     // §9: workspace_bytes of the example.
     assert_eq!(
         u64::from_le_bytes(stream[80..88].try_into().unwrap()),
@@ -136,7 +151,7 @@ fn section_2_and_8_constants() {
 #[test]
 fn section_10_3_minor_versions_and_trailing_bytes() {
     let stream = tetra_stream();
-    // Any minor version of major 2 decodes as 2.0 (§1).
+    // Any minor version of major 3 decodes as 3.0 (§1).
     let mut m = stream.clone();
     m[9] = 7;
     let crc = crc32(&m[..92]);
@@ -159,7 +174,7 @@ fn section_10_3_minor_versions_and_trailing_bytes() {
         "truncated"
     );
     let mut v2 = stream[..10].to_vec();
-    v2[8] = 3;
+    v2[8] = 2;
     assert_eq!(
         decode_all(&v2, false).unwrap_err().class(),
         "unsupported-version"
@@ -502,6 +517,7 @@ fn section_5_4_varints() {
         }
         let base = LevelPayload {
             round_splits: vec![],
+            plane: PlanePolicy::Off,
             substreams: b,
             vertex_count: 3,
             triangle_count: 1,
@@ -529,4 +545,52 @@ fn section_5_4_varints() {
         decode_base_triangle(&[0x80, 0x80, 0x80, 0x80, 0x80, 0x00, 1, 2]),
         Err("malformed")
     );
+}
+
+/// The intermediate numbers of Appendix A's record (§7.4), from the public
+/// prediction functions.
+#[test]
+fn appendix_a_predictions() {
+    use splitstream_decoder_core::{
+        ArcMeans, Plane, PlanePolicy, Target, arc_means, predict, predict::normal,
+    };
+    let layout = Layout::new(5, 6, 4, 4, 4);
+    let mut words = vec![0u64; layout.total as usize / 8 + 1];
+    let buf: &mut [u8] = bytemuck::cast_slice_mut(&mut words);
+    let (memory, _slots) = layout.carve(buf).unwrap();
+    let mut state = MeshState::new(memory, 8);
+    {
+        let (p, c, d) = state.base_arrays();
+        p[..4].copy_from_slice(&[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]]);
+        c[..12].copy_from_slice(&[0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3]);
+        d[..4].copy_from_slice(&[0, LEAF, LEAF, LEAF]);
+    }
+    state.finish_base(4, 4).unwrap();
+    let mut ring = Ring::default();
+    state.ring(0, &mut ring).unwrap();
+    assert_eq!(ring.vertices(), &[1, 3, 2]);
+    let eligible = state.wing_candidates(&ring);
+    assert_eq!(eligible.count(), 3);
+    assert_eq!(eligible.wings(0, 1), Ok((0, 1)));
+    let m = arc_means(state.positions(), [0, 0, 0], &ring, 0, 1);
+    assert_eq!(
+        m,
+        ArcMeans {
+            wings: [5, 0, 5],
+            arc_1: [0, 0, 0],
+            arc_2: [0, 10, 0],
+            sum: [10, 10, 10],
+            count: 3,
+            wing_edge: Some([-10, 0, 10]),
+        }
+    );
+    assert_eq!(predict(&m, PositionMode::Optimal, Target::P), [0, -1, 0]);
+    assert_eq!(predict(&m, PositionMode::Optimal, Target::C), [0, 2, 0]);
+    assert_eq!(normal(&m), [-100, 0, -100]);
+    let plane = Plane::new(PlanePolicy::Dominant, &m);
+    assert_eq!(plane.axis, Some(0));
+    assert_eq!(plane.order(), [1, 2, 0]);
+    assert_eq!(plane.order().map(|a| plane.context(a)), [0, 0, 1]);
+    assert_eq!(plane.decode([0, 1, 0]), [0, 1, 0]);
+    assert_eq!(plane.decode([4, 0, 2]), [2, 0, 2]);
 }

@@ -1,9 +1,14 @@
 //! Quantization of f64 positions onto the stream's integer grid (SPEC §3.2).
 //!
-//! Each axis gets its own step over its own extent, so a terrain's heights
-//! get the full precision and geographic longitudes and latitudes survive in
-//! their own units. The simplifier measures errors in metric space through
-//! separate per-axis factors ([`QuantizedMesh::metric`]), not in grid units.
+//! By default each axis gets its own step over its own extent, so a
+//! terrain's heights get the full precision and geographic longitudes and
+//! latitudes survive in their own units. [`Quantization::Uniform`] uses one
+//! step (in metres for geographic input) for all axes, the largest extent
+//! over the grid, as Draco quantizes at the same bit count: for terrain that
+//! quantizes heights as coarsely as the kilometres of x and y, but it is the
+//! fair setting for size comparisons with such codecs. The simplifier
+//! measures errors in metric space through separate per-axis factors
+//! ([`QuantizedMesh::metric`]), not in grid units.
 
 use crate::mesh::Mesh;
 
@@ -60,14 +65,41 @@ impl Units {
     }
 }
 
-/// Quantizes `mesh` to `bits` (1..=31) per axis over its bounding box.
+/// How the quantization step is chosen per axis.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Quantization {
+    /// Each axis over its own extent (the default).
+    #[default]
+    PerAxis,
+    /// One step for all axes: the largest extent (in metres for
+    /// geographic input) over the grid.
+    Uniform,
+}
+
+/// Quantizes `mesh` to `bits` (1..=31) per axis over its bounding box, each
+/// axis with its own step.
 pub fn quantize(mesh: &Mesh, bits: u8, units: Units) -> QuantizedMesh {
+    quantize_with(mesh, bits, units, Quantization::PerAxis)
+}
+
+/// Quantizes `mesh` to `bits` (1..=31) per axis with the steps `how` says.
+pub fn quantize_with(mesh: &Mesh, bits: u8, units: Units, how: Quantization) -> QuantizedMesh {
     let (lo, hi) = mesh.bounding_box().unwrap_or(([0.0; 3], [0.0; 3]));
     let top = ((1u64 << bits) - 1) as f64;
-    let scale: [f64; 3] = std::array::from_fn(|k| {
-        let extent = hi[k] - lo[k];
-        if extent > 0.0 { extent / top } else { 1.0 }
-    });
+    let metres = units.metres_per_unit(lo, hi);
+    let scale: [f64; 3] = match how {
+        Quantization::PerAxis => std::array::from_fn(|k| {
+            let extent = hi[k] - lo[k];
+            if extent > 0.0 { extent / top } else { 1.0 }
+        }),
+        Quantization::Uniform => {
+            let largest = (0..3)
+                .map(|k| (hi[k] - lo[k]) * metres[k])
+                .fold(0.0f64, f64::max);
+            let step = if largest > 0.0 { largest / top } else { 1.0 };
+            std::array::from_fn(|k| step / metres[k])
+        }
+    };
     let positions = mesh
         .positions
         .iter()
@@ -75,7 +107,6 @@ pub fn quantize(mesh: &Mesh, bits: u8, units: Units) -> QuantizedMesh {
             std::array::from_fn(|k| ((p[k] - lo[k]) / scale[k]).round().clamp(0.0, top) as u32)
         })
         .collect();
-    let metres = units.metres_per_unit(lo, hi);
     QuantizedMesh {
         positions,
         triangles: mesh.triangles.clone(),
@@ -83,5 +114,53 @@ pub fn quantize(mesh: &Mesh, bits: u8, units: Units) -> QuantizedMesh {
         origin: lo,
         scale,
         metric: std::array::from_fn(|k| scale[k] * metres[k]),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn slab() -> Mesh {
+        Mesh {
+            positions: vec![[0.0, 0.0, 0.0], [1000.0, 0.0, 0.0], [0.0, 500.0, 10.0]],
+            triangles: vec![[0, 1, 2]],
+        }
+    }
+
+    #[test]
+    fn per_axis_uses_each_extent() {
+        let q = quantize(&slab(), 10, Units::Linear);
+        assert_eq!(q.positions[1], [1023, 0, 0]);
+        assert_eq!(q.positions[2], [0, 1023, 1023]);
+    }
+
+    #[test]
+    fn uniform_uses_one_step() {
+        let q = quantize_with(&slab(), 10, Units::Linear, Quantization::Uniform);
+        assert_eq!(q.scale, [1000.0 / 1023.0; 3]);
+        assert_eq!(q.positions[1], [1023, 0, 0]);
+        assert_eq!(q.positions[2], [0, 512, 10]);
+        // Geographic: one step in metres, so degrees get a finer step.
+        let geo = Mesh {
+            positions: vec![[10.0, 50.0, 0.0], [10.01, 50.0, 100.0], [10.0, 50.01, 0.0]],
+            triangles: vec![[0, 1, 2]],
+        };
+        let q = quantize_with(&geo, 12, Units::Geographic, Quantization::Uniform);
+        let metric: Vec<f64> = q.metric.to_vec();
+        assert!(
+            metric
+                .iter()
+                .all(|m| (m - metric[0]).abs() < 1e-9 * metric[0])
+        );
+        // The largest extent is y's 0.01 degree (about 1106 m): 100 m of z
+        // are about 370 steps of 0.27 m, where per-axis steps give z 4095.
+        assert!(
+            (365..=375).contains(&q.positions[1][2]),
+            "{:?}",
+            q.positions
+        );
+        let per_axis = quantize(&geo, 12, Units::Geographic);
+        assert_eq!(per_axis.positions[1][2], 4095);
     }
 }

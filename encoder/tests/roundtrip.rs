@@ -6,8 +6,9 @@ mod roundtrip_check;
 
 use roundtrip_check::assert_roundtrip;
 
-use splitstream_decoder_core::PositionMode;
+use splitstream_decoder_core::{PlanePolicy, PositionMode};
 use splitstream_encoder::emit::EncodeOptions;
+use splitstream_encoder::quantize::{Quantization, Units};
 
 #[test]
 fn closed_sphere_roundtrips() {
@@ -46,4 +47,42 @@ fn locked_boundary_and_one_level() {
         ..EncodeOptions::default()
     };
     assert_roundtrip(&mesh, &options);
+}
+
+#[test]
+fn uniform_quantization_roundtrips() {
+    // One step for all axes; the stream's per-axis origin and scale say so.
+    for units in [Units::Linear, Units::Geographic] {
+        let options = EncodeOptions {
+            quantization: Quantization::Uniform,
+            units,
+            ..EncodeOptions::default()
+        };
+        assert_roundtrip(&common::bumpy_grid(19, 13, 2), &options);
+    }
+}
+
+#[test]
+fn every_plane_policy_roundtrips_at_31_bits() {
+    for (i, plane) in PlanePolicy::ALL.into_iter().enumerate() {
+        let options = EncodeOptions {
+            bits: if i % 2 == 0 { 31 } else { 14 },
+            plane: Some(plane),
+            position_mode: if i % 2 == 0 {
+                PositionMode::Constrained
+            } else {
+                PositionMode::Optimal
+            },
+            ..EncodeOptions::default()
+        };
+        assert_roundtrip(&common::icosphere(2), &options);
+    }
+    for mode in [PositionMode::Constrained, PositionMode::Optimal] {
+        let options = EncodeOptions {
+            bits: 31,
+            position_mode: mode,
+            ..EncodeOptions::default()
+        };
+        assert_roundtrip(&common::bumpy_grid(21, 17, 1), &options);
+    }
 }

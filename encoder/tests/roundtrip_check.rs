@@ -4,7 +4,7 @@
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
-use splitstream_encoder::quantize::quantize;
+use splitstream_encoder::quantize::quantize_with;
 
 fn canonical(t: [u32; 3]) -> [u32; 3] {
     let r = (0..3).min_by_key(|&i| t[i]).unwrap();
@@ -15,7 +15,7 @@ fn canonical(t: [u32; 3]) -> [u32; 3] {
 pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {
     let encoded = encode(mesh, options, |_| {}).expect("encode");
     let decoded = decode_all(&encoded.stream, false).expect("decode");
-    let q = quantize(mesh, options.bits, options.units);
+    let q = quantize_with(mesh, options.bits, options.units, options.quantization);
     assert_eq!(decoded.positions.len(), mesh.positions.len());
     for (d, &e) in encoded.permutation.iter().enumerate() {
         assert_eq!(decoded.positions[d], q.positions[e as usize], "vertex {e}");

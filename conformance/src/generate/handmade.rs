@@ -7,7 +7,7 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{PositionMode, context};
+use splitstream_decoder_core::{PlanePolicy, PositionMode, context};
 
 /// 8 bits per axis, unit scale, 4-byte chunks: every substream spans chunks.
 pub fn params(codec: ChunkCodec) -> StreamParams {
@@ -37,28 +37,34 @@ pub fn with_raw_substream(mut level: LevelPayload, index: usize, bytes: &[u8]) -
     level
 }
 
-/// One optimal-mode split record: o, d, deficits, and the two position
-/// residuals as coded: `e` in the edge substream (P minus its prediction)
-/// and `m` in the placement substream (C minus its prediction), SPEC §7.4.
-/// `k` is the split vertex's ring length, which only selects the rANS
-/// context of `d` (SPEC §5.5). Records built here start with zero
-/// residuals; [`solve`] sets them for wanted positions of P and C.
+/// One optimal-mode split record as coded (SPEC §7.4): the wing ranks `o`
+/// and `d` among the `m` ring entries that may be wings, the split-valence
+/// symbols `sp` and `sc` of P and C (0: a leaf), and the two position
+/// residual vectors per axis: `e` in the edge substream (P's) and `t` in the
+/// placement substream (C's). `valence_c` (C's valence right after the
+/// split) and `axis` (the plane's predicted axis, `None` under the policy
+/// `off`) only select the order and rANS contexts of the values (SPEC
+/// §5.5.5). Records built here start with zero residuals; [`solve`] sets
+/// them for wanted positions of P and C.
 #[derive(Clone, Copy)]
 pub struct Rec {
-    pub k: u8,
+    pub m: u8,
     pub o: u8,
     pub d: u8,
-    pub dp: u8,
-    pub dc: u8,
+    pub sp: u8,
+    pub sc: u8,
+    pub valence_c: u8,
+    pub axis: Option<usize>,
     pub e: [i32; 3],
-    pub m: [i32; 3],
+    pub t: [i32; 3],
 }
 
 /// Sets the residuals of `rec` so that its split (of vertex `r`, creating
 /// vertex `c`) places P at `p` and C at `cpos`: the stream `build` makes is
-/// first decoded with zero residuals, which yields P's prediction; then with
-/// P's residual set, which yields C's (it may depend on P), whatever
-/// predictor SPEC §7.4 uses, as long as residuals are added to it.
+/// decoded with trial residuals and corrected by what each axis missed,
+/// until both land (at most four probes: under a plane policy the predicted
+/// axis also moves with the other two, SPEC §7.4), whatever the
+/// prediction, as long as the residuals are added to it.
 pub fn solve(
     rec: Rec,
     r: usize,
@@ -67,63 +73,79 @@ pub fn solve(
     cpos: [i32; 3],
     build: &dyn Fn(Rec) -> Vec<u8>,
 ) -> Rec {
-    // C's probe residual is biased so that C stays inside the 8-bit grid
-    // whatever P is during the probes.
+    // The first probe is biased so that P and C stay inside the 8-bit grid
+    // whatever the predictions are.
     const BIAS: i32 = 64;
-    let zero = Rec {
-        e: [0; 3],
-        m: [BIAS; 3],
+    let mut trial = Rec {
+        e: [BIAS; 3],
+        t: [BIAS; 3],
         ..rec
     };
-    let probe = decode_all(&build(zero), false).expect("the zero-residual probe decodes");
-    let ph = probe.positions[r];
-    let half = Rec {
-        e: std::array::from_fn(|k| p[k] - ph[k] as i32),
-        ..zero
-    };
-    let probe = decode_all(&build(half), false).expect("the P-residual probe decodes");
-    let ch = probe.positions[c];
-    let solved = Rec {
-        m: std::array::from_fn(|k| cpos[k] - (ch[k] as i32 - BIAS)),
-        ..half
-    };
-    if let Ok(mesh) = decode_all(&build(solved), false) {
-        let want = (p.map(|x| x as u32), cpos.map(|x| x as u32));
-        assert_eq!(
-            (mesh.positions[r], mesh.positions[c]),
-            want,
-            "residuals do not add to the prediction (SPEC §7.4 changed?)"
-        );
+    for probe_index in 0..4 {
+        let probe = match decode_all(&build(trial), false) {
+            Ok(probe) => probe,
+            // A wanted position outside the grid: the correction stands.
+            Err(_) if probe_index > 0 => return trial,
+            Err(e) => panic!("the first probe does not decode: {e}"),
+        };
+        let (gp, gc) = (probe.positions[r], probe.positions[c]);
+        if (gp, gc) == (p.map(|x| x as u32), cpos.map(|x| x as u32)) {
+            return trial;
+        }
+        for k in 0..3 {
+            trial.e[k] += p[k] - gp[k] as i32;
+            trial.t[k] += cpos[k] - gc[k] as i32;
+        }
     }
-    solved
+    // A wanted position outside the grid: the last correction stands.
+    trial
 }
 
-/// A refinement level (ids 1..=7) in optimal mode, values in the contexts
-/// SPEC §5.5 gives them.
-pub fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> LevelPayload {
+/// A refinement level (ids 1..=7) in optimal mode under `plane`, values in
+/// the order and contexts SPEC §5.5 and §7.4 give them.
+pub fn level_with(
+    plane: PlanePolicy,
+    flags: &[bool],
+    rounds: Vec<u32>,
+    recs: &[Rec],
+    v: u32,
+    t: u32,
+) -> LevelPayload {
     let mut s = vec![SubstreamWriter::default(); 7];
     for &f in flags {
         s[0].bit(f);
     }
     for r in recs {
-        s[1].byte(r.o);
-        s[2].byte_in(context::wing_distance(r.k as usize), r.d);
-        s[3].byte(r.dp);
-        s[4].byte_in(context::deficit_c(r.dp), r.dc);
-        for k in 0..3 {
-            s[5].signed_in(context::axis(k), r.e[k]);
+        let wing = context::wing(r.m as usize);
+        s[1].byte_in(wing, r.o);
+        s[2].byte_in(wing, r.d);
+        s[3].byte(r.sp);
+        let deficit_p = if r.sp == 0 { LEAF } else { 0 };
+        s[4].byte_in(context::deficit_c(deficit_p, r.valence_c as usize), r.sc);
+        let order = match r.axis {
+            None => [0, 1, 2],
+            Some(j) => [(j + 1) % 3, (j + 2) % 3, j],
+        };
+        for k in order {
+            s[5].signed_in(context::residual(plane, k, r.axis), r.e[k]);
         }
-        for k in 0..3 {
-            s[6].signed_in(context::axis(k), r.m[k]);
+        for k in order {
+            s[6].signed_in(context::residual(plane, k, r.axis), r.t[k]);
         }
     }
     LevelPayload {
         round_splits: rounds,
+        plane,
         substreams: s,
         vertex_count: v,
         triangle_count: t,
         geometric_error: 0.0,
     }
+}
+
+/// [`level_with`] under the plane policy `off`.
+pub fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> LevelPayload {
+    level_with(PlanePolicy::Off, flags, rounds, recs, v, t)
 }
 
 pub const TETRA_POSITIONS: [[u32; 3]; 4] = [[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]];
@@ -144,31 +166,66 @@ pub fn tetrahedron_two_candidates() -> LevelPayload {
     base(&TETRA_POSITIONS, &TETRA_TRIANGLES, &[0, 0, LEAF, LEAF])
 }
 
-/// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge
-/// (0,1,3); P at its prediction (3, 0, 3), C at its prediction (-1, -1, -1)
-/// plus (2, 2, 2), inside the grid.
+/// Splits vertex 0 (ring 1, 3, 2, every entry a leaf: m = 3) with wings 1
+/// and 3, P keeping wedge (0,1,3); both halves leaves.
 pub fn tetra_split() -> Rec {
     Rec {
-        k: 3,
+        m: 3,
         o: 0,
         d: 1,
-        dp: LEAF,
-        dc: LEAF,
+        sp: 0,
+        sc: 0,
+        valence_c: 4,
+        axis: None,
         e: [0; 3],
-        m: [2; 3],
+        t: [0; 3],
     }
 }
 
 /// The one-split tetrahedron of SPEC Appendix A (5 vertices, 6 triangles):
-/// P = (0,0,0), C = (2,2,2).
+/// plane policy `dominant` (the predicted axis is x), P = (0,0,0),
+/// C = (2,2,2).
 pub fn tetra_stream(codec: ChunkCodec) -> Vec<u8> {
     let build = |rec: Rec| {
         write_stream(
             &params(codec),
-            &[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)],
+            &[
+                tetrahedron(),
+                level_with(PlanePolicy::Dominant, &[true], vec![1], &[rec], 5, 6),
+            ],
         )
     };
-    build(solve(tetra_split(), 0, 4, [0, 0, 0], [2, 2, 2], &build))
+    let rec = Rec {
+        axis: Some(0),
+        ..tetra_split()
+    };
+    build(solve(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build))
+}
+
+/// The octahedron (0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z) with
+/// `deficits`.
+pub fn octahedron(deficits: &[u8]) -> LevelPayload {
+    base(
+        &[
+            [20, 10, 10],
+            [0, 10, 10],
+            [10, 20, 10],
+            [10, 0, 10],
+            [10, 10, 20],
+            [10, 10, 0],
+        ],
+        &[
+            [0, 2, 4],
+            [2, 1, 4],
+            [1, 3, 4],
+            [3, 0, 4],
+            [2, 0, 5],
+            [1, 2, 5],
+            [3, 1, 5],
+            [0, 3, 5],
+        ],
+        deficits,
+    )
 }
 
 /// One triangle; vertex 0 (ring: ghost, 1, 2) splits with the ghost as a

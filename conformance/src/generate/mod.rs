@@ -12,7 +12,9 @@ use std::path::Path;
 use splitstream_decoder_core::limits::codec;
 use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
 use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
-use splitstream_decoder_core::{Fnv1a, Header, LevelHeader, LevelTable, PositionMode, head_len};
+use splitstream_decoder_core::{
+    Fnv1a, Header, LevelHeader, LevelTable, PlanePolicy, PositionMode, head_len,
+};
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
 
@@ -526,6 +528,110 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
         &["minimal", "handmade", "one-split", "rans"],
         handmade::tetra_stream(ChunkCodec::RansAlways { lanes: 1 }),
     );
+    // Every plane policy byte (SPEC §5.1, §7.4), forced for every level.
+    for (i, policy) in PlanePolicy::ALL.into_iter().enumerate() {
+        let (mode, what) = if i % 2 == 0 {
+            (PositionMode::Constrained, "constrained")
+        } else {
+            (PositionMode::Optimal, "optimal")
+        };
+        for (mesh, name) in [(&sphere2, "icosphere"), (&small_holed, "grid-hole")] {
+            s.valid(
+                &format!("plane-{}-{name}", policy.name()),
+                &format!(
+                    "{name} ({what} positions, stored chunks) with plane policy `{}` (byte {}) in every level.",
+                    policy.name(),
+                    policy.to_byte()
+                ),
+                &["encoded", "plane-policy"],
+                encoded(
+                    mesh,
+                    EncodeOptions {
+                        position_mode: mode,
+                        codec: ChunkCodec::Stored,
+                        plane: Some(policy),
+                        ..opts()
+                    },
+                ),
+            );
+        }
+    }
+    // 31 bits per axis: the arithmetic of SPEC §7.4 at its widest (the
+    // seed's rounds span the whole grid).
+    for (mode, what) in [
+        (PositionMode::Optimal, "optimal"),
+        (PositionMode::Constrained, "constrained"),
+    ] {
+        for (mesh, name) in [(&sphere3, "icosphere"), (&terrain, "terrain")] {
+            s.valid(
+                &format!("bits-31-{name}-{what}"),
+                &format!(
+                    "{name}, {what} positions, 31 bits per axis (the largest grid), rANS, plane policy chosen per level."
+                ),
+                &["encoded", "bits-31", "rans"],
+                encoded(
+                    mesh,
+                    EncodeOptions {
+                        position_mode: mode,
+                        bits: 31,
+                        codec: ChunkCodec::RansAlways { lanes: 2 },
+                        ..opts()
+                    },
+                ),
+            );
+        }
+        s.valid(
+            &format!("bits-31-icosphere-{what}-x"),
+            &format!(
+                "Icosphere (162 vertices), {what} positions, 31 bits per axis, plane policy `x` in every level: residuals and plane offsets wrap modulo 2^32 (SPEC §7.4)."
+            ),
+            &["encoded", "bits-31", "plane-policy", "wrapped-residuals"],
+            encoded(
+                &sphere2,
+                EncodeOptions {
+                    position_mode: mode,
+                    bits: 31,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Axis(0)),
+                    ..opts()
+                },
+            ),
+        );
+        s.valid(
+            &format!("bits-31-icosphere-{what}-off"),
+            &format!(
+                "Icosphere (162 vertices), {what} positions, 31 bits per axis, plane policy `off` (no plane offsets: the residuals are read x, y, z)."
+            ),
+            &["encoded", "bits-31", "plane-policy"],
+            encoded(
+                &sphere2,
+                EncodeOptions {
+                    position_mode: mode,
+                    bits: 31,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Off),
+                    ..opts()
+                },
+            ),
+        );
+        s.valid(
+            &format!("bits-31-grid-hole-{what}-dominant"),
+            &format!(
+                "Small height field with a hole, {what} positions, 31 bits per axis, plane policy `dominant` in every level."
+            ),
+            &["encoded", "bits-31", "plane-policy"],
+            encoded(
+                &small_holed,
+                EncodeOptions {
+                    position_mode: mode,
+                    bits: 31,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Dominant),
+                    ..opts()
+                },
+            ),
+        );
+    }
     let bunny = meshes::real(real_data, "bunny.ply")?;
     s.valid(
         "bunny-npm",
@@ -643,18 +749,18 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "unsupported-version",
         "unsupported-version",
-        "Major version 3 (header CRC recomputed).",
+        "Major version 2, the previous format (header CRC recomputed).",
         &["header", "versioning"],
         {
             let mut b = subject.clone();
-            b[8] = 3;
+            b[8] = 2;
             fix_header_crc(&mut b);
             b
         },
     );
     s.valid(
         "minor-version-1",
-        "Minor version 1 of major 2 with every reserved field zero: decodes exactly as 2.0 (header CRC recomputed).",
+        "Minor version 1 of major 3 with every reserved field zero: decodes exactly as 3.0 (header CRC recomputed).",
         &["header", "versioning"],
         {
             let mut b = handmade::tetra_stream(ChunkCodec::Stored);
@@ -787,6 +893,42 @@ fn invalid_vectors(s: &mut Specs) {
         },
     );
     s.invalid(
+        "plane-policy-reserved",
+        "malformed",
+        "Level 1's plane policy byte (level header byte 8) set to 5, a reserved value (level header CRC recomputed).",
+        &["reserved", "plane-policy"],
+        {
+            let mut b = subject.clone();
+            b[plane_policy_at(&subject, 1)] = 5;
+            fix_level_header_crc(&mut b, 1);
+            b
+        },
+    );
+    s.invalid(
+        "plane-policy-255",
+        "malformed",
+        "Level 0's plane policy byte set to 255 (level header CRC recomputed).",
+        &["reserved", "plane-policy"],
+        {
+            let mut b = subject.clone();
+            b[plane_policy_at(&subject, 0)] = 255;
+            fix_level_header_crc(&mut b, 0);
+            b
+        },
+    );
+    s.invalid(
+        "reserved-level-header",
+        "malformed",
+        "Level 1's reserved level header byte 9 (after the plane policy) not zero (level header CRC recomputed).",
+        &["reserved", "plane-policy"],
+        {
+            let mut b = subject.clone();
+            b[plane_policy_at(&subject, 1) + 1] = 1;
+            fix_level_header_crc(&mut b, 1);
+            b
+        },
+    );
+    s.invalid(
         "unknown-codec",
         "malformed",
         "Codec id 3 (reserved) on a stored chunk of level 1 (level header CRC recomputed).",
@@ -914,12 +1056,61 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "ring-offset-handmade",
         "ring-offset-out-of-range",
-        "Tetrahedron split with o = 2, d = 1 on a ring of 3 (o + d = k).",
+        "Tetrahedron split with wing ranks o' = 2, d' = 1 among m = 3 eligible ring entries (o' + d' = m).",
         &["handmade", "ring-offset"],
         {
             let mut rec = tetra_split();
             rec.o = 2;
             hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+        },
+    );
+    s.invalid(
+        "ring-offset-distance-0",
+        "ring-offset-out-of-range",
+        "Tetrahedron split with wing rank distance d' = 0.",
+        &["handmade", "ring-offset"],
+        {
+            let mut rec = tetra_split();
+            rec.d = 0;
+            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+        },
+    );
+    s.invalid(
+        "wing-rank-skips-round-start-candidate",
+        "ring-offset-out-of-range",
+        "Tetrahedron with adjacent candidates 0 and 1: vertex 1 was a candidate at the start of the round, so it may not be a wing and vertex 0's ring (1, 3, 2) has m = 2 eligible entries; ranks o' = 0, d' = 2 name none (SPEC §7.4).",
+        &["handmade", "ring-offset", "wing-eligibility"],
+        {
+            let rec = Rec {
+                m: 2,
+                d: 2,
+                ..tetra_split()
+            };
+            hand(&[
+                handmade::tetrahedron_two_candidates(),
+                level(&[true], vec![1], &[rec], 5, 6),
+            ])
+        },
+    );
+    s.valid(
+        "wing-ranks-skip-round-start-candidate",
+        "Tetrahedron with adjacent candidates 0 and 1; vertex 0 splits and ranks 0 and 1 among its m = 2 eligible ring entries (3 and 2; vertex 1 was a candidate at round start) name wings 3 and 2. Vertex 1 stays a candidate: its flag is inferred (SPEC §7.2, §7.4).",
+        &["handmade", "one-split", "wing-eligibility", "inferred-flags"],
+        {
+            let build = |rec: Rec| {
+                write_stream(
+                    &handmade::stored(),
+                    &[
+                        handmade::tetrahedron_two_candidates(),
+                        level(&[true], vec![1], &[rec], 5, 6),
+                    ],
+                )
+            };
+            let rec = Rec {
+                m: 2,
+                ..tetra_split()
+            };
+            build(handmade::solve(rec, 0, 4, [0, 0, 0], [4, 0, 2], &build))
         },
     );
     s.invalid(
@@ -942,12 +1133,21 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "valence-overflow-wing",
         "valence-overflow",
-        "Vertex 1 (deficit 0, its flag inferred 0) is a wing of vertex 0's split.",
-        &["handmade", "valence"],
-        hand(&[
-            handmade::tetrahedron_two_candidates(),
-            level(&[true], vec![1], &[tetra_split()], 5, 6),
-        ]),
+        "Octahedron whose non-adjacent vertices 0 and 1 are candidates and whose vertex 2 (deficit 1) is next to both: both split in one round with 2 as a wing. At round start 2 may be a wing (deficit 1); after the first split its deficit is 0 and the second split fails (SPEC §7.5).",
+        &["handmade", "valence", "wing-eligibility"],
+        {
+            let rec = Rec {
+                m: 4,
+                valence_c: 5,
+                e: [0; 3],
+                t: [0; 3],
+                ..tetra_split()
+            };
+            hand(&[
+                handmade::octahedron(&[0, 0, 1, 255, 255, 255]),
+                level(&[true, true], vec![2], &[rec, rec], 8, 12),
+            ])
+        },
     );
     rans_vectors(s);
     s.invalid(
@@ -964,14 +1164,45 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "valence-overflow-split",
         "valence-overflow",
-        "Split record giving P valence 3 and deficit 253 (split valence 256 > 255).",
-        &["handmade", "valence"],
+        "Split record whose split-valence symbol for P is 254: split valence 256 > 255 (SPEC §7.4).",
+        &["handmade", "valence", "split-valence"],
         {
             let rec = Rec {
-                dp: 253,
+                sp: 254,
                 ..tetra_split()
             };
             hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+        },
+    );
+    s.invalid(
+        "split-valence-below-valence",
+        "valence-overflow",
+        "Split record whose split-valence symbol for C is 1 (split valence 3) while C's valence right after the split is 4 (SPEC §7.4).",
+        &["handmade", "valence", "split-valence"],
+        {
+            let rec = Rec {
+                sc: 1,
+                ..tetra_split()
+            };
+            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+        },
+    );
+    s.valid(
+        "split-valence-255",
+        "Split record whose split-valence symbol for P is 253: split valence 255, P keeps deficit 252 at valence 3 (the largest legal symbol, SPEC §7.4).",
+        &["handmade", "one-split", "split-valence"],
+        {
+            let build = |rec: Rec| {
+                write_stream(
+                    &handmade::stored(),
+                    &[tetra(), level(&[true], vec![1], &[rec], 5, 6)],
+                )
+            };
+            let rec = Rec {
+                sp: 253,
+                ..tetra_split()
+            };
+            build(handmade::solve(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build))
         },
     );
     s.invalid(

@@ -9,7 +9,9 @@ use splitstream_decoder_core::limits::{CHUNK_ENTRY_LEN, HEADER_LEN, LEVEL_ENTRY_
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream_seeded,
 };
-use splitstream_decoder_core::{Header, Inflater, LevelHeader, LevelTable, crc32, head_len};
+use splitstream_decoder_core::{
+    Header, Inflater, LevelHeader, LevelTable, PlanePolicy, crc32, head_len,
+};
 
 /// One level's content, substreams as raw bytes.
 #[derive(Clone, Debug)]
@@ -18,6 +20,8 @@ pub struct Level {
     /// substreams (ids 8..=10).
     pub seed: Option<(u32, u32, Vec<Vec<u8>>)>,
     pub round_splits: Vec<u32>,
+    /// The level's plane policy (SPEC §5.1).
+    pub plane: PlanePolicy,
     /// The rounds' substreams, ids 1..=7.
     pub substreams: Vec<Vec<u8>>,
     pub vertex_count: u32,
@@ -71,6 +75,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
         levels.push(Level {
             seed,
             round_splits: (0..lh.round_count).map(|r| lh.split_count(r)).collect(),
+            plane: lh.plane_policy,
             substreams,
             vertex_count: info.vertex_count,
             triangle_count: info.triangle_count,
@@ -114,6 +119,7 @@ pub fn reframe(u: &Unframed) -> Vec<u8> {
         .iter()
         .map(|l| LevelPayload {
             round_splits: l.round_splits.clone(),
+            plane: l.plane,
             substreams: writers(&l.substreams),
             vertex_count: l.vertex_count,
             triangle_count: l.triangle_count,
@@ -162,10 +168,17 @@ pub fn level_range(s: &[u8], k: u16) -> Range<usize> {
     offset..offset + u32_at(s, at + 8) as usize
 }
 
-/// Offset of the split counts of level `k` (level 0 first holds the seed
-/// mesh's vertex and triangle counts, SPEC §5.1).
+/// Offset of the split counts of level `k`: after the round and chunk
+/// counts, the plane policy byte and 3 reserved bytes, and in level 0 the
+/// seed mesh's vertex and triangle counts (SPEC §5.1).
 fn split_counts_at(s: &[u8], k: u16) -> usize {
-    level_range(s, k).start + if k == 0 { 16 } else { 8 }
+    level_range(s, k).start + if k == 0 { 20 } else { 12 }
+}
+
+/// Offset of the plane policy byte of level `k` (SPEC §5.1); the 3
+/// reserved bytes follow it.
+pub fn plane_policy_at(s: &[u8], k: u16) -> usize {
+    level_range(s, k).start + 8
 }
 
 /// Where the level header of level `k` keeps its CRC.

@@ -39,9 +39,9 @@ pub fn fix_checksums(stream: &mut [u8]) {
         let (Some(rounds), Some(chunks)) = (rd32(level, 0), rd32(level, 4)) else {
             return;
         };
-        // Split counts start at H = 16 in level 0 (after the seed counts),
-        // 8 elsewhere (SPEC §5.1).
-        let h = if k == 0 { 16 } else { 8 };
+        // Split counts start at H = 20 in level 0 (after the plane policy,
+        // reserved bytes and seed counts), 12 elsewhere (SPEC §5.1).
+        let h = if k == 0 { 20 } else { 12 };
         let Some(dir) = (rounds as usize)
             .checked_mul(4)
             .and_then(|s| s.checked_add(h))

@@ -10,20 +10,26 @@
 //! known, so a decoder run can be compared round by round.
 //!
 //! With `allow_invalid`, a few choice values inject one fault per record
-//! (a raw wing offset/distance, a raw deficit, a flagged neighbour); the
-//! replay then stops at the error and the stream ends with that round, so the
-//! decoder must report the very same error.
+//! (raw wing ranks, raw split-valence symbols, a placement code above 2, a
+//! flagged neighbour); the replay then stops at the error and the stream
+//! ends with that round, so the decoder must report the very same error.
+//!
+//! Each level gets a plane policy from the choices (SPEC §5.1); with 31
+//! bits per axis the base meshes are scaled up to the top of the grid, so
+//! that the predictions' wide arithmetic (SPEC §7.4) is exercised.
 
 #![allow(dead_code)]
 
 use splitstream_decoder_core::limits::{LEAF, NONE};
+use splitstream_decoder_core::symbols::{deficit_of, split_valence_symbol};
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
     write_stream_seeded,
 };
 use splitstream_decoder_core::{
-    Decoder, Error, Inflater, Layout, MeshState, PositionMode, RecordSource, Ring, SplitRecord,
-    context, predict_split, refine_c, workspace_len,
+    Decoder, Error, Inflater, Layout, MeshState, Plane, PlanePolicy, PositionMode, RecordSource,
+    Ring, SplitRecord, Target, add_residual, arc_means, constrained_positions, context, predict,
+    residual, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -185,6 +191,7 @@ struct GenSource<'g, 'c> {
     next_flag: usize,
     subs: &'g mut [SubstreamWriter],
     mode: PositionMode,
+    plane: PlanePolicy,
     bits: u8,
     allow_invalid: bool,
 }
@@ -193,17 +200,20 @@ fn wing_ok(state: &MeshState<'_>, x: u32) -> bool {
     x == NONE || state.deficits()[x as usize] != 0
 }
 
-/// Wing pairs `(o, d)` that a valid record may name for this ring.
+/// Wing pairs `(o, d)` that a valid record may name for this ring: both
+/// eligible at round start (SPEC §7.4) and with a deficit left now.
 fn wing_pairs(state: &MeshState<'_>, ring: &Ring) -> Vec<(usize, usize)> {
     let k = ring.len();
     let v = ring.vertices();
+    let eligible = state.wing_candidates(ring);
+    let ok = |i: usize| eligible.contains(i) && wing_ok(state, v[i]);
     let mut pairs = Vec::new();
     for o in 0..k {
-        if !wing_ok(state, v[o]) {
+        if !ok(o) {
             continue;
         }
         for d in 1..k - o {
-            if wing_ok(state, v[o + d]) && !(v[o] == NONE && v[o + d] == NONE) {
+            if ok(o + d) && !(v[o] == NONE && v[o + d] == NONE) {
                 pairs.push((o, d));
             }
         }
@@ -256,91 +266,108 @@ impl RecordSource for GenSource<'_, '_> {
         let c = &mut *self.choices;
         let k = ring.len();
         let pairs = wing_pairs(state, ring);
-        let (o, d) = if self.allow_invalid && c.byte() == 0xFF {
-            (c.byte() as usize, c.byte() as usize)
+        let eligible = state.wing_candidates(ring);
+        let wing_context = context::wing(eligible.count());
+        // The wings as ranks among the entries that may be wings (SPEC
+        // §7.4); raw ranks name whatever pair they name, or none.
+        let (o_rank, d_rank) = if self.allow_invalid && c.byte() == 0xFF {
+            (c.byte(), c.byte())
         } else if pairs.is_empty() {
             (0, 0)
         } else {
-            pairs[c.below(pairs.len())]
+            let (o, d) = pairs[c.below(pairs.len())];
+            eligible.ranks(o, d).expect("pairs are eligible")
         };
-        let d_clamped = d.min(k);
-        let (len_p, len_c) = (d_clamped, k - d_clamped);
-        let (mut deficit_p, mut deficit_c) = (
-            pick_deficit(c.byte(), len_p + 2),
-            pick_deficit(c.byte(), len_c + 2),
+        self.subs[1].byte_in(wing_context, o_rank);
+        self.subs[2].byte_in(wing_context, d_rank);
+        let (o, d) = eligible.wings(o_rank, d_rank)?;
+        let (valence_p, valence_c) = (d + 2, k - d + 2);
+        let (deficit_p, deficit_c) = (
+            pick_deficit(c.byte(), valence_p),
+            pick_deficit(c.byte(), valence_c),
+        );
+        let (mut sp, mut sc) = (
+            split_valence_symbol(deficit_p, valence_p),
+            split_valence_symbol(deficit_c, valence_c),
         );
         if self.allow_invalid && c.byte() == 0xFE {
-            deficit_p = c.byte();
-            deficit_c = c.byte();
+            sp = c.byte();
+            sc = c.byte();
         }
+        self.subs[3].byte(sp);
+        let deficit_p = deficit_of(sp, valence_p)?;
+        self.subs[4].byte_in(context::deficit_c(deficit_p, valence_c), sc);
+        let deficit_c = deficit_of(sc, valence_c)?;
         let limit = 1i64 << self.bits;
         let in_grid = |v: &[i64; 3]| v.iter().all(|&x| (0..limit).contains(&x));
         let clamp = |v: i64| v.clamp(0, limit - 1);
         let parent = state.positions()[r as usize];
         let parent64 = parent.map(|x| x as i64);
-        // Positions are coded as residuals from the SPEC §7.4 prediction,
-        // which needs a valid ring partition; an invalid (o, d) is rejected
-        // before any position is read, so anything may follow it.
-        let (p_hat, c_hat) = if d >= 1 && o + d < k {
-            predict_split(state.positions(), parent, ring, o, d)
-        } else {
-            (parent64, parent64)
+        let means = arc_means(state.positions(), parent, ring, o, d);
+        let plane = Plane::new(self.plane, &means);
+        let write = |w: &mut SubstreamWriter, coded: [i64; 3]| {
+            for axis in plane.order() {
+                w.signed_in(plane.context(axis), coded[axis] as i32);
+            }
         };
-        let mut p = [0i64; 3];
-        let mut q = [0i64; 3];
-        match self.mode {
+        let sub = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|k| a[k] - b[k]) };
+        let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|k| a[k] + b[k]) };
+        // The positions are what the decoder computes from the values
+        // written (SPEC §7.4); residuals wrap modulo 2^32, so every chosen
+        // position of the grid can be coded.
+        let (p, q) = match self.mode {
             PositionMode::Optimal => {
+                let mut p = [0i64; 3];
+                let mut q = [0i64; 3];
                 for k in 0..3 {
                     p[k] = clamp(parent64[k] + small(c.byte()));
                     q[k] = clamp(p[k] + small(c.byte()));
                 }
-                let c_hat = refine_c(c_hat, parent, p);
-                for k in 0..3 {
-                    self.subs[5].signed_in(context::axis(k), (p[k] - p_hat[k]) as i32);
-                }
-                for k in 0..3 {
-                    self.subs[6].signed_in(context::axis(k), (q[k] - c_hat[k]) as i32);
-                }
+                let p_hat = predict(&means, self.mode, Target::P);
+                let c_hat = predict(&means, self.mode, Target::C);
+                let cs = plane.encode(residual(sub(p, parent64), p_hat));
+                let ct = plane.encode(residual(sub(q, parent64), c_hat));
+                write(&mut self.subs[5], cs);
+                write(&mut self.subs[6], ct);
+                (
+                    add(parent64, add_residual(p_hat, plane.decode(cs))),
+                    add(parent64, add_residual(c_hat, plane.decode(ct))),
+                )
             }
             PositionMode::Constrained => {
-                let code = c.byte() % 3;
+                let mut code = c.byte() % 3;
+                if self.allow_invalid && c.byte() == 0xFC {
+                    code = 3 + c.byte() % 253;
+                }
+                self.subs[6].byte_in(context::placement(&means), code);
+                let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
                 let mut edge = [0i64; 3];
                 for e in &mut edge {
                     *e = small(c.byte());
                 }
-                let place = |e: &[i64; 3]| -> ([i64; 3], [i64; 3]) {
+                let vector = |code: u8, e: &[i64; 3]| -> [i64; 3] {
                     match code {
-                        // R sits on P.
-                        0 => (parent64, core::array::from_fn(|k| parent64[k] + e[k])),
-                        // R sits on C.
-                        1 => (core::array::from_fn(|k| parent64[k] - e[k]), parent64),
-                        // R is the midpoint P + (e >> 1).
-                        _ => {
-                            let p: [i64; 3] = core::array::from_fn(|k| parent64[k] - (e[k] >> 1));
-                            (p, core::array::from_fn(|k| p[k] + e[k]))
-                        }
+                        // R sits on P: the vector is C - R.
+                        0 => *e,
+                        // R sits on C: the vector is P - R.
+                        1 => e.map(|x| -x),
+                        // R is the midpoint: the vector is the edge C - P.
+                        _ => *e,
                     }
                 };
-                (p, q) = place(&edge);
+                let (p, q) = constrained_positions(parent, code, vector(code, &edge));
                 if !in_grid(&p) || !in_grid(&q) {
                     edge = [0; 3];
-                    (p, q) = place(&edge);
                 }
-                for k in 0..3 {
-                    let residual = match code {
-                        0 => q[k] - c_hat[k],
-                        1 => p[k] - p_hat[k],
-                        _ => (q[k] - p[k]) - (c_hat[k] - p_hat[k]),
-                    };
-                    self.subs[5].signed_in(context::axis(k), residual as i32);
-                }
-                self.subs[6].byte(code);
+                let prediction = predict(&means, self.mode, target);
+                let coded = plane.encode(residual(vector(code, &edge), prediction));
+                write(&mut self.subs[5], coded);
+                constrained_positions(parent, code, add_residual(prediction, plane.decode(coded)))
             }
+        };
+        if !in_grid(&p) || !in_grid(&q) {
+            return Err(Error::PositionOutOfRange);
         }
-        self.subs[1].byte(o as u8);
-        self.subs[2].byte_in(context::wing_distance(k), d as u8);
-        self.subs[3].byte(deficit_p);
-        self.subs[4].byte_in(context::deficit_c(deficit_p), deficit_c);
         Ok(SplitRecord {
             wing_offset: o as u8,
             wing_distance: d as u8,
@@ -361,7 +388,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
     } else {
         PositionMode::Constrained
     };
-    let bits = [8u8, 10, 16, 24][choices.below(4)];
+    let bits = [8u8, 10, 16, 24, 31][choices.below(5)];
     // Deflate is rare: miniz_oxide's compressor state is large and is set
     // up per chunk, which would dominate the fuzzers' time.
     let codec = match choices.byte() % 8 {
@@ -387,6 +414,13 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         chunk_limit,
     };
     let refinement_levels = 4 - choices.below(4);
+    // With 31 bits, the base mesh is scaled towards the top of the grid.
+    let mut base = base;
+    if bits == 31 {
+        for p in &mut base.positions {
+            *p = p.map(|x| (x << 25) + 1);
+        }
+    }
     let bv = base.positions.len() as u32;
     let bt = base.triangles.len() as u32;
     let deficits: Vec<u8> = (0..bv as usize)
@@ -424,6 +458,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         let mut subs = vec![SubstreamWriter::default(); 7];
         let mut round_splits = Vec::new();
         let level_start_v = state.vertex_count();
+        let plane = PlanePolicy::ALL[choices.below(PlanePolicy::ALL.len())];
         let rounds = 3 - choices.below(3);
         for _ in 0..rounds {
             let n = state.vertex_count();
@@ -487,6 +522,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                 next_flag: 0,
                 subs: &mut subs,
                 mode: position_mode,
+                plane,
                 bits,
                 allow_invalid,
             };
@@ -497,6 +533,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                     let remaining = declared - done;
                     levels.push(LevelPayload {
                         round_splits,
+                        plane,
                         substreams: subs,
                         vertex_count: n + declared,
                         triangle_count: state.triangle_count() + remaining,
@@ -513,6 +550,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         debug_assert!(state.vertex_count() > level_start_v);
         levels.push(LevelPayload {
             round_splits,
+            plane,
             substreams: subs,
             vertex_count: state.vertex_count(),
             triangle_count: state.triangle_count(),
@@ -657,15 +695,22 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
         .iter()
         .map(|l| l.substreams.iter().map(|s| s.as_bytes().to_vec()).collect())
         .collect();
-    let mut meta: Vec<(Vec<u32>, u32, u32)> = g
+    let mut meta: Vec<(Vec<u32>, u32, u32, PlanePolicy)> = g
         .levels
         .iter()
-        .map(|l| (l.round_splits.clone(), l.vertex_count, l.triangle_count))
+        .map(|l| {
+            (
+                l.round_splits.clone(),
+                l.vertex_count,
+                l.triangle_count,
+                l.plane,
+            )
+        })
         .collect();
     let mut n_ops = 0;
     while !ops.exhausted() && n_ops < 32 {
         n_ops += 1;
-        let op = ops.byte() % 12;
+        let op = ops.byte() % 13;
         let l = ops.below(subs.len());
         let s = ops.below(subs[l].len());
         let bytes = &mut subs[l][s];
@@ -709,7 +754,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 }
             }
             6 => {
-                let (splits, _, _) = &mut meta[l];
+                let (splits, _, _, _) = &mut meta[l];
                 let r = ops.below(splits.len());
                 let delta = (ops.byte() as i8 % 3) as i32;
                 if let Some(x) = splits.get_mut(r) {
@@ -717,14 +762,14 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 }
             }
             7 => {
-                let (_, v, t) = &mut meta[l];
+                let (_, v, t, _) = &mut meta[l];
                 let dv = (ops.byte() as i8 % 3) as i64;
                 let dt = (ops.byte() as i8 % 3) as i64;
                 *v = (*v as i64 + dv).clamp(0, u32::MAX as i64) as u32;
                 *t = (*t as i64 + dt).clamp(0, u32::MAX as i64) as u32;
             }
             8 => {
-                let (splits, _, _) = &mut meta[l];
+                let (splits, _, _, _) = &mut meta[l];
                 if ops.byte() & 1 == 0 {
                     splits.pop();
                 } else {
@@ -757,6 +802,10 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 let n = ops.byte() % 16;
                 bytes.extend(core::iter::repeat_n(v, n as usize));
             }
+            11 => {
+                // Another plane policy for the level (SPEC §5.1, §7.4).
+                meta[l].3 = PlanePolicy::ALL[ops.below(PlanePolicy::ALL.len())];
+            }
             _ => {
                 // Drop the last level (never the base).
                 if subs.len() > 1 && ops.byte() & 1 == 0 {
@@ -770,8 +819,9 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
         .into_iter()
         .zip(meta)
         .map(
-            |(s, (round_splits, vertex_count, triangle_count))| LevelPayload {
+            |(s, (round_splits, vertex_count, triangle_count, plane))| LevelPayload {
                 round_splits,
+                plane,
                 substreams: s
                     .into_iter()
                     .map(|b| {

@@ -13,7 +13,7 @@ use splitstream_encoder::baseline::{BaselineOptions, simplify_sequential};
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, fractal_terrain, read_mesh};
 use splitstream_encoder::metrics::surface_distance;
-use splitstream_encoder::quantize::{QuantizedMesh, Units, quantize};
+use splitstream_encoder::quantize::{Quantization, QuantizedMesh, Units, quantize};
 use splitstream_encoder::simplify::{Backend, Simplification, SimplifyOptions, simplify_on};
 
 use super::info::{field_sizes, is_geometry};
@@ -89,9 +89,9 @@ pub fn run(settings: &Settings) -> CliResult {
     println!("# splitstream encoder benchmark\n");
     println!("## Stream size (5 levels, 14-bit positions), bits per vertex\n");
     println!(
-        "| input | vertices | mode | codec | total | connectivity | geometry | rounds | encode s | decode ms | M splits/s |"
+        "| input | vertices | mode | codec | quantization | total | connectivity | geometry | rounds | encode s | decode ms | M splits/s |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut loaded = Vec::new();
     for input in INPUTS.iter().filter(|i| {
         settings
@@ -102,23 +102,27 @@ pub fn run(settings: &Settings) -> CliResult {
         let path = data.join(input.file);
         if !path.exists() {
             println!(
-                "| {} | skipped: run encoder/data/fetch.sh | | | | | | | | | |",
+                "| {} | skipped: run encoder/data/fetch.sh | | | | | | | | | | |",
                 input.name
             );
             continue;
         }
         let mesh = read_mesh(&path, &ReadOptions::default()).map_err(|e| e.to_string())?;
         check_mesh(&mesh).map_err(|e| format!("{}: {e}", path.display()))?;
+        // Per-axis steps are the encoder's default; one step for all axes
+        // is what Draco does at the same bit count (fair comparisons).
         for mode in [PositionMode::Optimal, PositionMode::Constrained] {
-            for codec in [ChunkCodec::Rans { lanes: 4 }, ChunkCodec::Deflate(9)] {
-                size_row(
-                    input.name,
-                    &mesh,
-                    input.units,
-                    (mode, codec),
-                    admit,
-                    backend,
-                )?;
+            for quantization in [Quantization::PerAxis, Quantization::Uniform] {
+                for codec in [ChunkCodec::Rans { lanes: 4 }, ChunkCodec::Deflate(9)] {
+                    size_row(
+                        input.name,
+                        &mesh,
+                        input.units,
+                        (mode, codec, quantization),
+                        admit,
+                        backend,
+                    )?;
+                }
             }
         }
         loaded.push((input, mesh));
@@ -157,7 +161,7 @@ fn size_row(
     name: &str,
     mesh: &Mesh,
     units: Units,
-    (mode, codec): (PositionMode, ChunkCodec),
+    (mode, codec, quantization): (PositionMode, ChunkCodec, Quantization),
     admit: f64,
     backend: Backend,
 ) -> CliResult {
@@ -165,6 +169,7 @@ fn size_row(
         position_mode: mode,
         codec,
         units,
+        quantization,
         admit_quantile: admit,
         backend,
         ..EncodeOptions::default()
@@ -197,7 +202,7 @@ fn size_row(
         .seed_vertices;
     let splits = (header.vertex_capacity - seed) as f64;
     println!(
-        "| {name} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.2} |",
+        "| {name} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.2} |",
         mesh.positions.len(),
         if mode == PositionMode::Optimal {
             "optimal"
@@ -208,6 +213,10 @@ fn size_row(
             ChunkCodec::Deflate(_) => "deflate",
             ChunkCodec::Stored => "stored",
             _ => "rans",
+        },
+        match quantization {
+            Quantization::PerAxis => "per-axis",
+            Quantization::Uniform => "uniform",
         },
         bpv(stream.len() as u64),
         bpv(connectivity),

@@ -11,7 +11,7 @@ use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::Units;
 
-use super::{BackendArg, CliResult, Codec, Position};
+use super::{BackendArg, CliResult, Codec, PlaneArg, Position, QuantizationArg};
 
 /// `splitstream encode`'s arguments.
 #[derive(clap::Args)]
@@ -65,6 +65,14 @@ pub struct Args {
     /// errors are measured in metres.
     #[arg(long)]
     pub geographic: bool,
+    /// One quantization step per axis (default), or one for all axes (in
+    /// metres with --geographic), as Draco does at the same bit count.
+    #[arg(long, value_enum, default_value_t = QuantizationArg::PerAxis)]
+    pub quantization: QuantizationArg,
+    /// Which axis of each position residual the split's plane predicts
+    /// (SPEC §7.4); `auto` picks the cheapest per level.
+    #[arg(long, value_enum, default_value_t = PlaneArg::Auto)]
+    pub plane: PlaneArg,
     /// Where the simplification's data-parallel passes run (GPU backends:
     /// quadrics, best edges and selection on the device, collapses on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
@@ -120,7 +128,9 @@ pub fn run(a: Args) -> CliResult {
         } else {
             Units::Linear
         },
+        quantization: a.quantization.into(),
         backend: a.backend.into(),
+        plane: a.plane.policy(),
     };
     if !a.geographic && looks_geographic(&mesh) {
         eprintln!(

@@ -80,6 +80,16 @@ pub fn run(input: &Path, json: bool) -> CliResult {
     let header = Header::parse(&stream).map_err(fail)?;
     let table = LevelTable::parse(&stream, &header).map_err(fail)?;
     let sizes = field_sizes(&stream, &header, &table)?;
+    // Each level's plane policy (SPEC §5.1, §7.4).
+    let planes: Vec<&str> = (0..table.len())
+        .map(|k| {
+            let e = table.get(k);
+            stream
+                .get(e.offset as usize..(e.offset + e.length as u64) as usize)
+                .and_then(|b| LevelHeader::parse(b, k == 0, header.max_chunk_len).ok())
+                .map_or("?", |lh| lh.plane_policy.name())
+        })
+        .collect();
     let n = header.vertex_capacity as f64;
     let bpv = |bytes: u64| 8.0 * bytes as f64 / n;
     let connectivity: u64 = (1..FIELDS)
@@ -102,6 +112,7 @@ pub fn run(input: &Path, json: bool) -> CliResult {
                     "level": k, "offset": e.offset, "length": e.length,
                     "vertices": e.vertex_count, "triangles": e.triangle_count,
                     "rounds": e.round_count, "geometric_error": e.geometric_error,
+                    "plane_policy": planes[k as usize],
                 })
             })
             .collect();
@@ -165,17 +176,18 @@ pub fn run(input: &Path, json: bool) -> CliResult {
         header.workspace_bytes as f64 / n,
         header.max_chunk_len
     );
-    println!("  level    offset     bytes   vertices  triangles rounds  geometric error");
+    println!("  level    offset     bytes   vertices  triangles rounds  plane     geometric error");
     for k in 0..table.len() {
         let e = table.get(k);
         println!(
-            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:.6}",
+            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:.6}",
             k,
             e.offset,
             e.length,
             e.vertex_count,
             e.triangle_count,
             e.round_count,
+            planes[k as usize],
             e.geometric_error
         );
     }

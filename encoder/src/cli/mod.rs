@@ -36,6 +36,54 @@ pub enum Position {
     Constrained,
 }
 
+/// How positions are quantized (the stream format is the same either way).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum QuantizationArg {
+    /// Each axis over its own extent: full precision for terrain heights.
+    #[default]
+    PerAxis,
+    /// One step for all axes (the largest extent), as Draco quantizes: for
+    /// size comparisons at equal precision.
+    Uniform,
+}
+
+impl From<QuantizationArg> for splitstream_encoder::quantize::Quantization {
+    fn from(q: QuantizationArg) -> Self {
+        use splitstream_encoder::quantize::Quantization;
+        match q {
+            QuantizationArg::PerAxis => Quantization::PerAxis,
+            QuantizationArg::Uniform => Quantization::Uniform,
+        }
+    }
+}
+
+/// Which axis of each position residual the split's plane predicts (SPEC §7.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum PlaneArg {
+    /// Per level, the policy whose residuals take fewest bytes.
+    #[default]
+    Auto,
+    Off,
+    Dominant,
+    X,
+    Y,
+    Z,
+}
+
+impl PlaneArg {
+    pub fn policy(self) -> Option<splitstream_decoder_core::PlanePolicy> {
+        use splitstream_decoder_core::PlanePolicy;
+        match self {
+            PlaneArg::Auto => None,
+            PlaneArg::Off => Some(PlanePolicy::Off),
+            PlaneArg::Dominant => Some(PlanePolicy::Dominant),
+            PlaneArg::X => Some(PlanePolicy::Axis(0)),
+            PlaneArg::Y => Some(PlanePolicy::Axis(1)),
+            PlaneArg::Z => Some(PlanePolicy::Axis(2)),
+        }
+    }
+}
+
 /// Where the simplifier's data-parallel passes run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {

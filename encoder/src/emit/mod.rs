@@ -6,13 +6,13 @@ mod levels;
 mod replay;
 
 use rayon::prelude::*;
-use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, assemble_stream, frame_level,
 };
+use splitstream_decoder_core::{PlanePolicy, PositionMode};
 
 use crate::mesh::Mesh;
-use crate::quantize::{QuantizedMesh, Units, quantize};
+use crate::quantize::{Quantization, QuantizedMesh, Units, quantize_with};
 use crate::simplify::{Backend, GpuError, SimplifyOptions, simplify_on};
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
@@ -40,8 +40,13 @@ pub struct EncodeOptions {
     pub admit_quantile: f64,
     /// Units of the input coordinates, for the error metric.
     pub units: Units,
+    /// One quantization step per axis (default) or one for all axes.
+    pub quantization: Quantization,
     /// Where the simplification's data-parallel passes run.
     pub backend: Backend,
+    /// The plane policy of every level (SPEC §7.4); `None`: per level, the
+    /// one whose residuals take fewest bytes.
+    pub plane: Option<PlanePolicy>,
 }
 
 impl Default for EncodeOptions {
@@ -57,7 +62,9 @@ impl Default for EncodeOptions {
             lock_boundary: false,
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,
+            quantization: Quantization::PerAxis,
             backend: Backend::Cpu,
+            plane: None,
         }
     }
 }
@@ -109,7 +116,7 @@ pub fn encode(
     if options.levels == 0 {
         return Err(EncodeError::BadOption("--levels must be at least 1".into()));
     }
-    let quantized = quantize(mesh, options.bits, options.units);
+    let quantized = quantize_with(mesh, options.bits, options.units, options.quantization);
     encode_quantized(&quantized, options, progress)
 }
 
@@ -142,8 +149,6 @@ pub fn encode_quantized(
     let simplify_seconds = started.elapsed().as_secs_f64();
     let started = std::time::Instant::now();
     let plan = plan_levels(&simplification, options.levels, base);
-    let replayed =
-        replay(mesh, &simplification, &plan, options.position_mode).map_err(EncodeError::Replay)?;
     let params = StreamParams {
         position_mode: options.position_mode,
         bits: mesh.bits,
@@ -152,6 +157,8 @@ pub fn encode_quantized(
         codec: options.codec,
         chunk_limit: options.chunk_limit,
     };
+    let replayed = replay(mesh, &simplification, &plan, &params, options.plane)
+        .map_err(EncodeError::Replay)?;
     let level_vertex_counts = replayed
         .levels
         .iter()

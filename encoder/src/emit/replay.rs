@@ -3,10 +3,14 @@
 
 use splitstream_decoder_core::corner_refs;
 use splitstream_decoder_core::limits::{LEAF, NONE, substream};
-use splitstream_decoder_core::writer::{LevelPayload, SeedPayload, SubstreamWriter};
+use splitstream_decoder_core::symbols::split_valence_symbol;
+use splitstream_decoder_core::writer::{
+    LevelPayload, SeedPayload, StreamParams, SubstreamWriter, coded_len,
+};
 use splitstream_decoder_core::{
-    CornerRefs, Error, MeshState, PositionMode, RecordSource, Ring, SplitOutcome, SplitRecord,
-    StateMemory, context, predict_split, refine_c,
+    CornerRefs, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource, Ring,
+    SplitOutcome, SplitRecord, StateMemory, Target, add_residual, arc_means, constrained_positions,
+    context, predict, residual,
 };
 
 use super::levels::LevelPlan;
@@ -86,6 +90,39 @@ impl Memory {
     }
 }
 
+/// A level's residual substreams under one plane policy (SPEC §7.4): the
+/// encoder writes every policy's and keeps the cheapest.
+#[derive(Clone, Default)]
+struct PolicyResiduals {
+    edge: SubstreamWriter,
+    /// Optimal mode's second vector (the placement substream).
+    placement: SubstreamWriter,
+    /// Every coded value fits in 32 bits.
+    usable: bool,
+}
+
+fn policy_residuals() -> Vec<PolicyResiduals> {
+    vec![
+        PolicyResiduals {
+            usable: true,
+            ..PolicyResiduals::default()
+        };
+        PlanePolicy::ALL.len()
+    ]
+}
+
+/// Writes `coded` (a residual vector under `plane`) in the plane's order
+/// and contexts; `false` when a value does not fit in 32 bits.
+fn write_vector(w: &mut SubstreamWriter, plane: &Plane, coded: [i64; 3]) -> bool {
+    if coded.iter().any(|&x| i32::try_from(x).is_err()) {
+        return false;
+    }
+    for axis in plane.order() {
+        w.signed_in(plane.context(axis), coded[axis] as i32);
+    }
+    true
+}
+
 /// Feeds one round from the collapses of one simplification step.
 struct StepSource<'a> {
     collapses: &'a [Collapse],
@@ -94,6 +131,8 @@ struct StepSource<'a> {
     enc2dec: &'a mut [u32],
     dec2enc: &'a mut Vec<u32>,
     subs: &'a mut [SubstreamWriter],
+    /// The residual substreams of every plane policy, in `PlanePolicy::ALL` order.
+    residuals: &'a mut [PolicyResiduals],
     mode: PositionMode,
     pending: Option<usize>,
     /// Whether the pending split gives the collapse's C index R (SPEC §7.4).
@@ -176,60 +215,84 @@ impl RecordSource for StepSource<'_> {
                     .map(|x| x as u8)
             }
         };
-        let (Some(dp), Some(dc)) = (deficit(sv_p, len_p + 2), deficit(sv_c, k - len_p + 2)) else {
+        let (valence_p, valence_c) = (len_p + 2, k - len_p + 2);
+        let (Some(dp), Some(dc)) = (deficit(sv_p, valence_p), deficit(sv_c, valence_c)) else {
             return Err(self.fail(format!("valence of {id} grew past its split valence")));
         };
         let parent = state.positions()[r as usize];
         if parent != col.position_r {
             return Err(self.fail(format!("position of {id} differs from its collapse")));
         }
-        let (p_hat, c_hat) = predict_split(state.positions(), parent, ring, o, d);
-        let residual = |x: [u32; 3], hat: [i64; 3]| -> [i64; 3] {
-            std::array::from_fn(|i| x[i] as i64 - hat[i])
+        // SPEC §7.4: the wings as ranks among the entries that may be wings.
+        let eligible = state.wing_candidates(ring);
+        let Some((o_rank, d_rank)) = eligible.ranks(o, d) else {
+            return Err(self.fail(format!(
+                "a wing of the collapse of {id} was a candidate at the start of its round"
+            )));
         };
+        let wing_context = context::wing(eligible.count());
         let s = &mut *self.subs;
-        s[slot(substream::WING_OFFSET)].byte_in(context::SINGLE, o as u8);
-        s[slot(substream::WING_DISTANCE)].byte_in(context::wing_distance(k), d as u8);
-        s[slot(substream::DEFICIT_P)].byte_in(context::SINGLE, dp);
-        s[slot(substream::DEFICIT_C)].byte_in(context::deficit_c(dp), dc);
-        let (first, second): ([i64; 3], Option<[i64; 3]>) = match self.mode {
+        s[slot(substream::WING_OFFSET)].byte_in(wing_context, o_rank);
+        s[slot(substream::WING_DISTANCE)].byte_in(wing_context, d_rank);
+        s[slot(substream::DEFICIT_P)].byte_in(context::SINGLE, split_valence_symbol(dp, valence_p));
+        s[slot(substream::DEFICIT_C)].byte_in(
+            context::deficit_c(dp, valence_c),
+            split_valence_symbol(dc, valence_c),
+        );
+        let means = arc_means(state.positions(), parent, ring, o, d);
+        let wide = |x: [u32; 3]| x.map(|v| v as i64);
+        let sub = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] - b[i]) };
+        let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] + b[i]) };
+        let (origin, p_wide, c_wide) = (wide(parent), wide(p), wide(c));
+        let mode = self.mode;
+        let mut consistent = true;
+        match mode {
             PositionMode::Optimal => {
-                let p_wide = p.map(|x| x as i64);
-                (
-                    residual(p, p_hat),
-                    Some(residual(c, refine_c(c_hat, parent, p_wide))),
-                )
+                let p_hat = predict(&means, mode, Target::P);
+                let c_hat = predict(&means, mode, Target::C);
+                let rs = residual(sub(p_wide, origin), p_hat);
+                let rt = residual(sub(c_wide, origin), c_hat);
+                for (policy, out) in PlanePolicy::ALL.iter().zip(self.residuals.iter_mut()) {
+                    let plane = Plane::new(*policy, &means);
+                    let (cs, ct) = (plane.encode(rs), plane.encode(rt));
+                    // What the decoder will compute from the coded values.
+                    consistent &= add(origin, add_residual(p_hat, plane.decode(cs))) == p_wide
+                        && add(origin, add_residual(c_hat, plane.decode(ct))) == c_wide;
+                    out.usable &= write_vector(&mut out.edge, &plane, cs);
+                    out.usable &= write_vector(&mut out.placement, &plane, ct);
+                }
             }
             PositionMode::Constrained => {
-                let e: [i64; 3] = std::array::from_fn(|i| c[i] as i64 - p[i] as i64);
-                let mid: [u32; 3] = std::array::from_fn(|i| (p[i] as i64 + (e[i] >> 1)) as u32);
-                let (code, first) = if parent == p {
-                    (0, residual(c, c_hat))
+                let e = sub(c_wide, p_wide);
+                let mid: [u32; 3] = std::array::from_fn(|i| (p_wide[i] + (e[i] >> 1)) as u32);
+                let (code, x) = if parent == p {
+                    (0, sub(c_wide, origin))
                 } else if parent == c {
-                    (1, residual(p, p_hat))
+                    (1, sub(p_wide, origin))
                 } else if parent == mid {
-                    (2, std::array::from_fn(|i| e[i] - (c_hat[i] - p_hat[i])))
+                    (2, e)
                 } else {
                     return Err(self.fail(format!(
                         "constrained position of {id} off P, C and midpoint"
                     )));
                 };
-                s[slot(substream::PLACEMENT)].byte_in(context::SINGLE, code);
-                (first, None)
+                s[slot(substream::PLACEMENT)].byte_in(context::placement(&means), code);
+                let target = Target::of_code(code).expect("codes 0..=2");
+                let prediction = predict(&means, mode, target);
+                let r = residual(x, prediction);
+                for (policy, out) in PlanePolicy::ALL.iter().zip(self.residuals.iter_mut()) {
+                    let plane = Plane::new(*policy, &means);
+                    let coded = plane.encode(r);
+                    let decoded = add_residual(prediction, plane.decode(coded));
+                    consistent &= constrained_positions(parent, code, decoded) == (p_wide, c_wide);
+                    out.usable &= write_vector(&mut out.edge, &plane, coded);
+                }
             }
-        };
-        let fits = |v: &[i64; 3]| v.iter().all(|&x| i32::try_from(x).is_ok());
-        if !fits(&first) || second.as_ref().is_some_and(|v| !fits(v)) {
-            return Err(self.fail(format!("position residual of {id} beyond 32 bits")));
         }
-        let s = &mut *self.subs;
-        for (axis, x) in first.into_iter().enumerate() {
-            s[slot(substream::EDGE)].signed_in(context::axis(axis), x as i32);
-        }
-        if let Some(second) = second {
-            for (axis, x) in second.into_iter().enumerate() {
-                s[slot(substream::PLACEMENT)].signed_in(context::axis(axis), x as i32);
-            }
+        if !consistent {
+            return Err(self.fail(format!(
+                "the residuals of {id} do not decode to its positions"
+            )));
         }
         Ok(SplitRecord {
             wing_offset: o as u8,
@@ -258,13 +321,17 @@ impl RecordSource for StepSource<'_> {
     }
 }
 
-/// Replays `s` level by level as planned, returning the level payloads.
+/// Replays `s` level by level as planned, returning the level payloads,
+/// each with the plane policy `plane`, or by default the one whose
+/// residuals cost least under `params`.
 pub fn replay(
     mesh: &QuantizedMesh,
     s: &Simplification,
     plan: &LevelPlan,
-    mode: PositionMode,
+    params: &StreamParams,
+    plane: Option<PlanePolicy>,
 ) -> Result<Replayed, ReplayError> {
+    let mode = params.position_mode;
     let n = mesh.positions.len();
     let t_total = mesh.triangles.len();
     // Base mesh: survivors in ascending id.
@@ -320,6 +387,7 @@ pub fn replay(
     let mut ring = Ring::default();
     for (l, steps) in plan.rounds.iter().enumerate() {
         let mut subs = vec![SubstreamWriter::default(); 7];
+        let mut residuals = policy_residuals();
         let mut round_splits = Vec::with_capacity(steps.len());
         for &k in steps {
             let collapses = &s.steps[k];
@@ -332,6 +400,7 @@ pub fn replay(
                 enc2dec: &mut enc2dec,
                 dec2enc: &mut dec2enc,
                 subs: &mut subs,
+                residuals: &mut residuals,
                 mode,
                 pending: None,
                 swapped: false,
@@ -347,8 +416,11 @@ pub fn replay(
             }
             round_splits.push(collapses.len() as u32);
         }
+        let plane = choose_policy(&mut subs, residuals, params, plane)
+            .map_err(|why| ReplayError(format!("level {l}: {why}")))?;
         levels.push(LevelPayload {
             round_splits,
+            plane,
             substreams: subs,
             vertex_count: state.vertex_count(),
             triangle_count: state.triangle_count(),
@@ -363,6 +435,51 @@ pub fn replay(
         permutation: dec2enc,
         final_hash,
     })
+}
+
+/// Puts the cheapest usable policy's residual substreams (or those of
+/// `forced`) into `subs` (ids 6 and 7; in constrained mode id 7 holds the
+/// placement codes, which do not depend on the policy) and returns that
+/// policy. Ties go to the earlier policy of `PlanePolicy::ALL` (`off` first).
+fn choose_policy(
+    subs: &mut [SubstreamWriter],
+    residuals: Vec<PolicyResiduals>,
+    params: &StreamParams,
+    forced: Option<PlanePolicy>,
+) -> Result<PlanePolicy, String> {
+    use rayon::prelude::*;
+    let optimal = params.position_mode == PositionMode::Optimal;
+    let costs: Vec<Option<usize>> = residuals
+        .par_iter()
+        .zip(PlanePolicy::ALL)
+        .map(|(r, policy)| {
+            if forced.is_some_and(|f| f != policy) {
+                return None;
+            }
+            r.usable.then(|| {
+                if forced.is_some() {
+                    return 0;
+                }
+                let edge = coded_len(&r.edge, substream::EDGE, params);
+                let placement = if optimal {
+                    coded_len(&r.placement, substream::PLACEMENT, params)
+                } else {
+                    0
+                };
+                edge + placement
+            })
+        })
+        .collect();
+    let best = (0..costs.len())
+        .filter(|&i| costs[i].is_some())
+        .min_by_key(|&i| (costs[i], i))
+        .ok_or("a position residual does not fit in 32 bits under any plane policy")?;
+    let chosen = residuals.into_iter().nth(best).expect("index of a policy");
+    subs[slot(substream::EDGE)] = chosen.edge;
+    if optimal {
+        subs[slot(substream::PLACEMENT)] = chosen.placement;
+    }
+    Ok(PlanePolicy::ALL[best])
 }
 
 /// decode(encode(M)) == M: the refined state, mapped back to input ids, has

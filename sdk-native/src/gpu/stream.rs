@@ -192,10 +192,7 @@ fn capture_into(
             header.lane_count,
         );
         for r in 0..level_header.round_count {
-            let source = StreamSource {
-                subs: &mut subs,
-                mode: header.position_mode,
-            };
+            let source = StreamSource::new(&mut subs, header.position_mode);
             let mut capture = Capture::new(source);
             state
                 .run_round(level_header.split_count(r), &mut capture, &mut ring)
