@@ -129,12 +129,12 @@ fn appendix_a_tetrahedron() {
     // §9: workspace_bytes of the example.
     assert_eq!(
         u64::from_le_bytes(stream[80..88].try_into().unwrap()),
-        13304
+        13296
     );
-    assert_eq!(
-        splitstream_decoder_core::Layout::new(5, 6, 4, 4, 4).total,
-        64 + 72 + 120 + 24 + 8 + 24 + 7 * 1856
-    );
+    // Corner references take 3 bytes here (3T = 18 fits in 24 bits).
+    let layout = splitstream_decoder_core::Layout::new(5, 6, 4, 4, 4);
+    assert_eq!(layout.corner_ref_width, 3);
+    assert_eq!(layout.total, 64 + 72 + 120 + 16 + 8 + 24 + 7 * 1856);
 }
 
 #[test]
