@@ -108,18 +108,13 @@ impl MeshState<'_> {
         // The round-start copy of the candidate bitmap (SPEC §9, region 6).
         let third = self.candidates.len() / 3;
         let start = &self.candidates[third..2 * third];
-        // A vertex whose deficit is not 0 now was no candidate at round
-        // start either (deficits only fall during a round, and no ring
-        // entry of a flagged vertex splits in it): only the entries at
-        // deficit 0 need the bitmap, whose words are rarely in the cache.
-        // The ghost (NONE) has no deficit and is beyond every bitmap.
+        // 1 when `v` may be a wing. The ghost (NONE) is beyond every
+        // bitmap: never a candidate. (The bitmap, a bit per vertex, is
+        // denser in the cache than the deficits.)
         let eligible = |v: u32| -> u64 {
-            match self.deficit.get(v as usize) {
-                Some(0) => start
-                    .get((v / 64) as usize)
-                    .map_or(1, |w| !(w >> (v % 64)) & 1),
-                _ => 1,
-            }
+            start
+                .get((v / 64) as usize)
+                .map_or(1, |w| !(w >> (v % 64)) & 1)
         };
         let mut out = WingCandidates::default();
         let vertices = ring.vertices();
