@@ -26,6 +26,45 @@ pub fn prev(c: u32) -> u32 {
     if c.is_multiple_of(3) { c + 2 } else { c - 1 }
 }
 
+/// The items `0..count` that have an edge (`ends(i)`, a pair of vertex ids
+/// below `vertex_count`, in either direction) as `(key, item)` with key
+/// `min << 32 | max`, sorted: what sorting those pairs gives, by a counting
+/// sort on the lower id and sorts of the short runs that share it. Every
+/// 2-manifold vertex owns a few edges, so this is linear where a full sort
+/// was the largest cost of setting up a simplification.
+pub fn by_undirected_edge(
+    vertex_count: usize,
+    count: usize,
+    ends: impl Fn(u32) -> Option<(u32, u32)>,
+) -> Vec<(u64, u32)> {
+    let keys: Vec<Option<u64>> = (0..count as u32)
+        .map(|i| ends(i).map(|(u, v)| (u64::from(u.min(v)) << 32) | u64::from(u.max(v))))
+        .collect();
+    let mut start = vec![0u32; vertex_count + 1];
+    for key in keys.iter().flatten() {
+        start[(key >> 32) as usize + 1] += 1;
+    }
+    for k in 1..start.len() {
+        start[k] += start[k - 1];
+    }
+    let mut fill = start.clone();
+    let mut order = vec![(0u64, 0u32); start[vertex_count] as usize];
+    for (i, key) in keys.iter().enumerate() {
+        if let &Some(key) = key {
+            let slot = &mut fill[(key >> 32) as usize];
+            order[*slot as usize] = (key, i as u32);
+            *slot += 1;
+        }
+    }
+    for w in start.windows(2) {
+        let run = &mut order[w[0] as usize..w[1] as usize];
+        if run.len() > 1 {
+            run.sort_unstable();
+        }
+    }
+    order
+}
+
 /// The corners around one vertex, in fan order, and whether the fan is open.
 #[derive(Default)]
 pub struct Fan {
@@ -40,22 +79,17 @@ impl CornerTable {
     pub fn new(vertex_count: usize, triangles: &[[u32; 3]]) -> CornerTable {
         let vertex: Vec<u32> = triangles.iter().flatten().copied().collect();
         let mut opposite = vec![NONE; vertex.len()];
-        // Key each corner by the undirected edge it faces; the corner's own
-        // direction (from `next` to `prev`) tells the two sides apart.
-        let mut keys: Vec<(u64, u32)> = (0..vertex.len() as u32)
-            .map(|c| {
-                let (u, v) = (vertex[next(c) as usize], vertex[prev(c) as usize]);
-                ((u64::from(u.min(v)) << 32) | u64::from(u.max(v)), c)
-            })
-            .collect();
-        keys.sort_unstable();
+        // Group the corners by the undirected edge they face; the corner's
+        // own direction (from `next` to `prev`) tells the two sides apart.
+        let from = |c: u32| vertex[next(c) as usize];
+        let ends = |c: u32| (from(c), vertex[prev(c) as usize]);
+        let keys = by_undirected_edge(vertex_count, vertex.len(), |c| Some(ends(c)));
         for run in keys.chunk_by(|x, y| x.0 == y.0) {
-            if let [(_, c0), (_, c1)] = *run {
-                let from = |c: u32| vertex[next(c) as usize];
-                if from(c0) != from(c1) {
-                    opposite[c0 as usize] = c1;
-                    opposite[c1 as usize] = c0;
-                }
+            if let [(_, c0), (_, c1)] = *run
+                && from(c0) != from(c1)
+            {
+                opposite[c0 as usize] = c1;
+                opposite[c1 as usize] = c0;
             }
         }
         let mut corner_of = vec![NONE; vertex_count];
@@ -202,6 +236,20 @@ impl CornerTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn edges_come_in_key_order() {
+        let pairs: Vec<(u32, u32)> = (0..500u32)
+            .map(|i| ((i * 37) % 23, (i * 11 + 5) % 29))
+            .collect();
+        let ends = |i: u32| (i % 7 != 3).then(|| pairs[i as usize]);
+        let got = by_undirected_edge(29, pairs.len(), ends);
+        let mut want: Vec<(u64, u32)> = (0..pairs.len() as u32)
+            .filter_map(|i| ends(i).map(|(u, v)| (((u.min(v) as u64) << 32) | u.max(v) as u64, i)))
+            .collect();
+        want.sort_unstable();
+        assert_eq!(got, want);
+    }
 
     #[test]
     fn fans_of_a_square() {

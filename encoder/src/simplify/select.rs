@@ -1,8 +1,15 @@
 //! Step a of §2: each vertex's best incident edge, with the sub-grid tie-break.
+//!
+//! Validity is checked lazily: a vertex points at its cheapest edge not known
+//! to be invalid, and only the pairs that step c chooses are checked
+//! (`check_collapse`, in `state`). A refused edge is stamped in its slot with
+//! the state it was refused in and stays refused until a collapse changes the
+//! 1-ring of one of its endpoints, the only thing that can make it valid.
+//! Checking a few chosen pairs instead of every dirty vertex's candidates is
+//! most of the simplifier's speed.
 
-use super::check::{CheckScratch, check_collapse};
 use super::state::State;
-use crate::corner_table::{NONE, next, prev};
+use crate::corner_table::{Fan, NONE, next, prev};
 use crate::quadric::collapse_target;
 
 /// A vertex's chosen collapse; `other == NONE` when it has none.
@@ -14,6 +21,9 @@ pub struct Best {
     /// errors tie exactly and the tie-breaks decide.
     pub error_key: u32,
     pub target: [u32; 3],
+    /// A corner facing the edge (its slot in the Edge array); [`NONE`] where
+    /// the chooser does not track slots (GPU backends).
+    pub corner: u32,
 }
 
 impl Best {
@@ -22,6 +32,7 @@ impl Best {
         error: f64::INFINITY,
         error_key: u32::MAX,
         target: [0; 3],
+        corner: NONE,
     };
 }
 
@@ -60,22 +71,47 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
     } else {
         let (t, _) = collapse_target(&q, s.geometry[pi], s.geometry[ci], false);
         let top = ((1u64 << s.bits) - 1) as f64;
-        std::array::from_fn(|k| (t[k] / s.metric[k]).round().clamp(0.0, top) as u32)
+        std::array::from_fn(|k| to_grid(t[k] / s.metric[k], top))
     };
     Some((target, q.error(s.to_metric(target))))
 }
 
+/// `x.round().clamp(0.0, top) as u32` (round half away from zero), without
+/// the libm call `round` becomes on x86-64 without SSE4.1: three per edge
+/// evaluation, a sixth of its time.
+fn to_grid(x: f64, top: f64) -> u32 {
+    // Beyond 2^52 every f64 is an integer; NaN goes to 0 as with `round`.
+    if x.is_nan() || x.abs() >= 4.0e15 {
+        return x.clamp(0.0, top) as u32;
+    }
+    let i = x as i64;
+    let fraction = x - i as f64;
+    let r = if fraction >= 0.5 {
+        i + 1
+    } else if fraction <= -0.5 {
+        i - 1
+    } else {
+        i
+    };
+    (r as f64).clamp(0.0, top) as u32
+}
+
 /// Cached collapse of the edge facing one corner (the paper's Edge array).
+/// Both corners facing an edge hold the same slot.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EdgeSlot {
     pub error: f64,
     pub target: [u32; 3],
+    /// State number (see [`Known`]) in which the collapse was checked and
+    /// found invalid; 0 if it never was since the slot was evaluated.
+    pub refused: u32,
 }
 
 impl EdgeSlot {
     pub const FORBIDDEN: EdgeSlot = EdgeSlot {
         error: f64::INFINITY,
         target: [0; 3],
+        refused: 0,
     };
 }
 
@@ -86,7 +122,11 @@ pub fn edge_slot(s: &State, c: u32) -> EdgeSlot {
         return EdgeSlot::FORBIDDEN;
     }
     match evaluate(s, a, b) {
-        Some((target, error)) => EdgeSlot { error, target },
+        Some((target, error)) => EdgeSlot {
+            error,
+            target,
+            refused: 0,
+        },
         None => EdgeSlot::FORBIDDEN,
     }
 }
@@ -101,90 +141,199 @@ pub struct Scale {
 }
 
 fn cell_of(p: [f64; 3], cell: f64) -> [i64; 3] {
-    p.map(|x| (x / cell).floor() as i64)
+    p.map(|x| floor_i64(x / cell))
 }
 
-/// The best valid collapse of `v` (§2 step a), from the cached edge slots.
-pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) -> Best {
-    best_edge_avoiding(s, v, scale, scratch, &[])
+/// `x.floor() as i64`, without the libm call `floor` becomes on x86-64
+/// without SSE4.1 (the cell tie-break runs once per considered edge).
+pub(super) fn floor_i64(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) > x {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
 }
 
-/// [`best_edge`] among the neighbours `u` with `blocked[u] == false`
-/// (`blocked` empty: all of them).
-pub fn best_edge_avoiding(
+/// What the chooser knows about validity and this step's blocked vertices.
+/// States are numbered from 1: state k is the mesh step k - 1 selects on.
+#[derive(Clone, Copy)]
+pub struct Known<'a> {
+    /// The current state.
+    pub state: u32,
+    /// Per vertex, the state since which its 1-ring is what it is now.
+    pub changed: &'a [u32],
+    /// Per vertex, `== state` when a winner of this step blocks it.
+    pub blocked: &'a [u32],
+}
+
+impl Known<'_> {
+    /// Whether a slot's refusal still holds: neither endpoint's 1-ring (fan
+    /// and neighbour positions, all a check reads but the wings' valences,
+    /// which only fall and so cannot make a refused edge valid) changed
+    /// since the refusal.
+    pub fn refused(&self, slot: &EdgeSlot, v: u32, u: u32) -> bool {
+        slot.refused != 0
+            && slot.refused >= self.changed[v as usize]
+            && slot.refused >= self.changed[u as usize]
+    }
+}
+
+/// Order of one vertex's requests: error key, then same sub-grid cell
+/// (Fig. 2), then the minimal coordinates of the other end, then its id.
+type Rank = (u32, bool, [u32; 3], u32);
+
+/// How vertex `v` (sub-grid cell `home`) ranks its edge to `u`.
+fn rank(s: &State, home: Option<[i64; 3]>, scale: Scale, error_key: u32, u: u32) -> Rank {
+    let other_cell = home.is_some_and(|h| h != cell_of(s.geometry(u), scale.cell));
+    (error_key, other_cell, s.positions[u as usize], u)
+}
+
+fn error_key(error: f64, scale: Scale) -> u32 {
+    if error <= scale.flat {
+        0
+    } else {
+        (error as f32).to_bits()
+    }
+}
+
+fn home(s: &State, v: u32, scale: Scale) -> Option<[i64; 3]> {
+    (scale.cell > 0.0).then(|| cell_of(s.geometry(v), scale.cell))
+}
+
+/// §2 step a: the cheapest edge of `v` to a neighbour that is not blocked,
+/// skipping edges known to be invalid (their validity is checked only once
+/// chosen), in [`Rank`] order.
+///
+/// `reopened` receives the neighbours `u` whose edge to `v` was refused before
+/// `v`'s 1-ring last changed: that edge may be valid again and `u` should
+/// choose again too.
+pub fn pick_edge(
     s: &State,
     v: u32,
     scale: Scale,
-    scratch: &mut CheckScratch,
-    blocked: &[bool],
+    known: Known<'_>,
+    fan: &mut Fan,
+    reopened: &mut Vec<u32>,
 ) -> Best {
     if !s.alive[v as usize] {
         return Best::NONE;
     }
-    let mut fan = std::mem::take(&mut scratch.fan_v);
-    s.table.fan(v, &mut fan);
-    let mut candidates = std::mem::take(&mut scratch.candidates);
-    candidates.clear();
-    let home = (scale.cell > 0.0).then(|| cell_of(s.geometry(v), scale.cell));
-    for &c in &fan.corners {
-        // Edge (v, next c) faces prev c; edge (v, prev c) faces next c.
-        for (u, facing) in [(s.table.v(next(c)), prev(c)), (s.table.v(prev(c)), next(c))] {
-            if candidates.iter().any(|x: &Candidate| x.other == u)
-                || blocked.get(u as usize).copied().unwrap_or(false)
-            {
-                continue;
-            }
-            let slot = s.edges[facing as usize];
-            if slot.error == f64::INFINITY {
-                continue;
-            }
-            let error_key = if slot.error <= scale.flat {
-                0
-            } else {
-                (slot.error as f32).to_bits()
-            };
-            let other_cell = home.is_some_and(|h| h != cell_of(s.geometry(u), scale.cell));
-            candidates.push(Candidate {
-                rank: (error_key, other_cell, s.positions[u as usize], u),
-                other: u,
-                best: Best {
-                    other: u,
-                    error: slot.error,
-                    error_key,
-                    target: slot.target,
-                },
-            });
-        }
-    }
-    candidates.sort_unstable_by_key(|x| x.rank);
+    s.table.fan(v, fan);
+    let home = home(s, v, scale);
+    let changed_v = known.changed[v as usize];
     let mut found = Best::NONE;
-    for cand in &candidates {
-        let (p, c) = (v.min(cand.other), v.max(cand.other));
-        if check_collapse(s, p, c, s.to_metric(cand.best.target), scratch).is_ok() {
-            found = cand.best;
-            break;
+    let mut found_rank: Rank = (u32::MAX, true, [u32::MAX; 3], NONE);
+    let mut consider = |u: u32, facing: u32| {
+        if known.blocked[u as usize] == known.state {
+            return;
+        }
+        let slot = &s.edges[facing as usize];
+        if slot.error == f64::INFINITY {
+            return;
+        }
+        if slot.refused != 0 {
+            if known.refused(slot, v, u) {
+                return;
+            }
+            if slot.refused < changed_v {
+                reopened.push(u);
+            }
+        }
+        let error_key = error_key(slot.error, scale);
+        // Keys of real errors stay below u32::MAX, the key of no choice.
+        if error_key > found.error_key {
+            return;
+        }
+        let rank = rank(s, home, scale, error_key, u);
+        if rank < found_rank {
+            found_rank = rank;
+            found = Best {
+                other: u,
+                error: slot.error,
+                error_key,
+                target: slot.target,
+                corner: facing,
+            };
+        }
+    };
+    // Every edge of v once: (v, next c) faces prev c for each corner c; on a
+    // boundary the edge (v, prev c) of the fan's open end faces next c and
+    // has no corner of its own.
+    for &c in &fan.corners {
+        consider(s.table.v(next(c)), prev(c));
+        if s.table.o(next(c)) == NONE {
+            consider(s.table.v(prev(c)), next(c));
         }
     }
-    scratch.fan_v = fan;
-    scratch.candidates = candidates;
     found
 }
 
-/// A candidate edge of one vertex, ranked by error, then same sub-grid cell,
-/// then minimal coordinates of the other end (Fig. 2), then id.
-#[derive(Clone, Copy, Debug)]
-pub struct Candidate {
-    rank: (u32, bool, [u32; 3], u32),
-    other: u32,
-    best: Best,
+/// `current`, or the edge of `v` to `u` facing corner `facing` if that ranks
+/// first: what [`pick_edge`] would return for `v` when only that edge changed
+/// among edges that did not beat `current` (no refusals, nothing blocked).
+pub fn offer(s: &State, v: u32, current: Best, u: u32, facing: u32, scale: Scale) -> Best {
+    let slot = &s.edges[facing as usize];
+    if slot.error == f64::INFINITY {
+        return current;
+    }
+    let key = error_key(slot.error, scale);
+    if key > current.error_key {
+        return current;
+    }
+    let home = home(s, v, scale);
+    if current.other != NONE
+        && rank(s, home, scale, current.error_key, current.other) < rank(s, home, scale, key, u)
+    {
+        return current;
+    }
+    Best {
+        other: u,
+        error: slot.error,
+        error_key: key,
+        target: slot.target,
+        corner: facing,
+    }
 }
 
-impl Default for Candidate {
-    fn default() -> Self {
-        Candidate {
-            rank: (u32::MAX, true, [0; 3], NONE),
-            other: NONE,
-            best: Best::NONE,
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inline_rounding_matches_libm() {
+        let top = 16383.0;
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            2.5,
+            -1.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            16382.5,
+            16383.4999,
+            16383.5,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            4.0e15 + 0.5,
+            -3.2,
+            7.9999999,
+        ];
+        let mut x = 0.1234f64;
+        for _ in 0..10_000 {
+            x = (x * 7919.0 + 0.377).rem_euclid(40_000.0) - 10_000.0;
+            xs.push(x);
+            xs.push(x.floor() + 0.5);
+        }
+        for &x in &xs {
+            assert_eq!(to_grid(x, top), x.round().clamp(0.0, top) as u32, "{x}");
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
         }
     }
 }

@@ -2,8 +2,8 @@
 
 use rayon::prelude::*;
 
-use super::check::{CheckScratch, Plan, check_collapse};
-use super::select::{Best, EdgeSlot, Scale, best_edge, best_edge_avoiding, edge_slot, pair_key};
+use super::check::{CheckScratch, Plan, check_collapse, check_walked};
+use super::select::{Best, EdgeSlot, Known, Scale, edge_slot, offer, pair_key, pick_edge};
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
@@ -146,6 +146,114 @@ impl State {
     }
 }
 
+/// Time spent per phase over the whole simplification, printed under
+/// `SPLITSTREAM_DEBUG`.
+#[derive(Default)]
+struct Phases {
+    at: Option<std::time::Instant>,
+    seconds: Vec<(&'static str, f64)>,
+}
+
+impl Phases {
+    /// Charges the time since the last lap to `name`.
+    fn lap(&mut self, name: &'static str) {
+        let now = std::time::Instant::now();
+        if let Some(at) = self.at {
+            let dt = (now - at).as_secs_f64();
+            match self.seconds.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, s)) => *s += dt,
+                None => self.seconds.push((name, dt)),
+            }
+        }
+        self.at = Some(now);
+    }
+
+    fn report(&self) -> String {
+        let total: f64 = self.seconds.iter().map(|(_, s)| s).sum();
+        let parts: Vec<String> = self
+            .seconds
+            .iter()
+            .map(|(n, s)| format!("{n} {:.0}", s * 1e3))
+            .collect();
+        format!(
+            "simplify phases, ms (total {:.0}): {}",
+            total * 1e3,
+            parts.join(", ")
+        )
+    }
+}
+
+/// Per-vertex bookkeeping of the CPU step loop (the GPU backends keep their
+/// own on the device). The `u32` stamps hold state numbers ([`Known`]), so
+/// none is ever cleared.
+struct Tracking {
+    /// Each vertex's request (§2 step a), chosen without the constraints of
+    /// a step's later passes.
+    best: Vec<Best>,
+    /// Requests chosen again within a step (blocked partners, refused
+    /// edges), valid where `repick_at == state`; they never outlive it.
+    repick: Vec<Best>,
+    repick_at: Vec<u32>,
+    /// State since which each vertex's 1-ring is what it is.
+    changed: Vec<u32>,
+    /// `== state`: the vertex was merged (survived as R) at the last step.
+    merged: Vec<u32>,
+    /// Latest state in which one of the vertex's edges was refused (0: none
+    /// since its 1-ring last changed).
+    refusals: Vec<u32>,
+    /// `== state`: a winner of this step blocks the vertex.
+    blocked: Vec<u32>,
+    /// `== state`: the vertex chooses from scratch at this step.
+    listed: Vec<u32>,
+    /// `== state`: the vertex was sorted into choosing or taking offers.
+    sorted: Vec<u32>,
+    /// Pair key of each vertex's admitted request in the current pass,
+    /// `u64::MAX` otherwise (reset after each pass, so never swept whole).
+    keys: Vec<u64>,
+}
+
+impl Tracking {
+    fn new(n: usize) -> Tracking {
+        Tracking {
+            best: vec![Best::NONE; n],
+            repick: vec![Best::NONE; n],
+            repick_at: vec![0; n],
+            changed: vec![0; n],
+            merged: vec![0; n],
+            refusals: vec![0; n],
+            blocked: vec![0; n],
+            // Every vertex is on the first step's list.
+            listed: vec![1; n],
+            sorted: vec![0; n],
+            keys: vec![u64::MAX; n],
+        }
+    }
+
+    fn known(&self, state: u32) -> Known<'_> {
+        Known {
+            state,
+            changed: &self.changed,
+            blocked: &self.blocked,
+        }
+    }
+
+    /// The request of `v` in the current pass of step `state`.
+    fn request(&self, v: u32, state: u32) -> &Best {
+        if self.repick_at[v as usize] == state {
+            &self.repick[v as usize]
+        } else {
+            &self.best[v as usize]
+        }
+    }
+}
+
+/// A collapse chosen and checked in this step, with what applying it needs.
+struct Winner {
+    p: u32,
+    best: Best,
+    plan: Plan,
+}
+
 /// Simplifies `mesh` (quantized, checked manifold) with the parallel algorithm.
 pub fn simplify(
     mesh: &QuantizedMesh,
@@ -153,27 +261,37 @@ pub fn simplify(
     mut progress: impl FnMut(usize),
 ) -> Simplification {
     let n = mesh.positions.len();
+    let mut phases = Phases::default();
+    phases.lap("");
     let mut s = State::new(mesh, options);
+    phases.lap("table");
     s.quadrics = vertex_quadrics(&s.geometry, &mesh.triangles, options.boundary_weight);
-    s.edges = (0..s.table.vertex.len() as u32)
-        .into_par_iter()
-        .map(|c| edge_slot(&s, c))
-        .collect();
+    phases.lap("quadrics");
+    s.edges = initial_slots(&s);
+    phases.lap("slots");
     let mut alive_count = s.alive.iter().filter(|&&a| a).count();
     let mut steps = Vec::new();
     let mut step_errors = Vec::new();
     let mut threshold = 0.0f64;
-    let mut best = vec![Best::NONE; n];
+    let mut t = Tracking::new(n);
     let mut live: Vec<u32> = (0..n as u32).filter(|&v| s.alive[v as usize]).collect();
-    let mut dirty = vec![true; n];
+    // Who chooses at the start of a step (all vertices at the first): see
+    // `refresh_edges` and `step_winners`; `offers` are the edges refreshed
+    // by the last step's collapses, for their other ends.
+    let mut choosers = live.clone();
+    let mut offers: Vec<Offer> = Vec::new();
     let limit = options.max_error.unwrap_or(f64::INFINITY);
+    let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
     // The mean edge length sets the sub-grid and the flat threshold; it
     // changes slowly, so it is measured again only when a fifth of the
     // vertices are gone since the last measure (a full pass over the corners).
-    let (mut edge, mut edge_measured_at) = (mean_edge_length(&s), alive_count);
+    let mut meter = EdgeMeter::new(&s);
+    let (mut edge, mut edge_measured_at) = (meter.measure(&s), alive_count);
     while alive_count > options.target_vertices {
+        let state = steps.len() as u32 + 1;
+        phases.lap("loop");
         if alive_count * 5 < edge_measured_at * 4 {
-            edge = mean_edge_length(&s);
+            edge = meter.measure(&s);
             edge_measured_at = alive_count;
         }
         let scale = Scale {
@@ -183,22 +301,24 @@ pub fn simplify(
             flat: 1e-8 * edge.powi(4),
         };
         let t_best = std::time::Instant::now();
-        // Only vertices whose 2-ring changed can have a new best edge; the
-        // passes below run over the live vertices only.
-        let updates: Vec<(u32, Best)> = live
-            .par_iter()
-            .filter(|&&v| dirty[v as usize])
-            .map_init(CheckScratch::default, |scratch, &v| {
-                (v, best_edge(&s, v, scale, scratch))
-            })
+        phases.lap("measure");
+        let offered = take_offers(&s, &mut t, &offers, &mut choosers, scale, state);
+        phases.lap("offers");
+        let reopened = choose(&s, &mut t, &choosers, scale, state);
+        phases.lap("choose");
+        // Neighbours whose refused edge to a changed vertex may be valid
+        // again choose too (they reopen nothing themselves: their own 1-ring
+        // did not change).
+        let again: Vec<u32> = reopened
+            .into_iter()
+            .filter(|&u| std::mem::replace(&mut t.listed[u as usize], state) != state)
             .collect();
-        for (v, b) in updates {
-            best[v as usize] = b;
-        }
+        choose(&s, &mut t, &again, scale, state);
+        let chose = choosers.len() + again.len();
         // Raise S to the admitted quantile of the current candidate errors.
         let mut errors: Vec<f64> = live
             .iter()
-            .map(|&v| &best[v as usize])
+            .map(|&v| &t.best[v as usize])
             .filter(|b| b.other != NONE)
             .map(|b| b.error)
             .collect();
@@ -209,7 +329,20 @@ pub fn simplify(
         let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
         threshold = threshold.max(*quantile).min(limit);
         let t_select = std::time::Instant::now();
-        let mut winners = step_winners(&s, &mut best, &live, threshold, scale);
+        phases.lap("quantile");
+        choosers.clear();
+        let mut winners = step_winners(
+            &mut s,
+            &mut t,
+            &live,
+            Step {
+                state,
+                threshold,
+                scale,
+            },
+            &mut choosers,
+            &mut phases,
+        );
         // Nothing under S: raise it (the paper's "S is increased"), doubling
         // past the smallest candidate error, until a step finds collapses or
         // S passes every candidate error or the maximum error.
@@ -220,7 +353,18 @@ pub fn simplify(
                 .max(smallest)
                 .max(f64::MIN_POSITIVE)
                 .min(limit);
-            winners = step_winners(&s, &mut best, &live, threshold, scale);
+            winners = step_winners(
+                &mut s,
+                &mut t,
+                &live,
+                Step {
+                    state,
+                    threshold,
+                    scale,
+                },
+                &mut choosers,
+                &mut phases,
+            );
         }
         if winners.is_empty() {
             break;
@@ -228,32 +372,44 @@ pub fn simplify(
         // Hit the target exactly: keep the cheapest collapses of the last step.
         let room = alive_count - options.target_vertices;
         if winners.len() > room {
-            winners.sort_by_key(|&v| pair_key(&best[v as usize], v));
+            winners.sort_by_key(|w| pair_key(&w.best, w.p));
             winners.truncate(room);
-            winners.sort_unstable();
+            winners.sort_unstable_by_key(|w| w.p);
         }
         let t_apply = std::time::Instant::now();
+        phases.lap("select");
         let mut collapses = Vec::with_capacity(winners.len());
         let mut fans = [Fan::default(), Fan::default()];
         let mut step_error = 0.0f64;
-        for &p in &winners {
-            let b = best[p as usize];
-            let collapse = apply_collapse(&mut s, p, b, &mut fans);
-            step_error = step_error.max(b.error);
-            collapses.push(collapse);
+        for w in &winners {
+            debug_assert_eq!(
+                check_collapse(
+                    &s,
+                    w.p,
+                    w.best.other,
+                    s.to_metric(w.best.target),
+                    &mut CheckScratch::default()
+                ),
+                Ok(w.plan),
+                "a winner's check holds after the other collapses of its step"
+            );
+            collapses.push(apply_plan(&mut s, w.p, w.best, w.plan, &mut fans));
+            step_error = step_error.max(w.best.error);
         }
         let t_refresh = std::time::Instant::now();
-        refresh_edges(&mut s, &winners);
+        phases.lap("apply");
+        let merged: Vec<u32> = winners.iter().map(|w| w.p).collect();
+        offers = refresh_edges(&mut s, &mut t, &merged, state + 1, &mut choosers);
+        phases.lap("refresh");
         live.retain(|&v| s.alive[v as usize]);
-        mark_two_rings(&s, &winners, &mut dirty);
-        if std::env::var_os("SPLITSTREAM_DEBUG").is_some() {
+        phases.lap("retain");
+        if debug {
             let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
             let now = std::time::Instant::now();
             eprintln!(
-                "step {}: alive {alive_count}, collapses {}, dirty {}, ms: best {:.1} select {:.1} apply {:.1} refresh {:.1}",
+                "step {}: alive {alive_count}, collapses {}, chose {chose}, offered {offered}, ms: best {:.1} select {:.1} apply {:.1} refresh {:.1}",
                 steps.len(),
                 winners.len(),
-                dirty.iter().filter(|&&d| d).count(),
                 ms(t_best, t_select),
                 ms(t_select, t_apply),
                 ms(t_apply, t_refresh),
@@ -264,6 +420,9 @@ pub fn simplify(
         steps.push(collapses);
         step_errors.push(step_error);
         progress(n - alive_count);
+    }
+    if debug {
+        eprintln!("{}", phases.report());
     }
     Simplification {
         steps,
@@ -276,112 +435,317 @@ pub fn simplify(
     }
 }
 
+/// Every corner's edge slot, each edge evaluated once for its two corners.
+fn initial_slots(s: &State) -> Vec<EdgeSlot> {
+    let t = &s.table;
+    let mut edges: Vec<EdgeSlot> = (0..t.vertex.len() as u32)
+        .into_par_iter()
+        .map(|c| match t.o(c) {
+            o if o != NONE && o < c => EdgeSlot::FORBIDDEN,
+            _ => edge_slot(s, c),
+        })
+        .collect();
+    for c in 0..edges.len() {
+        let o = t.opposite[c];
+        if o != NONE && (o as usize) < c {
+            edges[c] = edges[o as usize];
+        }
+    }
+    edges
+}
+
+/// A refreshed edge of merged vertex `r`, offered to its other end `x`.
+#[derive(Clone, Copy)]
+struct Offer {
+    x: u32,
+    r: u32,
+    /// A corner facing the edge.
+    facing: u32,
+}
+
+/// Sorts the neighbours of the last step's merged vertices into those that
+/// must choose from scratch (appended to `choosers`) and those for which the
+/// refreshed edge to R is the only change, which take it if it beats their
+/// request. Returns how many took offers.
+///
+/// A neighbour x of R whose request was not its edge to P or C, and that has
+/// no refused edge, keeps every other edge as it was (its quadric, position
+/// and other neighbours are unchanged), so [`pick_edge`] would return the
+/// better of its request and the offers; the edges to P and C it loses did
+/// not beat its request. Most of a step's changed vertices are such
+/// neighbours, and an offer costs no fan walk.
+fn take_offers(
+    s: &State,
+    t: &mut Tracking,
+    offers: &[Offer],
+    choosers: &mut Vec<u32>,
+    scale: Scale,
+    state: u32,
+) -> usize {
+    let mut offered = 0;
+    for o in offers {
+        let x = o.x as usize;
+        if t.sorted[x] != state {
+            t.sorted[x] = state;
+            let b = &t.best[x];
+            let lost = b.other != NONE
+                && (!s.alive[b.other as usize] || t.merged[b.other as usize] == state);
+            if t.listed[x] != state && (lost || t.refusals[x] != 0) {
+                t.listed[x] = state;
+                choosers.push(o.x);
+            }
+            if t.listed[x] != state {
+                offered += 1;
+            }
+        }
+        if t.listed[x] == state {
+            continue;
+        }
+        t.best[x] = offer(s, o.x, t.best[x], o.r, o.facing, scale);
+    }
+    // Every chooser's refused edges are stale now (its 1-ring changed, or
+    // it was refused and chooses without the refused edge).
+    for &v in choosers.iter() {
+        if t.changed[v as usize] == state {
+            t.refusals[v as usize] = 0;
+        }
+    }
+    offered
+}
+
+/// §2 step a for `vertices`, in parallel: their requests are replaced.
+/// Returns the neighbours whose refused edges the choosers found reopened.
+fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u32) -> Vec<u32> {
+    let (updates, reopened) = pick_all(s, t, vertices, scale, state);
+    for (v, b) in updates {
+        t.best[v as usize] = b;
+    }
+    reopened
+}
+
+/// [`pick_edge`] for each of `vertices`, in parallel: the requests in the
+/// order of `vertices`, and the reopened neighbours.
+fn pick_all(
+    s: &State,
+    t: &Tracking,
+    vertices: &[u32],
+    scale: Scale,
+    state: u32,
+) -> (Vec<(u32, Best)>, Vec<u32>) {
+    let known = t.known(state);
+    let chunks = par_chunks_map(vertices, |chunk| {
+        let mut fan = Fan::default();
+        let mut reopened = Vec::new();
+        let picks: Vec<(u32, Best)> = chunk
+            .iter()
+            .map(|&v| (v, pick_edge(s, v, scale, known, &mut fan, &mut reopened)))
+            .collect();
+        (picks, reopened)
+    });
+    let mut picks = Vec::with_capacity(vertices.len());
+    let mut reopened = Vec::new();
+    for (p, r) in chunks {
+        picks.extend(p);
+        reopened.extend(r);
+    }
+    (picks, reopened)
+}
+
+/// `f` over consecutive chunks of `items` in parallel, the results in
+/// order. Each chunk fills its own buffers: no allocation per item and no
+/// merging copies (rayon's fold/reduce re-copies at every level).
+fn par_chunks_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&[T]) -> R + Sync + Send) -> Vec<R> {
+    let size = (items.len() / (8 * rayon::current_num_threads())).clamp(512, 16384);
+    items.par_chunks(size).map(f).collect()
+}
+
+/// What one step selects with: its state number, the threshold S and the
+/// scale of the tie-breaks.
+#[derive(Clone, Copy)]
+struct Step {
+    state: u32,
+    threshold: f64,
+    scale: Scale,
+}
+
 /// Steps b and c: reciprocal pairs under the threshold that are local minima
-/// among the requests of their 1-rings. Returns the survivors (lower ids).
+/// among the requests of their 1-rings, each then checked (`check_collapse`);
+/// returns the valid ones in ascending survivor id (the lower id).
 ///
 /// Steps a to c are then repeated on what they left undecided: a vertex
 /// whose partner was taken by a cheaper collapse chooses again among its free
-/// neighbours, and a pair blocked only by a pair that itself lost gets its
-/// turn. The passes grow the step towards a maximal set of independent
-/// collapses in error order, still in parallel; more collapses per step mean
-/// fewer rounds and fewer flags in the stream. Vertices changed here are all
-/// within the 2-ring of a collapse, so they are recomputed next step.
+/// neighbours, the two ends of a refused pair choose again without that edge,
+/// and a pair blocked only by a pair that itself lost gets its turn. The
+/// passes grow the step towards a maximal set of independent collapses in
+/// error order, still in parallel; more collapses per step mean fewer rounds
+/// and fewer flags in the stream. Choices made again here last for the step
+/// only (`Tracking::repick`); the ends of refused pairs are appended to
+/// `refused_ends` to choose from scratch at the next step.
 fn step_winners(
-    s: &State,
-    best: &mut [Best],
+    s: &mut State,
+    t: &mut Tracking,
     live: &[u32],
-    threshold: f64,
-    scale: Scale,
-) -> Vec<u32> {
-    // On jacksboro the passes add 100 %, 30 %, 4 % and 0.2 % of the first
-    // pass's collapses: a fourth pass is not worth its O(n) sweeps.
+    step: Step,
+    refused_ends: &mut Vec<u32>,
+    phases: &mut Phases,
+) -> Vec<Winner> {
+    let Step {
+        state,
+        threshold,
+        scale,
+    } = step;
+    // Passes that find winners; on jacksboro they add 100 %, 30 %, 4 % and
+    // 0.2 % of the first pass's collapses: a fourth is not worth its O(n)
+    // sweeps. A pass whose chosen pairs are all refused does not count (each
+    // such pass refuses edges for good, so they are finitely many).
     const PASSES: usize = 3;
-    let n = best.len();
-    let mut blocked = vec![false; n];
-    let mut winners = Vec::new();
-    for pass in 0..PASSES {
-        if pass > 0 {
-            let updates: Vec<(u32, Best)> = live
+    let mut winners: Vec<Winner> = Vec::new();
+    let mut refused_now: Vec<u32> = Vec::new();
+    let mut counted = 0;
+    let mut first = true;
+    // Only vertices whose request is under S can take part: choosing again
+    // among fewer neighbours never gets cheaper (up to requests of equal f32
+    // key, whose order the tie-breaks decide, not the error).
+    let tr: &Tracking = t;
+    let players: Vec<u32> = live
+        .par_iter()
+        .copied()
+        .filter(|&v| {
+            let b = &tr.best[v as usize];
+            b.other != NONE && b.error <= threshold
+        })
+        .collect();
+    let live = &players[..];
+    loop {
+        if !first {
+            let tr: &Tracking = t;
+            let mut again: Vec<u32> = live
                 .par_iter()
                 .copied()
                 .filter(|&v| {
-                    let b = &best[v as usize];
-                    s.alive[v as usize]
-                        && !blocked[v as usize]
+                    let b = tr.request(v, state);
+                    tr.blocked[v as usize] != state
                         && b.other != NONE
-                        && blocked[b.other as usize]
-                })
-                .map_init(CheckScratch::default, |scratch, v| {
-                    (v, best_edge_avoiding(s, v, scale, scratch, &blocked))
+                        && b.error <= threshold
+                        && tr.blocked[b.other as usize] == state
                 })
                 .collect();
+            // The ends of a refused pair are never blocked: a winner of the
+            // same pass would be in their 1-ring, and both cannot be local
+            // minima.
+            again.append(&mut refused_now);
+            phases.lap("repick scan");
+            let (updates, _) = pick_all(s, t, &again, scale, state);
             for (v, b) in updates {
-                best[v as usize] = b;
+                t.repick[v as usize] = b;
+                t.repick_at[v as usize] = state;
             }
+            phases.lap("repick");
         }
-        let best_now: &[Best] = best;
-        let admitted = |v: usize| {
-            let b = &best_now[v];
-            !blocked[v]
+        first = false;
+        let tr: &Tracking = t;
+        let admitted = |v: u32| {
+            let b = tr.request(v, state);
+            tr.blocked[v as usize] != state
                 && b.other != NONE
                 && b.error <= threshold
-                && best_now[b.other as usize].other == v as u32
+                && tr.request(b.other, state).other == v
         };
         // One key per pair, taken from its lower endpoint, so that both
         // endpoints compare alike (their cached errors may come from
         // different steps).
         let admitted_keys: Vec<(u32, u64)> = live
             .par_iter()
-            .filter(|&&v| admitted(v as usize))
+            .filter(|&&v| admitted(v))
             .map(|&v| {
-                let low = v.min(best_now[v as usize].other);
-                (v, pair_key(&best_now[low as usize], low))
+                let low = v.min(tr.request(v, state).other);
+                (v, pair_key(tr.request(low, state), low))
             })
             .collect();
-        let mut keys = vec![u64::MAX; n];
         for &(v, key) in &admitted_keys {
-            keys[v as usize] = key;
+            t.keys[v as usize] = key;
         }
-        let chosen: Vec<u32> = admitted_keys
-            .par_iter()
-            .map(|&(v, _)| v)
-            .filter(|&v| {
-                let key = keys[v as usize];
-                let c = best_now[v as usize].other;
-                key != u64::MAX && v < c && is_local_minimum(s, v, c, key, &keys)
-            })
-            .collect();
-        if chosen.is_empty() {
+        phases.lap("admit");
+        let tr: &Tracking = t;
+        let s_now: &State = s;
+        // Local minima, checked; a valid one lists the vertices it blocks
+        // (from the fans its check walked).
+        type Checked = (Vec<(u32, Result<Plan, ()>)>, Vec<u32>);
+        let checked: Vec<Checked> = par_chunks_map(&admitted_keys, |chunk| {
+            let mut scratch = CheckScratch::default();
+            let (mut out, mut blocks) = (Vec::new(), Vec::new());
+            for &(v, key) in chunk {
+                let c = tr.request(v, state).other;
+                if v > c {
+                    continue;
+                }
+                let (fan_p, fan_c) = scratch.walk(s_now, v, c);
+                if !is_local_minimum(s_now, v, c, key, &tr.keys, [fan_p, fan_c]) {
+                    continue;
+                }
+                let target = s_now.to_metric(tr.request(v, state).target);
+                let result = check_walked(s_now, v, c, target, &mut scratch);
+                if result.is_ok() {
+                    blocks.extend(scratch.neighbourhood());
+                }
+                out.push((v, result));
+            }
+            (out, blocks)
+        });
+        for &(v, _) in &admitted_keys {
+            t.keys[v as usize] = u64::MAX;
+        }
+        phases.lap("minima+check");
+        if checked.iter().all(|(out, _)| out.is_empty()) {
             break;
         }
-        // The chosen pairs' endpoints and neighbours leave the game.
-        let touched: Vec<u32> = chosen
-            .par_iter()
-            .flat_map_iter(|&v| {
-                let mut fan = Fan::default();
-                let mut out = Vec::new();
-                for x in [v, best_now[v as usize].other] {
-                    out.push(x);
-                    s.table.fan(x, &mut fan);
-                    out.extend(fan.corners.iter().map(|&k| s.table.v(next(k))));
-                    out.extend(fan.corners.iter().map(|&k| s.table.v(prev(k))));
+        let mut found = false;
+        for (p, result) in checked.iter().flat_map(|(out, _)| out.iter().copied()) {
+            let b = *t.request(p, state);
+            match result {
+                Ok(plan) => {
+                    found = true;
+                    winners.push(Winner { p, best: b, plan });
                 }
-                out
-            })
-            .collect();
-        for x in touched {
-            blocked[x as usize] = true;
+                Err(()) => {
+                    // Both corners facing the edge hold its slot.
+                    s.edges[b.corner as usize].refused = state;
+                    let across = s.table.o(b.corner);
+                    if across != NONE {
+                        s.edges[across as usize].refused = state;
+                    }
+                    for x in [p, b.other] {
+                        t.refusals[x as usize] = state;
+                        refused_now.push(x);
+                        if t.listed[x as usize] != state + 1 {
+                            t.listed[x as usize] = state + 1;
+                            refused_ends.push(x);
+                        }
+                    }
+                }
+            }
         }
-        winners.extend_from_slice(&chosen);
+        if !found {
+            continue;
+        }
+        // The winners' endpoints and neighbours leave the game.
+        for (_, blocks) in &checked {
+            for &x in blocks {
+                t.blocked[x as usize] = state;
+            }
+        }
+        phases.lap("block");
+        counted += 1;
+        if counted == PASSES {
+            break;
+        }
     }
-    winners.sort_unstable();
+    winners.sort_unstable_by_key(|w| w.p);
     winners
 }
 
-fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64]) -> bool {
-    let mut fan = Fan::default();
-    for v in [p, c] {
-        s.table.fan(v, &mut fan);
+fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64], fans: [&Fan; 2]) -> bool {
+    for fan in fans {
         for &corner in &fan.corners {
             for x in [s.table.v(next(corner)), s.table.v(prev(corner))] {
                 if x != p && x != c && keys[x as usize] < key {
@@ -393,13 +757,6 @@ fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64]) -> bool {
     true
 }
 
-/// Applies the collapse chosen by `p`, returning its record.
-fn apply_collapse(s: &mut State, p: u32, b: Best, fans: &mut [Fan; 2]) -> Collapse {
-    try_apply_collapse(s, p, b, fans)
-        .expect("the winner was checked in this step and its neighbourhood is untouched")
-        .0
-}
-
 /// Applies the collapse chosen by `p` if `check_collapse` accepts it,
 /// returning its record and plan; `None` leaves the state untouched (GPU
 /// backends choose in f32, the CPU has the last word in f64).
@@ -409,9 +766,15 @@ pub(super) fn try_apply_collapse(
     b: Best,
     fans: &mut [Fan; 2],
 ) -> Option<(Collapse, Plan)> {
-    let c = b.other;
     let mut scratch = CheckScratch::default();
-    let plan = check_collapse(s, p, c, s.to_metric(b.target), &mut scratch).ok()?;
+    let plan = check_collapse(s, p, b.other, s.to_metric(b.target), &mut scratch).ok()?;
+    Some((apply_plan(s, p, b, plan, fans), plan))
+}
+
+/// Applies the collapse of `p` and `b.other` that `check_collapse` planned,
+/// returning its record.
+fn apply_plan(s: &mut State, p: u32, b: Best, plan: Plan, fans: &mut [Fan; 2]) -> Collapse {
+    let c = b.other;
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
     let weight = q.c[0] + q.c[4] + q.c[7];
     let distance = if weight > 0.0 {
@@ -440,38 +803,76 @@ pub(super) fn try_apply_collapse(
     s.boundary[pi] |= s.boundary[ci];
     s.alive[ci] = false;
     s.split_valence[pi] = plan.valence_r as u8;
-    Some((record, plan))
+    record
 }
 
-/// Re-evaluates the edges around each merged vertex: only their quadric or
-/// position changed.
-fn refresh_edges(s: &mut State, merged: &[u32]) {
-    let updates: Vec<(u32, EdgeSlot)> = merged
-        .par_iter()
-        .flat_map_iter(|&r| {
-            let mut fan = Fan::default();
-            s.table.fan(r, &mut fan);
-            let mut out = Vec::with_capacity(4 * fan.corners.len());
+/// Re-evaluates the edges around each merged vertex (only their quadric or
+/// position changed) and stamps the merged vertices and their neighbours as
+/// changed in `next_state` (their 1-rings are new). The merged vertices are
+/// appended to `choosers`; their neighbours get the refreshed edges as
+/// offers (returned, see `take_offers`): no other vertex's request can
+/// change.
+fn refresh_edges(
+    s: &mut State,
+    t: &mut Tracking,
+    merged: &[u32],
+    next_state: u32,
+    choosers: &mut Vec<u32>,
+) -> Vec<Offer> {
+    let s_now: &State = s;
+    let chunks = par_chunks_map(merged, |chunk| {
+        let mut fan = Fan::default();
+        // About six edges a vertex, most with two corners.
+        let mut updates = Vec::with_capacity(14 * chunk.len());
+        let mut offers = Vec::with_capacity(7 * chunk.len());
+        for &r in chunk {
+            s_now.table.fan(r, &mut fan);
             for &c in &fan.corners {
                 // Edge (r, prev c) faces next c and, across it, the opposite
                 // corner: evaluate it once for both. A boundary edge
                 // (r, next c) has no other side and is evaluated on its own.
-                let slot = edge_slot(s, next(c));
-                out.push((next(c), slot));
-                let across = s.table.o(next(c));
+                let slot = edge_slot(s_now, next(c));
+                updates.push((next(c), slot));
+                let across = s_now.table.o(next(c));
                 if across != NONE {
-                    out.push((across, slot));
+                    updates.push((across, slot));
                 }
-                if s.table.o(prev(c)) == NONE {
-                    out.push((prev(c), edge_slot(s, prev(c))));
+                offers.push(Offer {
+                    x: s_now.table.v(prev(c)),
+                    r,
+                    facing: next(c),
+                });
+                if s_now.table.o(prev(c)) == NONE {
+                    updates.push((prev(c), edge_slot(s_now, prev(c))));
+                    offers.push(Offer {
+                        x: s_now.table.v(next(c)),
+                        r,
+                        facing: prev(c),
+                    });
                 }
             }
-            out
-        })
-        .collect();
-    for (c, slot) in updates {
-        s.edges[c as usize] = slot;
+        }
+        (updates, offers)
+    });
+    let mut offers = Vec::new();
+    for (updates, chunk_offers) in chunks {
+        for (c, slot) in updates {
+            s.edges[c as usize] = slot;
+        }
+        offers.extend(chunk_offers);
     }
+    for &r in merged {
+        t.changed[r as usize] = next_state;
+        t.merged[r as usize] = next_state;
+        if t.listed[r as usize] != next_state {
+            t.listed[r as usize] = next_state;
+            choosers.push(r);
+        }
+    }
+    for o in &offers {
+        t.changed[o.x as usize] = next_state;
+    }
+    offers
 }
 
 /// Marks the vertices within two edges of each merged vertex: the only
@@ -513,20 +914,49 @@ fn neighbours_of<'a>(s: &'a State, fan: &'a Fan) -> impl Iterator<Item = u32> + 
         .chain(ends.iter().map(|&k| s.table.v(prev(k))))
 }
 
-/// Mean length of the live edges, for the sub-grid cell size.
-pub(super) fn mean_edge_length(s: &State) -> f64 {
-    let t = &s.table;
-    let (sum, count) = (0..t.vertex.len() as u32)
-        .into_par_iter()
-        .filter(|&c| t.v(c) != NONE)
-        .map(|c| {
-            let a = s.geometry(t.v(c));
-            let b = s.geometry(t.v(next(c)));
-            let d = crate::quadric::norm(crate::quadric::sub(a, b));
-            (d, 1usize)
-        })
-        .reduce(|| (0.0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
-    if count == 0 { 1.0 } else { sum / count as f64 }
+/// Mean length of the live edges, for the sub-grid cell size and the flat
+/// threshold. Keeps the list of triangles that were alive at the last
+/// measure, so a measure costs the live triangles, not every corner ever
+/// allocated (the corner array never shrinks: with 43 measures down to the
+/// seed, sweeping it cost more than some whole phases).
+pub(super) struct EdgeMeter {
+    triangles: Vec<u32>,
+}
+
+impl EdgeMeter {
+    pub fn new(s: &State) -> EdgeMeter {
+        EdgeMeter {
+            triangles: (0..(s.table.vertex.len() / 3) as u32).collect(),
+        }
+    }
+
+    pub fn measure(&mut self, s: &State) -> f64 {
+        let t = &s.table;
+        self.triangles.retain(|&k| t.v(3 * k) != NONE);
+        // Fixed chunks summed in order: the same bits whatever the thread
+        // count (a rayon reduce's tree follows the work stealing).
+        let sums: Vec<f64> = self
+            .triangles
+            .par_chunks(4096)
+            .map(|chunk| {
+                let mut sum = 0.0;
+                for &k in chunk {
+                    for c in 3 * k..3 * k + 3 {
+                        let a = s.geometry(t.v(c));
+                        let b = s.geometry(t.v(next(c)));
+                        sum += crate::quadric::norm(crate::quadric::sub(a, b));
+                    }
+                }
+                sum
+            })
+            .collect();
+        let count = 3 * self.triangles.len();
+        if count == 0 {
+            1.0
+        } else {
+            sums.iter().sum::<f64>() / count as f64
+        }
+    }
 }
 
 impl Simplification {
