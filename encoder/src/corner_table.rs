@@ -156,6 +156,41 @@ impl CornerTable {
         }
     }
 
+    /// Calls `f` on the corners around vertex `v` in the order [`Self::fan`]
+    /// lists them, without collecting them (the hot loops only look).
+    #[inline]
+    pub fn for_each_corner(&self, v: u32, mut f: impl FnMut(u32)) {
+        let start = self.corner_of[v as usize];
+        if start == NONE {
+            return;
+        }
+        let limit = self.vertex.len();
+        let mut seen = 0;
+        let mut c = start;
+        loop {
+            f(c);
+            seen += 1;
+            let o = self.o(prev(c));
+            if o == NONE {
+                break;
+            }
+            c = prev(o);
+            if c == start || seen > limit {
+                return;
+            }
+        }
+        let mut c = start;
+        loop {
+            let o = self.o(next(c));
+            if o == NONE || seen > limit {
+                return;
+            }
+            c = next(o);
+            f(c);
+            seen += 1;
+        }
+    }
+
     /// Unlinks triangle `t`: its two remaining outer neighbours become each
     /// other's opposites (the edge between them is being folded shut) and the
     /// corners are marked dead. `keep` is the corner of `t` whose facing edge
@@ -278,5 +313,19 @@ mod tests {
         t.fan(3, &mut fan);
         assert!(fan.boundary);
         assert_eq!(fan.corners.len(), 2);
+    }
+
+    #[test]
+    fn corner_walk_lists_the_fan() {
+        // A hexagon fan around 0 with one triangle missing: open fans too.
+        let tris: Vec<[u32; 3]> = (0..5).map(|i| [0, 1 + i, 1 + (i + 1) % 6]).collect();
+        let t = CornerTable::new(7, &tris);
+        let mut fan = Fan::default();
+        for v in 0..7 {
+            t.fan(v, &mut fan);
+            let mut walked = Vec::new();
+            t.for_each_corner(v, |c| walked.push(c));
+            assert_eq!(walked, fan.corners, "vertex {v}");
+        }
     }
 }

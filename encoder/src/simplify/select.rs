@@ -9,7 +9,7 @@
 //! most of the simplifier's speed.
 
 use super::state::State;
-use crate::corner_table::{Fan, NONE, next, prev};
+use crate::corner_table::{NONE, next, prev};
 use crate::quadric::collapse_target;
 
 /// A vertex's chosen collapse; `other == NONE` when it has none.
@@ -201,9 +201,18 @@ fn home(s: &State, v: u32, scale: Scale) -> Option<[i64; 3]> {
     (scale.cell > 0.0).then(|| cell_of(s.geometry(v), scale.cell))
 }
 
+/// A vertex's two cheapest choices with different partners, in [`Rank`]
+/// order; `second` is `None` when it is not known (the best was taken from
+/// it since the last full pick).
+#[derive(Clone, Copy, Debug)]
+pub struct Choices {
+    pub best: Best,
+    pub second: Option<Best>,
+}
+
 /// §2 step a: the cheapest edge of `v` to a neighbour that is not blocked,
 /// skipping edges known to be invalid (their validity is checked only once
-/// chosen), in [`Rank`] order.
+/// chosen), in [`Rank`] order, and the runner-up with another partner.
 ///
 /// `reopened` receives the neighbours `u` whose edge to `v` was refused before
 /// `v`'s 1-ring last changed: that edge may be valid again and `u` should
@@ -213,17 +222,20 @@ pub fn pick_edge(
     v: u32,
     scale: Scale,
     known: Known<'_>,
-    fan: &mut Fan,
     reopened: &mut Vec<u32>,
-) -> Best {
+) -> Choices {
+    let mut best = Best::NONE;
+    let mut second = Best::NONE;
     if !s.alive[v as usize] {
-        return Best::NONE;
+        return Choices {
+            best,
+            second: Some(second),
+        };
     }
-    s.table.fan(v, fan);
     let home = home(s, v, scale);
     let changed_v = known.changed[v as usize];
-    let mut found = Best::NONE;
-    let mut found_rank: Rank = (u32::MAX, true, [u32::MAX; 3], NONE);
+    const LAST: Rank = (u32::MAX, true, [u32::MAX; 3], NONE);
+    let (mut best_rank, mut second_rank) = (LAST, LAST);
     let mut consider = |u: u32, facing: u32| {
         if known.blocked[u as usize] == known.state {
             return;
@@ -242,57 +254,77 @@ pub fn pick_edge(
         }
         let error_key = error_key(slot.error, scale);
         // Keys of real errors stay below u32::MAX, the key of no choice.
-        if error_key > found.error_key {
+        if error_key > second.error_key {
             return;
         }
         let rank = rank(s, home, scale, error_key, u);
-        if rank < found_rank {
-            found_rank = rank;
-            found = Best {
-                other: u,
-                error: slot.error,
-                error_key,
-                target: slot.target,
-                corner: facing,
-            };
+        if rank >= second_rank {
+            return;
+        }
+        let choice = Best {
+            other: u,
+            error: slot.error,
+            error_key,
+            target: slot.target,
+            corner: facing,
+        };
+        if rank < best_rank {
+            (second, second_rank) = (best, best_rank);
+            (best, best_rank) = (choice, rank);
+        } else {
+            (second, second_rank) = (choice, rank);
         }
     };
     // Every edge of v once: (v, next c) faces prev c for each corner c; on a
     // boundary the edge (v, prev c) of the fan's open end faces next c and
     // has no corner of its own.
-    for &c in &fan.corners {
+    s.table.for_each_corner(v, |c| {
         consider(s.table.v(next(c)), prev(c));
         if s.table.o(next(c)) == NONE {
             consider(s.table.v(prev(c)), next(c));
         }
+    });
+    Choices {
+        best,
+        second: Some(second),
     }
-    found
 }
 
-/// `current`, or the edge of `v` to `u` facing corner `facing` if that ranks
-/// first: what [`pick_edge`] would return for `v` when only that edge changed
-/// among edges that did not beat `current` (no refusals, nothing blocked).
-pub fn offer(s: &State, v: u32, current: Best, u: u32, facing: u32, scale: Scale) -> Best {
+/// Updates `choices` of `v` with its edge to `u` facing corner `facing`,
+/// an edge whose slot was refreshed (no refusal, nothing blocked): the two
+/// cheapest of the old candidates and the new one. An unknown runner-up
+/// stays unknown unless the new edge beats the best (the old best is then
+/// the runner-up).
+pub fn offer(s: &State, v: u32, choices: &mut Choices, u: u32, facing: u32, scale: Scale) {
     let slot = &s.edges[facing as usize];
     if slot.error == f64::INFINITY {
-        return current;
+        return;
     }
     let key = error_key(slot.error, scale);
-    if key > current.error_key {
-        return current;
+    let bound = choices
+        .second
+        .map_or(choices.best.error_key, |b| b.error_key);
+    if key > bound {
+        return;
     }
     let home = home(s, v, scale);
-    if current.other != NONE
-        && rank(s, home, scale, current.error_key, current.other) < rank(s, home, scale, key, u)
-    {
-        return current;
-    }
-    Best {
+    let rank_of = |b: &Best| rank(s, home, scale, b.error_key, b.other);
+    let new_rank = rank(s, home, scale, key, u);
+    let choice = Best {
         other: u,
         error: slot.error,
         error_key: key,
         target: slot.target,
         corner: facing,
+    };
+    let best = choices.best;
+    if best.other == NONE || new_rank < rank_of(&best) {
+        choices.second = Some(best);
+        choices.best = choice;
+    } else if let Some(second) = choices.second
+        && (second.other == NONE || new_rank < rank_of(&second))
+    {
+        choices.second = Some(choice);
     }
 }
 

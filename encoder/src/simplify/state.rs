@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use super::check::{CheckScratch, Plan, check_collapse, check_walked};
-use super::select::{Best, EdgeSlot, Known, Scale, edge_slot, offer, pair_key, pick_edge};
+use super::select::{Best, Choices, EdgeSlot, Known, Scale, edge_slot, offer, pair_key, pick_edge};
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
@@ -190,6 +190,10 @@ struct Tracking {
     /// Each vertex's request (§2 step a), chosen without the constraints of
     /// a step's later passes.
     best: Vec<Best>,
+    /// The runner-up of each request (another partner), `None` if unknown:
+    /// a vertex whose partner a collapse took falls back on it instead of
+    /// walking its fan.
+    second: Vec<Option<Best>>,
     /// Requests chosen again within a step (blocked partners, refused
     /// edges), valid where `repick_at == state`; they never outlive it.
     repick: Vec<Best>,
@@ -216,6 +220,7 @@ impl Tracking {
     fn new(n: usize) -> Tracking {
         Tracking {
             best: vec![Best::NONE; n],
+            second: vec![None; n],
             repick: vec![Best::NONE; n],
             repick_at: vec![0; n],
             changed: vec![0; n],
@@ -464,16 +469,16 @@ struct Offer {
 }
 
 /// Sorts the neighbours of the last step's merged vertices into those that
-/// must choose from scratch (appended to `choosers`) and those for which the
-/// refreshed edge to R is the only change, which take it if it beats their
-/// request. Returns how many took offers.
+/// must choose from scratch (appended to `choosers`) and those whose choices
+/// the refreshed edges update. Returns how many took offers.
 ///
-/// A neighbour x of R whose request was not its edge to P or C, and that has
-/// no refused edge, keeps every other edge as it was (its quadric, position
-/// and other neighbours are unchanged), so [`pick_edge`] would return the
-/// better of its request and the offers; the edges to P and C it loses did
-/// not beat its request. Most of a step's changed vertices are such
-/// neighbours, and an offer costs no fan walk.
+/// A neighbour x of R has the same quadric, position and other neighbours
+/// as before, so its candidates are the old ones without its edges to P and
+/// C, plus its edges to merged vertices, which are offered: the old best
+/// (or, if that went to P or C, the runner-up) and the offers give what
+/// [`pick_edge`] would. Only a vertex that lost both, or has refused edges
+/// (now stale), walks its fan again. Most of a step's changed vertices are
+/// such neighbours, and an offer costs no fan walk.
 fn take_offers(
     s: &State,
     t: &mut Tracking,
@@ -483,25 +488,42 @@ fn take_offers(
     state: u32,
 ) -> usize {
     let mut offered = 0;
+    let gone =
+        |t: &Tracking, u: u32| u != NONE && (!s.alive[u as usize] || t.merged[u as usize] == state);
     for o in offers {
         let x = o.x as usize;
         if t.sorted[x] != state {
             t.sorted[x] = state;
-            let b = &t.best[x];
-            let lost = b.other != NONE
-                && (!s.alive[b.other as usize] || t.merged[b.other as usize] == state);
-            if t.listed[x] != state && (lost || t.refusals[x] != 0) {
-                t.listed[x] = state;
-                choosers.push(o.x);
-            }
             if t.listed[x] != state {
-                offered += 1;
+                let second = t.second[x];
+                let second_gone = second.is_none_or(|b| gone(t, b.other));
+                if t.refusals[x] != 0 || (gone(t, t.best[x].other) && second_gone) {
+                    t.listed[x] = state;
+                    choosers.push(o.x);
+                } else {
+                    offered += 1;
+                    if gone(t, t.best[x].other) {
+                        // The runner-up is the best of what is left; what
+                        // comes after it is not known.
+                        let b = second.unwrap_or(Best::NONE);
+                        t.best[x] = b;
+                        t.second[x] = (b.other == NONE).then_some(Best::NONE);
+                    } else if second_gone {
+                        t.second[x] = None;
+                    }
+                }
             }
         }
         if t.listed[x] == state {
             continue;
         }
-        t.best[x] = offer(s, o.x, t.best[x], o.r, o.facing, scale);
+        let mut choices = Choices {
+            best: t.best[x],
+            second: t.second[x],
+        };
+        offer(s, o.x, &mut choices, o.r, o.facing, scale);
+        t.best[x] = choices.best;
+        t.second[x] = choices.second;
     }
     // Every chooser's refused edges are stale now (its 1-ring changed, or
     // it was refused and chooses without the refused edge).
@@ -517,8 +539,9 @@ fn take_offers(
 /// Returns the neighbours whose refused edges the choosers found reopened.
 fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u32) -> Vec<u32> {
     let (updates, reopened) = pick_all(s, t, vertices, scale, state);
-    for (v, b) in updates {
-        t.best[v as usize] = b;
+    for (v, choices) in updates {
+        t.best[v as usize] = choices.best;
+        t.second[v as usize] = choices.second;
     }
     reopened
 }
@@ -531,14 +554,13 @@ fn pick_all(
     vertices: &[u32],
     scale: Scale,
     state: u32,
-) -> (Vec<(u32, Best)>, Vec<u32>) {
+) -> (Vec<(u32, Choices)>, Vec<u32>) {
     let known = t.known(state);
     let chunks = par_chunks_map(vertices, |chunk| {
-        let mut fan = Fan::default();
         let mut reopened = Vec::new();
-        let picks: Vec<(u32, Best)> = chunk
+        let picks: Vec<(u32, Choices)> = chunk
             .iter()
-            .map(|&v| (v, pick_edge(s, v, scale, known, &mut fan, &mut reopened)))
+            .map(|&v| (v, pick_edge(s, v, scale, known, &mut reopened)))
             .collect();
         (picks, reopened)
     });
@@ -636,8 +658,8 @@ fn step_winners(
             again.append(&mut refused_now);
             phases.lap("repick scan");
             let (updates, _) = pick_all(s, t, &again, scale, state);
-            for (v, b) in updates {
-                t.repick[v as usize] = b;
+            for (v, choices) in updates {
+                t.repick[v as usize] = choices.best;
                 t.repick_at[v as usize] = state;
             }
             phases.lap("repick");
