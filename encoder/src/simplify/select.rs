@@ -181,12 +181,44 @@ impl Known<'_> {
 
 /// Order of one vertex's requests: error key, then same sub-grid cell
 /// (Fig. 2), then the minimal coordinates of the other end, then its id.
-type Rank = (u32, bool, [u32; 3], u32);
+/// The tie-break is computed only between equal keys (the sub-grid cell
+/// costs three divisions a vertex).
+struct Order<'a> {
+    s: &'a State,
+    v: u32,
+    scale: Scale,
+    home: std::cell::OnceCell<Option<[i64; 3]>>,
+}
 
-/// How vertex `v` (sub-grid cell `home`) ranks its edge to `u`.
-fn rank(s: &State, home: Option<[i64; 3]>, scale: Scale, error_key: u32, u: u32) -> Rank {
-    let other_cell = home.is_some_and(|h| h != cell_of(s.geometry(u), scale.cell));
-    (error_key, other_cell, s.positions[u as usize], u)
+impl<'a> Order<'a> {
+    fn new(s: &'a State, v: u32, scale: Scale) -> Order<'a> {
+        Order {
+            s,
+            v,
+            scale,
+            home: std::cell::OnceCell::new(),
+        }
+    }
+
+    fn tie(&self, u: u32) -> (bool, [u32; 3], u32) {
+        let (s, cell) = (self.s, self.scale.cell);
+        let home = self
+            .home
+            .get_or_init(|| (cell > 0.0).then(|| cell_of(s.geometry(self.v), cell)));
+        let other_cell = home.is_some_and(|h| h != cell_of(s.geometry(u), cell));
+        (other_cell, s.positions[u as usize], u)
+    }
+
+    /// Whether the edge to `u` with key `key` ranks before `b`. Real keys
+    /// stay below u32::MAX, the key of no choice, so [`Best::NONE`] ranks
+    /// last.
+    fn before(&self, key: u32, u: u32, b: &Best) -> bool {
+        if key != b.error_key {
+            key < b.error_key
+        } else {
+            self.tie(u) < self.tie(b.other)
+        }
+    }
 }
 
 fn error_key(error: f64, scale: Scale) -> u32 {
@@ -197,17 +229,63 @@ fn error_key(error: f64, scale: Scale) -> u32 {
     }
 }
 
-fn home(s: &State, v: u32, scale: Scale) -> Option<[i64; 3]> {
-    (scale.cell > 0.0).then(|| cell_of(s.geometry(v), scale.cell))
-}
-
-/// A vertex's two cheapest choices with different partners, in [`Rank`]
-/// order; `second` is `None` when it is not known (the best was taken from
-/// it since the last full pick).
+/// A vertex's two cheapest choices with different partners, in [`Order`];
+/// `second` is `None` when it is not known (the best was taken from it
+/// since the last full pick).
 #[derive(Clone, Copy, Debug)]
 pub struct Choices {
     pub best: Best,
     pub second: Option<Best>,
+}
+
+/// The two cheapest candidates of one vertex seen so far, in [`Order`].
+pub struct Ranking<'a> {
+    order: Order<'a>,
+    best: Best,
+    second: Best,
+}
+
+impl<'a> Ranking<'a> {
+    pub fn new(s: &'a State, v: u32, scale: Scale) -> Ranking<'a> {
+        Ranking {
+            order: Order::new(s, v, scale),
+            best: Best::NONE,
+            second: Best::NONE,
+        }
+    }
+
+    /// Considers the edge to `u` whose slot (held by corner `facing`) is
+    /// `slot`.
+    #[inline]
+    pub fn consider(&mut self, u: u32, facing: u32, slot: &EdgeSlot) {
+        if slot.error == f64::INFINITY {
+            return;
+        }
+        let key = error_key(slot.error, self.order.scale);
+        if key > self.second.error_key || !self.order.before(key, u, &self.second) {
+            return;
+        }
+        let choice = Best {
+            other: u,
+            error: slot.error,
+            error_key: key,
+            target: slot.target,
+            corner: facing,
+        };
+        if self.order.before(key, u, &self.best) {
+            self.second = self.best;
+            self.best = choice;
+        } else {
+            self.second = choice;
+        }
+    }
+
+    pub fn choices(&self) -> Choices {
+        Choices {
+            best: self.best,
+            second: Some(self.second),
+        }
+    }
 }
 
 /// §2 step a: the cheapest edge of `v` to a neighbour that is not blocked,
@@ -224,26 +302,16 @@ pub fn pick_edge(
     known: Known<'_>,
     reopened: &mut Vec<u32>,
 ) -> Choices {
-    let mut best = Best::NONE;
-    let mut second = Best::NONE;
+    let mut ranking = Ranking::new(s, v, scale);
     if !s.alive[v as usize] {
-        return Choices {
-            best,
-            second: Some(second),
-        };
+        return ranking.choices();
     }
-    let home = home(s, v, scale);
     let changed_v = known.changed[v as usize];
-    const LAST: Rank = (u32::MAX, true, [u32::MAX; 3], NONE);
-    let (mut best_rank, mut second_rank) = (LAST, LAST);
     let mut consider = |u: u32, facing: u32| {
         if known.blocked[u as usize] == known.state {
             return;
         }
         let slot = &s.edges[facing as usize];
-        if slot.error == f64::INFINITY {
-            return;
-        }
         if slot.refused != 0 {
             if known.refused(slot, v, u) {
                 return;
@@ -252,28 +320,7 @@ pub fn pick_edge(
                 reopened.push(u);
             }
         }
-        let error_key = error_key(slot.error, scale);
-        // Keys of real errors stay below u32::MAX, the key of no choice.
-        if error_key > second.error_key {
-            return;
-        }
-        let rank = rank(s, home, scale, error_key, u);
-        if rank >= second_rank {
-            return;
-        }
-        let choice = Best {
-            other: u,
-            error: slot.error,
-            error_key,
-            target: slot.target,
-            corner: facing,
-        };
-        if rank < best_rank {
-            (second, second_rank) = (best, best_rank);
-            (best, best_rank) = (choice, rank);
-        } else {
-            (second, second_rank) = (choice, rank);
-        }
+        ranking.consider(u, facing, slot);
     };
     // Every edge of v once: (v, next c) faces prev c for each corner c; on a
     // boundary the edge (v, prev c) of the fan's open end faces next c and
@@ -284,10 +331,7 @@ pub fn pick_edge(
             consider(s.table.v(prev(c)), next(c));
         }
     });
-    Choices {
-        best,
-        second: Some(second),
-    }
+    ranking.choices()
 }
 
 /// Updates `choices` of `v` with its edge to `u` facing corner `facing`,
@@ -307,9 +351,7 @@ pub fn offer(s: &State, v: u32, choices: &mut Choices, u: u32, facing: u32, scal
     if key > bound {
         return;
     }
-    let home = home(s, v, scale);
-    let rank_of = |b: &Best| rank(s, home, scale, b.error_key, b.other);
-    let new_rank = rank(s, home, scale, key, u);
+    let order = Order::new(s, v, scale);
     let choice = Best {
         other: u,
         error: slot.error,
@@ -317,12 +359,11 @@ pub fn offer(s: &State, v: u32, choices: &mut Choices, u: u32, facing: u32, scal
         target: slot.target,
         corner: facing,
     };
-    let best = choices.best;
-    if best.other == NONE || new_rank < rank_of(&best) {
-        choices.second = Some(best);
+    if order.before(key, u, &choices.best) {
+        choices.second = Some(choices.best);
         choices.best = choice;
     } else if let Some(second) = choices.second
-        && (second.other == NONE || new_rank < rank_of(&second))
+        && order.before(key, u, &second)
     {
         choices.second = Some(choice);
     }

@@ -3,7 +3,9 @@
 use rayon::prelude::*;
 
 use super::check::{CheckScratch, Plan, check_collapse, check_walked};
-use super::select::{Best, Choices, EdgeSlot, Known, Scale, edge_slot, offer, pair_key, pick_edge};
+use super::select::{
+    Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, offer, pair_key, pick_edge,
+};
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
@@ -404,7 +406,17 @@ pub fn simplify(
         let t_refresh = std::time::Instant::now();
         phases.lap("apply");
         let merged: Vec<u32> = winners.iter().map(|w| w.p).collect();
-        offers = refresh_edges(&mut s, &mut t, &merged, state + 1, &mut choosers);
+        // The next step keeps this scale unless it measures edges again.
+        let left = alive_count - collapses.len();
+        let same_scale = (left * 5 >= edge_measured_at * 4).then_some(scale);
+        offers = refresh_edges(
+            &mut s,
+            &mut t,
+            &merged,
+            state + 1,
+            same_scale,
+            &mut choosers,
+        );
         phases.lap("refresh");
         live.retain(|&v| s.alive[v as usize]);
         phases.lap("retain");
@@ -538,39 +550,38 @@ fn take_offers(
 /// §2 step a for `vertices`, in parallel: their requests are replaced.
 /// Returns the neighbours whose refused edges the choosers found reopened.
 fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u32) -> Vec<u32> {
-    let (updates, reopened) = pick_all(s, t, vertices, scale, state);
-    for (v, choices) in updates {
-        t.best[v as usize] = choices.best;
-        t.second[v as usize] = choices.second;
+    let mut reopened = Vec::new();
+    for (picks, chunk_reopened) in pick_all(s, t, vertices, scale, state) {
+        for (v, choices) in picks {
+            t.best[v as usize] = choices.best;
+            t.second[v as usize] = choices.second;
+        }
+        reopened.extend(chunk_reopened);
     }
     reopened
 }
 
-/// [`pick_edge`] for each of `vertices`, in parallel: the requests in the
-/// order of `vertices`, and the reopened neighbours.
+/// One chunk's picks (vertex and choices, in order) and reopened neighbours.
+type PickedChunk = (Vec<(u32, Choices)>, Vec<u32>);
+
+/// [`pick_edge`] for each of `vertices`, in parallel: per chunk of
+/// `vertices`, its requests in order and the reopened neighbours.
 fn pick_all(
     s: &State,
     t: &Tracking,
     vertices: &[u32],
     scale: Scale,
     state: u32,
-) -> (Vec<(u32, Choices)>, Vec<u32>) {
+) -> Vec<PickedChunk> {
     let known = t.known(state);
-    let chunks = par_chunks_map(vertices, |chunk| {
+    par_chunks_map(vertices, |chunk| {
         let mut reopened = Vec::new();
         let picks: Vec<(u32, Choices)> = chunk
             .iter()
             .map(|&v| (v, pick_edge(s, v, scale, known, &mut reopened)))
             .collect();
         (picks, reopened)
-    });
-    let mut picks = Vec::with_capacity(vertices.len());
-    let mut reopened = Vec::new();
-    for (p, r) in chunks {
-        picks.extend(p);
-        reopened.extend(r);
-    }
-    (picks, reopened)
+    })
 }
 
 /// `f` over consecutive chunks of `items` in parallel, the results in
@@ -657,9 +668,26 @@ fn step_winners(
             // minima.
             again.append(&mut refused_now);
             phases.lap("repick scan");
-            let (updates, _) = pick_all(s, t, &again, scale, state);
-            for (v, choices) in updates {
-                t.repick[v as usize] = choices.best;
+            // A vertex still on its unconstrained request whose runner-up is
+            // free takes it: everything else ranks after the runner-up.
+            let known = t.known(state);
+            let mut walk = Vec::new();
+            let mut quick = Vec::new();
+            for &v in &again {
+                let free = |b: &Best| {
+                    b.other == NONE
+                        || (t.blocked[b.other as usize] != state
+                            && !known.refused(&s.edges[b.corner as usize], v, b.other))
+                };
+                match t.second[v as usize] {
+                    Some(b) if t.repick_at[v as usize] != state && free(&b) => quick.push((v, b)),
+                    _ => walk.push(v),
+                }
+            }
+            let walked = pick_all(s, t, &walk, scale, state);
+            let walked = walked.into_iter().flat_map(|(picks, _)| picks);
+            for (v, b) in quick.into_iter().chain(walked.map(|(v, c)| (v, c.best))) {
+                t.repick[v as usize] = b;
                 t.repick_at[v as usize] = state;
             }
             phases.lap("repick");
@@ -767,16 +795,15 @@ fn step_winners(
 }
 
 fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64], fans: [&Fan; 2]) -> bool {
-    for fan in fans {
-        for &corner in &fan.corners {
-            for x in [s.table.v(next(corner)), s.table.v(prev(corner))] {
-                if x != p && x != c && keys[x as usize] < key {
-                    return false;
-                }
-            }
-        }
-    }
-    true
+    let beaten = |x: u32| x != p && x != c && keys[x as usize] < key;
+    // Each neighbour once: the next vertex of every corner, and the previous
+    // one where the fan is open after it.
+    fans.iter().all(|fan| {
+        fan.corners.iter().all(|&corner| {
+            !beaten(s.table.v(next(corner)))
+                && (s.table.o(next(corner)) != NONE || !beaten(s.table.v(prev(corner))))
+        })
+    })
 }
 
 /// Applies the collapse chosen by `p` if `check_collapse` accepts it,
@@ -830,65 +857,80 @@ fn apply_plan(s: &mut State, p: u32, b: Best, plan: Plan, fans: &mut [Fan; 2]) -
 
 /// Re-evaluates the edges around each merged vertex (only their quadric or
 /// position changed) and stamps the merged vertices and their neighbours as
-/// changed in `next_state` (their 1-rings are new). The merged vertices are
-/// appended to `choosers`; their neighbours get the refreshed edges as
-/// offers (returned, see `take_offers`): no other vertex's request can
-/// change.
+/// changed in `next_state` (their 1-rings are new). Their neighbours get the
+/// refreshed edges as offers (returned, see `take_offers`): no other
+/// vertex's request can change.
+///
+/// The merged vertices choose here, from the slots just evaluated, when
+/// `scale` is the next step's (a pick then would see the same fresh slots,
+/// no refusal and nothing blocked); otherwise they are appended to
+/// `choosers`.
 fn refresh_edges(
     s: &mut State,
     t: &mut Tracking,
     merged: &[u32],
     next_state: u32,
+    scale: Option<Scale>,
     choosers: &mut Vec<u32>,
 ) -> Vec<Offer> {
     let s_now: &State = s;
     let chunks = par_chunks_map(merged, |chunk| {
-        let mut fan = Fan::default();
         // About six edges a vertex, most with two corners.
         let mut updates = Vec::with_capacity(14 * chunk.len());
         let mut offers = Vec::with_capacity(7 * chunk.len());
+        let mut choices = Vec::with_capacity(if scale.is_some() { chunk.len() } else { 0 });
         for &r in chunk {
-            s_now.table.fan(r, &mut fan);
-            for &c in &fan.corners {
-                // Edge (r, prev c) faces next c and, across it, the opposite
-                // corner: evaluate it once for both. A boundary edge
-                // (r, next c) has no other side and is evaluated on its own.
-                let slot = edge_slot(s_now, next(c));
-                updates.push((next(c), slot));
-                let across = s_now.table.o(next(c));
+            let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
+            let mut refresh = |x: u32, facing: u32| {
+                let slot = edge_slot(s_now, facing);
+                updates.push((facing, slot));
+                let across = s_now.table.o(facing);
                 if across != NONE {
                     updates.push((across, slot));
                 }
-                offers.push(Offer {
-                    x: s_now.table.v(prev(c)),
-                    r,
-                    facing: next(c),
-                });
-                if s_now.table.o(prev(c)) == NONE {
-                    updates.push((prev(c), edge_slot(s_now, prev(c))));
-                    offers.push(Offer {
-                        x: s_now.table.v(next(c)),
-                        r,
-                        facing: prev(c),
-                    });
+                offers.push(Offer { x, r, facing });
+                if let Some(ranking) = &mut ranking {
+                    ranking.consider(x, facing, &slot);
                 }
+            };
+            // Edge (r, prev c) faces next c and, across it, the opposite
+            // corner: evaluate it once for both. A boundary edge (r, next c)
+            // has no other side and is evaluated on its own.
+            s_now.table.for_each_corner(r, |c| {
+                refresh(s_now.table.v(prev(c)), next(c));
+                if s_now.table.o(prev(c)) == NONE {
+                    refresh(s_now.table.v(next(c)), prev(c));
+                }
+            });
+            if let Some(ranking) = ranking {
+                choices.push(ranking.choices());
             }
         }
-        (updates, offers)
+        (updates, offers, choices)
     });
     let mut offers = Vec::new();
-    for (updates, chunk_offers) in chunks {
+    let mut chosen = Vec::with_capacity(merged.len());
+    for (updates, chunk_offers, choices) in chunks {
         for (c, slot) in updates {
             s.edges[c as usize] = slot;
         }
         offers.extend(chunk_offers);
+        chosen.extend(choices);
     }
-    for &r in merged {
-        t.changed[r as usize] = next_state;
-        t.merged[r as usize] = next_state;
-        if t.listed[r as usize] != next_state {
-            t.listed[r as usize] = next_state;
-            choosers.push(r);
+    for (i, &r) in merged.iter().enumerate() {
+        let v = r as usize;
+        t.changed[v] = next_state;
+        t.merged[v] = next_state;
+        // Never listed already: merged vertices are not refused ends.
+        t.listed[v] = next_state;
+        match chosen.get(i) {
+            Some(choices) => {
+                t.best[v] = choices.best;
+                t.second[v] = choices.second;
+                // Its edges are all fresh: nothing refused to forget.
+                t.refusals[v] = 0;
+            }
+            None => choosers.push(r),
         }
     }
     for o in &offers {
