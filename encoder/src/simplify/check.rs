@@ -64,11 +64,16 @@ pub fn check_collapse(
 }
 
 impl CheckScratch {
-    /// The fans of P and C, for [`check_walked`] to use as they are.
-    pub fn walk(&mut self, s: &State, p: u32, c: u32) -> (&Fan, &Fan) {
+    /// The fan of P, then (`walk_c`) of C, for [`check_walked`] to use as
+    /// they are.
+    pub fn walk_p(&mut self, s: &State, p: u32) -> &Fan {
         s.table.fan(p, &mut self.fan_p);
+        &self.fan_p
+    }
+
+    pub fn walk_c(&mut self, s: &State, c: u32) -> &Fan {
         s.table.fan(c, &mut self.fan_c);
-        (&self.fan_p, &self.fan_c)
+        &self.fan_c
     }
 
     /// After a successful check: P, C and every neighbour of either, the
@@ -82,7 +87,8 @@ impl CheckScratch {
     }
 }
 
-/// [`check_collapse`] on the fans `k` holds from [`CheckScratch::walk`].
+/// [`check_collapse`] on the fans `k` holds from [`CheckScratch::walk_p`]
+/// and [`CheckScratch::walk_c`].
 pub fn check_walked(
     s: &State,
     p: u32,

@@ -287,6 +287,7 @@ pub fn simplify(
     // by the last step's collapses, for their other ends.
     let mut choosers = live.clone();
     let mut offers: Vec<Offer> = Vec::new();
+    let mut buffers = Buffers::default();
     let limit = options.max_error.unwrap_or(f64::INFINITY);
     let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
     // The mean edge length sets the sub-grid and the flat threshold; it
@@ -323,18 +324,22 @@ pub fn simplify(
         choose(&s, &mut t, &again, scale, state);
         let chose = choosers.len() + again.len();
         // Raise S to the admitted quantile of the current candidate errors.
-        let mut errors: Vec<f64> = live
-            .iter()
-            .map(|&v| &t.best[v as usize])
-            .filter(|b| b.other != NONE)
-            .map(|b| b.error)
-            .collect();
+        let errors = &mut buffers.errors;
+        errors.clear();
+        errors.extend(
+            live.iter()
+                .map(|&v| &t.best[v as usize])
+                .filter(|b| b.other != NONE)
+                .map(|b| b.error),
+        );
         if errors.is_empty() {
             break;
         }
         let q = ((errors.len() - 1) as f64 * options.admit_quantile.clamp(0.0, 1.0)) as usize;
         let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
         threshold = threshold.max(*quantile).min(limit);
+        let largest = errors.iter().copied().fold(0.0f64, f64::max);
+        let smallest = errors.iter().copied().fold(f64::INFINITY, f64::min);
         let t_select = std::time::Instant::now();
         phases.lap("quantile");
         choosers.clear();
@@ -348,13 +353,12 @@ pub fn simplify(
                 scale,
             },
             &mut choosers,
+            &mut buffers,
             &mut phases,
         );
         // Nothing under S: raise it (the paper's "S is increased"), doubling
         // past the smallest candidate error, until a step finds collapses or
         // S passes every candidate error or the maximum error.
-        let largest = errors.iter().copied().fold(0.0f64, f64::max);
-        let smallest = errors.iter().copied().fold(f64::INFINITY, f64::min);
         while winners.is_empty() && threshold < limit && threshold < largest {
             threshold = (2.0 * threshold)
                 .max(smallest)
@@ -370,6 +374,7 @@ pub fn simplify(
                     scale,
                 },
                 &mut choosers,
+                &mut buffers,
                 &mut phases,
             );
         }
@@ -409,13 +414,14 @@ pub fn simplify(
         // The next step keeps this scale unless it measures edges again.
         let left = alive_count - collapses.len();
         let same_scale = (left * 5 >= edge_measured_at * 4).then_some(scale);
-        offers = refresh_edges(
+        refresh_edges(
             &mut s,
             &mut t,
             &merged,
             state + 1,
             same_scale,
             &mut choosers,
+            &mut offers,
         );
         phases.lap("refresh");
         live.retain(|&v| s.alive[v as usize]);
@@ -584,6 +590,31 @@ fn pick_all(
     })
 }
 
+/// The values `f` gives for `items`, in order, into `out` (cleared first):
+/// the step's large lists keep their capacity from step to step instead of
+/// faulting fresh pages in (a few percent of the run).
+fn par_filter_into<T: Sync, U: Send>(
+    items: &[T],
+    out: &mut Vec<U>,
+    f: impl Fn(&T) -> Option<U> + Sync + Send,
+) {
+    out.clear();
+    for part in par_chunks_map(items, |chunk| {
+        chunk.iter().filter_map(&f).collect::<Vec<U>>()
+    }) {
+        out.extend(part);
+    }
+}
+
+/// Lists a step rebuilds, kept between steps for their capacity.
+#[derive(Default)]
+struct Buffers {
+    errors: Vec<f64>,
+    players: Vec<u32>,
+    again: Vec<u32>,
+    admitted: Vec<(u32, u64)>,
+}
+
 /// `f` over consecutive chunks of `items` in parallel, the results in
 /// order. Each chunk fills its own buffers: no allocation per item and no
 /// merging copies (rayon's fold/reduce re-copies at every level).
@@ -620,6 +651,7 @@ fn step_winners(
     live: &[u32],
     step: Step,
     refused_ends: &mut Vec<u32>,
+    buffers: &mut Buffers,
     phases: &mut Phases,
 ) -> Vec<Winner> {
     let Step {
@@ -640,29 +672,28 @@ fn step_winners(
     // among fewer neighbours never gets cheaper (up to requests of equal f32
     // key, whose order the tie-breaks decide, not the error).
     let tr: &Tracking = t;
-    let players: Vec<u32> = live
-        .par_iter()
-        .copied()
-        .filter(|&v| {
-            let b = &tr.best[v as usize];
-            b.other != NONE && b.error <= threshold
-        })
-        .collect();
+    let Buffers {
+        players,
+        again,
+        admitted: admitted_keys,
+        ..
+    } = buffers;
+    par_filter_into(live, players, |&v| {
+        let b = &tr.best[v as usize];
+        (b.other != NONE && b.error <= threshold).then_some(v)
+    });
     let live = &players[..];
     loop {
         if !first {
             let tr: &Tracking = t;
-            let mut again: Vec<u32> = live
-                .par_iter()
-                .copied()
-                .filter(|&v| {
-                    let b = tr.request(v, state);
-                    tr.blocked[v as usize] != state
-                        && b.other != NONE
-                        && b.error <= threshold
-                        && tr.blocked[b.other as usize] == state
-                })
-                .collect();
+            par_filter_into(live, again, |&v| {
+                let b = tr.request(v, state);
+                (tr.blocked[v as usize] != state
+                    && b.other != NONE
+                    && b.error <= threshold
+                    && tr.blocked[b.other as usize] == state)
+                    .then_some(v)
+            });
             // The ends of a refused pair are never blocked: a winner of the
             // same pass would be in their 1-ring, and both cannot be local
             // minima.
@@ -673,7 +704,7 @@ fn step_winners(
             let known = t.known(state);
             let mut walk = Vec::new();
             let mut quick = Vec::new();
-            for &v in &again {
+            for &v in again.iter() {
                 let free = |b: &Best| {
                     b.other == NONE
                         || (t.blocked[b.other as usize] != state
@@ -704,15 +735,13 @@ fn step_winners(
         // One key per pair, taken from its lower endpoint, so that both
         // endpoints compare alike (their cached errors may come from
         // different steps).
-        let admitted_keys: Vec<(u32, u64)> = live
-            .par_iter()
-            .filter(|&&v| admitted(v))
-            .map(|&v| {
+        par_filter_into(live, admitted_keys, |&v| {
+            admitted(v).then(|| {
                 let low = v.min(tr.request(v, state).other);
                 (v, pair_key(tr.request(low, state), low))
             })
-            .collect();
-        for &(v, key) in &admitted_keys {
+        });
+        for &(v, key) in admitted_keys.iter() {
             t.keys[v as usize] = key;
         }
         phases.lap("admit");
@@ -721,7 +750,7 @@ fn step_winners(
         // Local minima, checked; a valid one lists the vertices it blocks
         // (from the fans its check walked).
         type Checked = (Vec<(u32, Result<Plan, ()>)>, Vec<u32>);
-        let checked: Vec<Checked> = par_chunks_map(&admitted_keys, |chunk| {
+        let checked: Vec<Checked> = par_chunks_map(admitted_keys, |chunk| {
             let mut scratch = CheckScratch::default();
             let (mut out, mut blocks) = (Vec::new(), Vec::new());
             for &(v, key) in chunk {
@@ -729,8 +758,10 @@ fn step_winners(
                 if v > c {
                     continue;
                 }
-                let (fan_p, fan_c) = scratch.walk(s_now, v, c);
-                if !is_local_minimum(s_now, v, c, key, &tr.keys, [fan_p, fan_c]) {
+                // C's fan only if P's neighbours do not already beat the pair.
+                if !is_local_minimum(s_now, v, c, key, &tr.keys, scratch.walk_p(s_now, v))
+                    || !is_local_minimum(s_now, v, c, key, &tr.keys, scratch.walk_c(s_now, c))
+                {
                     continue;
                 }
                 let target = s_now.to_metric(tr.request(v, state).target);
@@ -742,7 +773,7 @@ fn step_winners(
             }
             (out, blocks)
         });
-        for &(v, _) in &admitted_keys {
+        for &(v, _) in admitted_keys.iter() {
             t.keys[v as usize] = u64::MAX;
         }
         phases.lap("minima+check");
@@ -794,15 +825,15 @@ fn step_winners(
     winners
 }
 
-fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64], fans: [&Fan; 2]) -> bool {
+/// Whether no neighbour in `fan` (of P or C) other than P and C has an
+/// admitted request with a key below `key`.
+fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64], fan: &Fan) -> bool {
     let beaten = |x: u32| x != p && x != c && keys[x as usize] < key;
     // Each neighbour once: the next vertex of every corner, and the previous
     // one where the fan is open after it.
-    fans.iter().all(|fan| {
-        fan.corners.iter().all(|&corner| {
-            !beaten(s.table.v(next(corner)))
-                && (s.table.o(next(corner)) != NONE || !beaten(s.table.v(prev(corner))))
-        })
+    fan.corners.iter().all(|&corner| {
+        !beaten(s.table.v(next(corner)))
+            && (s.table.o(next(corner)) != NONE || !beaten(s.table.v(prev(corner))))
     })
 }
 
@@ -858,7 +889,7 @@ fn apply_plan(s: &mut State, p: u32, b: Best, plan: Plan, fans: &mut [Fan; 2]) -
 /// Re-evaluates the edges around each merged vertex (only their quadric or
 /// position changed) and stamps the merged vertices and their neighbours as
 /// changed in `next_state` (their 1-rings are new). Their neighbours get the
-/// refreshed edges as offers (returned, see `take_offers`): no other
+/// refreshed edges as offers (into `offers`, see `take_offers`): no other
 /// vertex's request can change.
 ///
 /// The merged vertices choose here, from the slots just evaluated, when
@@ -872,7 +903,8 @@ fn refresh_edges(
     next_state: u32,
     scale: Option<Scale>,
     choosers: &mut Vec<u32>,
-) -> Vec<Offer> {
+    offers: &mut Vec<Offer>,
+) {
     let s_now: &State = s;
     let chunks = par_chunks_map(merged, |chunk| {
         // About six edges a vertex, most with two corners.
@@ -908,7 +940,7 @@ fn refresh_edges(
         }
         (updates, offers, choices)
     });
-    let mut offers = Vec::new();
+    offers.clear();
     let mut chosen = Vec::with_capacity(merged.len());
     for (updates, chunk_offers, choices) in chunks {
         for (c, slot) in updates {
@@ -933,10 +965,9 @@ fn refresh_edges(
             None => choosers.push(r),
         }
     }
-    for o in &offers {
+    for o in offers.iter() {
         t.changed[o.x as usize] = next_state;
     }
-    offers
 }
 
 /// Marks the vertices within two edges of each merged vertex: the only
