@@ -223,6 +223,20 @@ impl CornerTable {
         let [fa, fb] = fans;
         self.fan(keep, fa);
         self.fan(gone, fb);
+        self.collapse_fans(keep, gone, left, right, &fa.corners, &fb.corners);
+    }
+
+    /// [`Self::collapse`] given the fans of `keep` and `gone` as they are
+    /// before it (the parallel simplifier has them from its check).
+    pub fn collapse_fans(
+        &mut self,
+        keep: u32,
+        gone: u32,
+        left: u32,
+        right: u32,
+        fan_keep: &[u32],
+        fan_gone: &[u32],
+    ) {
         let doomed = |c: u32| c != NONE && (c / 3 == left / 3 || c / 3 == right / 3);
         // Re-anchor the wing vertices on triangles that survive: the
         // neighbours across their two folded edges.
@@ -239,7 +253,7 @@ impl CornerTable {
                 .unwrap_or(NONE);
             self.corner_of[x as usize] = anchor;
         }
-        for &c in &fb.corners {
+        for &c in fan_gone {
             if !doomed(c) {
                 self.vertex[c as usize] = keep;
             }
@@ -250,10 +264,9 @@ impl CornerTable {
         if right != NONE {
             self.remove_triangle(next(right));
         }
-        self.corner_of[keep as usize] = fa
-            .corners
+        self.corner_of[keep as usize] = fan_keep
             .iter()
-            .chain(&fb.corners)
+            .chain(fan_gone)
             .copied()
             .find(|&c| !doomed(c))
             .unwrap_or(NONE);

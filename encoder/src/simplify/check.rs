@@ -76,6 +76,11 @@ impl CheckScratch {
         &self.fan_c
     }
 
+    /// The fans of P and C the check used.
+    pub fn fans(&self) -> (&Fan, &Fan) {
+        (&self.fan_p, &self.fan_c)
+    }
+
     /// After a successful check: P, C and every neighbour of either, the
     /// vertices the collapse blocks for the rest of its step.
     pub fn neighbourhood(&self) -> impl Iterator<Item = u32> + '_ {

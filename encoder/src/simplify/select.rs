@@ -93,8 +93,8 @@ fn to_grid(x: f64, top: f64) -> u32 {
     i + u32::from(x - f64::from(i) >= 0.5)
 }
 
-/// Cached collapse of the edge facing one corner (the paper's Edge array).
-/// Both corners facing an edge hold the same slot.
+/// Cached collapse of the edge facing one corner (the paper's Edge array),
+/// kept at the lower of the edge's two corners ([`State::slot_index`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EdgeSlot {
     pub error: f64,
@@ -308,7 +308,7 @@ pub fn pick_edge(
         if known.blocked[u as usize] == known.state {
             return;
         }
-        let slot = &s.edges[facing as usize];
+        let slot = s.slot(facing);
         if slot.refused != 0 {
             if known.refused(slot, v, u) {
                 return;
@@ -337,7 +337,7 @@ pub fn pick_edge(
 /// stays unknown unless the new edge beats the best (the old best is then
 /// the runner-up).
 pub fn offer(s: &State, v: u32, choices: &mut Choices, u: u32, facing: u32, scale: Scale) {
-    let slot = &s.edges[facing as usize];
+    let slot = s.slot(facing);
     if slot.error == f64::INFINITY {
         return;
     }

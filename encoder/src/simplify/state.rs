@@ -142,6 +142,22 @@ impl State {
         self.geometry[v as usize]
     }
 
+    /// Where the slot of the edge facing corner `c` is kept: at the lower of
+    /// its two corners, so a refresh writes it once.
+    pub fn slot_index(&self, c: u32) -> usize {
+        let o = self.table.o(c);
+        if o != NONE && o < c {
+            o as usize
+        } else {
+            c as usize
+        }
+    }
+
+    /// The slot of the edge facing corner `c`.
+    pub fn slot(&self, c: u32) -> &EdgeSlot {
+        &self.edges[self.slot_index(c)]
+    }
+
     /// Metric coordinates of a grid point.
     pub fn to_metric(&self, q: [u32; 3]) -> [f64; 3] {
         std::array::from_fn(|k| q[k] as f64 * self.metric[k])
@@ -213,6 +229,8 @@ struct Tracking {
     listed: Vec<u32>,
     /// `== state`: the vertex was sorted into choosing or taking offers.
     sorted: Vec<u32>,
+    /// The vertex's last offer in the step's list (valid where sorted).
+    last_offer: Vec<u32>,
     /// Pair key of each vertex's admitted request in the current pass,
     /// `u64::MAX` otherwise (reset after each pass, so never swept whole).
     keys: Vec<u64>,
@@ -232,6 +250,7 @@ impl Tracking {
             // Every vertex is on the first step's list.
             listed: vec![1; n],
             sorted: vec![0; n],
+            last_offer: vec![0; n],
             keys: vec![u64::MAX; n],
         }
     }
@@ -259,6 +278,13 @@ struct Winner {
     p: u32,
     best: Best,
     plan: Plan,
+    /// Its record and the merged quadric, prepared in parallel with its
+    /// check (from the step's mesh, which the other winners do not touch).
+    record: Collapse,
+    quadric: Quadric,
+    /// The fans of P then C as its check walked them, at `fans` in
+    /// [`Buffers::fans`]: applying the collapse needs no walk.
+    fans: (u32, u32, u32),
 }
 
 /// Simplifies `mesh` (quantized, checked manifold) with the parallel algorithm.
@@ -391,7 +417,6 @@ pub fn simplify(
         let t_apply = std::time::Instant::now();
         phases.lap("select");
         let mut collapses = Vec::with_capacity(winners.len());
-        let mut fans = [Fan::default(), Fan::default()];
         let mut step_error = 0.0f64;
         for w in &winners {
             debug_assert_eq!(
@@ -405,7 +430,13 @@ pub fn simplify(
                 Ok(w.plan),
                 "a winner's check holds after the other collapses of its step"
             );
-            collapses.push(apply_plan(&mut s, w.p, w.best, w.plan, &mut fans));
+            let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
+            let fan_p = &buffers.fans[start..start + np];
+            let fan_c = &buffers.fans[start + np..start + np + nc];
+            s.table
+                .collapse_fans(w.p, w.best.other, w.plan.left, w.plan.right, fan_p, fan_c);
+            commit(&mut s, w.p, w.best, w.plan, w.quadric);
+            collapses.push(w.record);
             step_error = step_error.max(w.best.error);
         }
         let t_refresh = std::time::Instant::now();
@@ -458,23 +489,17 @@ pub fn simplify(
     }
 }
 
-/// Every corner's edge slot, each edge evaluated once for its two corners.
+/// Every edge's slot, at the lower of its corners ([`State::slot_index`]);
+/// the other corner's entry is never read.
 fn initial_slots(s: &State) -> Vec<EdgeSlot> {
     let t = &s.table;
-    let mut edges: Vec<EdgeSlot> = (0..t.vertex.len() as u32)
+    (0..t.vertex.len() as u32)
         .into_par_iter()
         .map(|c| match t.o(c) {
             o if o != NONE && o < c => EdgeSlot::FORBIDDEN,
             _ => edge_slot(s, c),
         })
-        .collect();
-    for c in 0..edges.len() {
-        let o = t.opposite[c];
-        if o != NONE && (o as usize) < c {
-            edges[c] = edges[o as usize];
-        }
-    }
-    edges
+        .collect()
 }
 
 /// A refreshed edge of merged vertex `r`, offered to its other end `x`.
@@ -505,43 +530,80 @@ fn take_offers(
     scale: Scale,
     state: u32,
 ) -> usize {
-    let mut offered = 0;
-    let gone =
-        |t: &Tracking, u: u32| u != NONE && (!s.alive[u as usize] || t.merged[u as usize] == state);
-    for o in offers {
+    // Link each vertex's offers, so that one task takes them all.
+    let mut links = vec![NONE; offers.len()];
+    let mut firsts = Vec::new();
+    for (i, o) in offers.iter().enumerate() {
         let x = o.x as usize;
         if t.sorted[x] != state {
             t.sorted[x] = state;
-            if t.listed[x] != state {
-                let second = t.second[x];
-                let second_gone = second.is_none_or(|b| gone(t, b.other));
-                if t.refusals[x] != 0 || (gone(t, t.best[x].other) && second_gone) {
-                    t.listed[x] = state;
-                    choosers.push(o.x);
-                } else {
-                    offered += 1;
-                    if gone(t, t.best[x].other) {
-                        // The runner-up is the best of what is left; what
-                        // comes after it is not known.
-                        let b = second.unwrap_or(Best::NONE);
-                        t.best[x] = b;
-                        t.second[x] = (b.other == NONE).then_some(Best::NONE);
-                    } else if second_gone {
-                        t.second[x] = None;
-                    }
+            firsts.push(i as u32);
+        } else {
+            links[t.last_offer[x] as usize] = i as u32;
+        }
+        t.last_offer[x] = i as u32;
+    }
+    enum Outcome {
+        /// Already listed to choose from scratch (a refused end).
+        Listed,
+        Choose,
+        Take(Choices),
+    }
+    let tr: &Tracking = t;
+    let gone = |u: u32| u != NONE && (!s.alive[u as usize] || tr.merged[u as usize] == state);
+    let outcomes = par_chunks_map(&firsts, |chunk| {
+        chunk
+            .iter()
+            .map(|&first| {
+                let x = offers[first as usize].x;
+                let xi = x as usize;
+                if tr.listed[xi] == state {
+                    return (x, Outcome::Listed);
                 }
+                let (best, second) = (tr.best[xi], tr.second[xi]);
+                let second_gone = second.is_none_or(|b| gone(b.other));
+                if tr.refusals[xi] != 0 || (gone(best.other) && second_gone) {
+                    return (x, Outcome::Choose);
+                }
+                let mut choices = if gone(best.other) {
+                    // The runner-up is the best of what is left; what comes
+                    // after it is not known.
+                    let b = second.unwrap_or(Best::NONE);
+                    Choices {
+                        best: b,
+                        second: (b.other == NONE).then_some(Best::NONE),
+                    }
+                } else {
+                    Choices {
+                        best,
+                        second: if second_gone { None } else { second },
+                    }
+                };
+                let mut i = first;
+                while i != NONE {
+                    let o = &offers[i as usize];
+                    offer(s, x, &mut choices, o.r, o.facing, scale);
+                    i = links[i as usize];
+                }
+                (x, Outcome::Take(choices))
+            })
+            .collect::<Vec<_>>()
+    });
+    let mut offered = 0;
+    for (x, outcome) in outcomes.into_iter().flatten() {
+        let xi = x as usize;
+        match outcome {
+            Outcome::Listed => {}
+            Outcome::Choose => {
+                t.listed[xi] = state;
+                choosers.push(x);
+            }
+            Outcome::Take(choices) => {
+                offered += 1;
+                t.best[xi] = choices.best;
+                t.second[xi] = choices.second;
             }
         }
-        if t.listed[x] == state {
-            continue;
-        }
-        let mut choices = Choices {
-            best: t.best[x],
-            second: t.second[x],
-        };
-        offer(s, o.x, &mut choices, o.r, o.facing, scale);
-        t.best[x] = choices.best;
-        t.second[x] = choices.second;
     }
     // Every chooser's refused edges are stale now (its 1-ring changed, or
     // it was refused and chooses without the refused edge).
@@ -613,6 +675,19 @@ struct Buffers {
     players: Vec<u32>,
     again: Vec<u32>,
     admitted: Vec<(u32, u64)>,
+    /// The fans of the step's winners (see [`Winner::fans`]).
+    fans: Vec<u32>,
+}
+
+/// One chunk's checks: results in order, and for the valid ones the
+/// vertices they block, their prepared records and merged quadrics, and
+/// their fans (offsets into `corners`).
+#[derive(Default)]
+struct Checked {
+    results: Vec<(u32, Result<Plan, ()>)>,
+    blocks: Vec<u32>,
+    prepared: Vec<(Collapse, Quadric, (u32, u32, u32))>,
+    corners: Vec<u32>,
 }
 
 /// `f` over consecutive chunks of `items` in parallel, the results in
@@ -676,8 +751,10 @@ fn step_winners(
         players,
         again,
         admitted: admitted_keys,
+        fans,
         ..
     } = buffers;
+    fans.clear();
     par_filter_into(live, players, |&v| {
         let b = &tr.best[v as usize];
         (b.other != NONE && b.error <= threshold).then_some(v)
@@ -708,7 +785,7 @@ fn step_winners(
                 let free = |b: &Best| {
                     b.other == NONE
                         || (t.blocked[b.other as usize] != state
-                            && !known.refused(&s.edges[b.corner as usize], v, b.other))
+                            && !known.refused(s.slot(b.corner), v, b.other))
                 };
                 match t.second[v as usize] {
                     Some(b) if t.repick_at[v as usize] != state && free(&b) => quick.push((v, b)),
@@ -749,12 +826,12 @@ fn step_winners(
         let s_now: &State = s;
         // Local minima, checked; a valid one lists the vertices it blocks
         // (from the fans its check walked).
-        type Checked = (Vec<(u32, Result<Plan, ()>)>, Vec<u32>);
         let checked: Vec<Checked> = par_chunks_map(admitted_keys, |chunk| {
             let mut scratch = CheckScratch::default();
-            let (mut out, mut blocks) = (Vec::new(), Vec::new());
+            let mut out = Checked::default();
             for &(v, key) in chunk {
-                let c = tr.request(v, state).other;
+                let b = tr.request(v, state);
+                let c = b.other;
                 if v > c {
                     continue;
                 }
@@ -764,43 +841,67 @@ fn step_winners(
                 {
                     continue;
                 }
-                let target = s_now.to_metric(tr.request(v, state).target);
-                let result = check_walked(s_now, v, c, target, &mut scratch);
-                if result.is_ok() {
-                    blocks.extend(scratch.neighbourhood());
+                let result = check_walked(s_now, v, c, s_now.to_metric(b.target), &mut scratch);
+                if let Ok(plan) = result {
+                    out.blocks.extend(scratch.neighbourhood());
+                    let (fan_p, fan_c) = scratch.fans();
+                    let start = out.corners.len() as u32;
+                    out.corners.extend_from_slice(&fan_p.corners);
+                    out.corners.extend_from_slice(&fan_c.corners);
+                    let (record, quadric) = prepare(s_now, v, *b, plan);
+                    out.prepared.push((
+                        record,
+                        quadric,
+                        (
+                            start,
+                            fan_p.corners.len() as u32,
+                            fan_c.corners.len() as u32,
+                        ),
+                    ));
                 }
-                out.push((v, result));
+                out.results.push((v, result));
             }
-            (out, blocks)
+            out
         });
         for &(v, _) in admitted_keys.iter() {
             t.keys[v as usize] = u64::MAX;
         }
         phases.lap("minima+check");
-        if checked.iter().all(|(out, _)| out.is_empty()) {
+        if checked.iter().all(|out| out.results.is_empty()) {
             break;
         }
         let mut found = false;
-        for (p, result) in checked.iter().flat_map(|(out, _)| out.iter().copied()) {
-            let b = *t.request(p, state);
-            match result {
-                Ok(plan) => {
-                    found = true;
-                    winners.push(Winner { p, best: b, plan });
-                }
-                Err(()) => {
-                    // Both corners facing the edge hold its slot.
-                    s.edges[b.corner as usize].refused = state;
-                    let across = s.table.o(b.corner);
-                    if across != NONE {
-                        s.edges[across as usize].refused = state;
+        for out in &checked {
+            let base = fans.len() as u32;
+            fans.extend_from_slice(&out.corners);
+            let mut prepared = out.prepared.iter();
+            for &(p, result) in &out.results {
+                let b = *t.request(p, state);
+                match result {
+                    Ok(plan) => {
+                        found = true;
+                        let &(record, quadric, (start, np, nc)) = prepared
+                            .next()
+                            .expect("one prepared collapse per valid check");
+                        winners.push(Winner {
+                            p,
+                            best: b,
+                            plan,
+                            record,
+                            quadric,
+                            fans: (base + start, np, nc),
+                        });
                     }
-                    for x in [p, b.other] {
-                        t.refusals[x as usize] = state;
-                        refused_now.push(x);
-                        if t.listed[x as usize] != state + 1 {
-                            t.listed[x as usize] = state + 1;
-                            refused_ends.push(x);
+                    Err(()) => {
+                        let slot = s.slot_index(b.corner);
+                        s.edges[slot].refused = state;
+                        for x in [p, b.other] {
+                            t.refusals[x as usize] = state;
+                            refused_now.push(x);
+                            if t.listed[x as usize] != state + 1 {
+                                t.listed[x as usize] = state + 1;
+                                refused_ends.push(x);
+                            }
                         }
                     }
                 }
@@ -810,8 +911,8 @@ fn step_winners(
             continue;
         }
         // The winners' endpoints and neighbours leave the game.
-        for (_, blocks) in &checked {
-            for &x in blocks {
+        for out in &checked {
+            for &x in &out.blocks {
                 t.blocked[x as usize] = state;
             }
         }
@@ -854,6 +955,15 @@ pub(super) fn try_apply_collapse(
 /// Applies the collapse of `p` and `b.other` that `check_collapse` planned,
 /// returning its record.
 fn apply_plan(s: &mut State, p: u32, b: Best, plan: Plan, fans: &mut [Fan; 2]) -> Collapse {
+    let (record, q) = prepare(s, p, b, plan);
+    s.table.collapse(p, b.other, plan.left, plan.right, fans);
+    commit(s, p, b, plan, q);
+    record
+}
+
+/// The record of the collapse of `p` and `b.other` and the merged quadric,
+/// from the mesh before it.
+fn prepare(s: &State, p: u32, b: Best, plan: Plan) -> (Collapse, Quadric) {
     let c = b.other;
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
     let weight = q.c[0] + q.c[4] + q.c[7];
@@ -875,15 +985,18 @@ fn apply_plan(s: &mut State, p: u32, b: Best, plan: Plan, fans: &mut [Fan; 2]) -
         error: b.error,
         distance,
     };
-    s.table.collapse(p, c, plan.left, plan.right, fans);
-    let (pi, ci) = (p as usize, c as usize);
+    (record, q)
+}
+
+/// The merged vertex's new attributes once the corner table is collapsed.
+fn commit(s: &mut State, p: u32, b: Best, plan: Plan, q: Quadric) {
+    let (pi, ci) = (p as usize, b.other as usize);
     s.positions[pi] = b.target;
     s.geometry[pi] = s.to_metric(b.target);
     s.quadrics[pi] = q;
     s.boundary[pi] |= s.boundary[ci];
     s.alive[ci] = false;
     s.split_valence[pi] = plan.valence_r as u8;
-    record
 }
 
 /// Re-evaluates the edges around each merged vertex (only their quadric or
@@ -907,27 +1020,22 @@ fn refresh_edges(
 ) {
     let s_now: &State = s;
     let chunks = par_chunks_map(merged, |chunk| {
-        // About six edges a vertex, most with two corners.
-        let mut updates = Vec::with_capacity(14 * chunk.len());
+        // About six edges a vertex.
+        let mut updates = Vec::with_capacity(7 * chunk.len());
         let mut offers = Vec::with_capacity(7 * chunk.len());
         let mut choices = Vec::with_capacity(if scale.is_some() { chunk.len() } else { 0 });
         for &r in chunk {
             let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
             let mut refresh = |x: u32, facing: u32| {
                 let slot = edge_slot(s_now, facing);
-                updates.push((facing, slot));
-                let across = s_now.table.o(facing);
-                if across != NONE {
-                    updates.push((across, slot));
-                }
+                updates.push((s_now.slot_index(facing) as u32, slot));
                 offers.push(Offer { x, r, facing });
                 if let Some(ranking) = &mut ranking {
                     ranking.consider(x, facing, &slot);
                 }
             };
-            // Edge (r, prev c) faces next c and, across it, the opposite
-            // corner: evaluate it once for both. A boundary edge (r, next c)
-            // has no other side and is evaluated on its own.
+            // Edge (r, prev c) faces next c; a boundary edge (r, next c)
+            // faces prev c.
             s_now.table.for_each_corner(r, |c| {
                 refresh(s_now.table.v(prev(c)), next(c));
                 if s_now.table.o(prev(c)) == NONE {
