@@ -149,9 +149,12 @@ pub fn check_walked(
         if w == NONE {
             continue;
         }
-        t.fan(w, &mut k.fan_x);
-        let valence = k.fan_x.corners.len() + if k.fan_x.boundary { 2 } else { 0 };
-        if valence < 4 {
+        if cfg!(debug_assertions) {
+            t.fan(w, &mut k.fan_x);
+            let walked = k.fan_x.corners.len() + if k.fan_x.boundary { 2 } else { 0 };
+            debug_assert_eq!(s.valence[w as usize] as usize, walked, "valence of {w}");
+        }
+        if s.valence[w as usize] < 4 {
             return Err(());
         }
     }

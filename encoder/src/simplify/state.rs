@@ -91,6 +91,11 @@ pub(super) struct State {
     pub geometry: Vec<[f64; 3]>,
     pub quadrics: Vec<Quadric>,
     pub boundary: Vec<bool>,
+    /// Valence of each vertex with the boundary ghost counted (triangles,
+    /// plus 2 on a boundary: the fan's extra neighbour and the ghost), kept
+    /// up to date by the collapses so that a check reads the wings' valences
+    /// instead of walking their fans.
+    pub valence: Vec<u32>,
     pub alive: Vec<bool>,
     pub split_valence: Vec<u8>,
     /// Cached collapse of the edge facing each corner.
@@ -122,12 +127,17 @@ impl State {
             }
         }
         let alive: Vec<bool> = table.corner_of.iter().map(|&c| c != NONE).collect();
+        let mut valence: Vec<u32> = boundary.iter().map(|&b| if b { 2 } else { 0 }).collect();
+        for &v in &table.vertex {
+            valence[v as usize] += 1;
+        }
         State {
             quadrics: Vec::new(),
             positions: mesh.positions.clone(),
             geometry,
             table,
             boundary,
+            valence,
             alive,
             split_valence: vec![LEAF; n],
             edges: Vec::new(),
@@ -229,8 +239,6 @@ struct Tracking {
     listed: Vec<u32>,
     /// `== state`: the vertex was sorted into choosing or taking offers.
     sorted: Vec<u32>,
-    /// The vertex's last offer in the step's list (valid where sorted).
-    last_offer: Vec<u32>,
     /// Pair key of each vertex's admitted request in the current pass,
     /// `u64::MAX` otherwise (reset after each pass, so never swept whole).
     keys: Vec<u64>,
@@ -250,7 +258,6 @@ impl Tracking {
             // Every vertex is on the first step's list.
             listed: vec![1; n],
             sorted: vec![0; n],
-            last_offer: vec![0; n],
             keys: vec![u64::MAX; n],
         }
     }
@@ -530,80 +537,43 @@ fn take_offers(
     scale: Scale,
     state: u32,
 ) -> usize {
-    // Link each vertex's offers, so that one task takes them all.
-    let mut links = vec![NONE; offers.len()];
-    let mut firsts = Vec::new();
-    for (i, o) in offers.iter().enumerate() {
+    let mut offered = 0;
+    let gone =
+        |t: &Tracking, u: u32| u != NONE && (!s.alive[u as usize] || t.merged[u as usize] == state);
+    for o in offers {
         let x = o.x as usize;
         if t.sorted[x] != state {
             t.sorted[x] = state;
-            firsts.push(i as u32);
-        } else {
-            links[t.last_offer[x] as usize] = i as u32;
-        }
-        t.last_offer[x] = i as u32;
-    }
-    enum Outcome {
-        /// Already listed to choose from scratch (a refused end).
-        Listed,
-        Choose,
-        Take(Choices),
-    }
-    let tr: &Tracking = t;
-    let gone = |u: u32| u != NONE && (!s.alive[u as usize] || tr.merged[u as usize] == state);
-    let outcomes = par_chunks_map(&firsts, |chunk| {
-        chunk
-            .iter()
-            .map(|&first| {
-                let x = offers[first as usize].x;
-                let xi = x as usize;
-                if tr.listed[xi] == state {
-                    return (x, Outcome::Listed);
-                }
-                let (best, second) = (tr.best[xi], tr.second[xi]);
-                let second_gone = second.is_none_or(|b| gone(b.other));
-                if tr.refusals[xi] != 0 || (gone(best.other) && second_gone) {
-                    return (x, Outcome::Choose);
-                }
-                let mut choices = if gone(best.other) {
-                    // The runner-up is the best of what is left; what comes
-                    // after it is not known.
-                    let b = second.unwrap_or(Best::NONE);
-                    Choices {
-                        best: b,
-                        second: (b.other == NONE).then_some(Best::NONE),
-                    }
+            if t.listed[x] != state {
+                let second = t.second[x];
+                let second_gone = second.is_none_or(|b| gone(t, b.other));
+                if t.refusals[x] != 0 || (gone(t, t.best[x].other) && second_gone) {
+                    t.listed[x] = state;
+                    choosers.push(o.x);
                 } else {
-                    Choices {
-                        best,
-                        second: if second_gone { None } else { second },
+                    offered += 1;
+                    if gone(t, t.best[x].other) {
+                        // The runner-up is the best of what is left; what
+                        // comes after it is not known.
+                        let b = second.unwrap_or(Best::NONE);
+                        t.best[x] = b;
+                        t.second[x] = (b.other == NONE).then_some(Best::NONE);
+                    } else if second_gone {
+                        t.second[x] = None;
                     }
-                };
-                let mut i = first;
-                while i != NONE {
-                    let o = &offers[i as usize];
-                    offer(s, x, &mut choices, o.r, o.facing, scale);
-                    i = links[i as usize];
                 }
-                (x, Outcome::Take(choices))
-            })
-            .collect::<Vec<_>>()
-    });
-    let mut offered = 0;
-    for (x, outcome) in outcomes.into_iter().flatten() {
-        let xi = x as usize;
-        match outcome {
-            Outcome::Listed => {}
-            Outcome::Choose => {
-                t.listed[xi] = state;
-                choosers.push(x);
-            }
-            Outcome::Take(choices) => {
-                offered += 1;
-                t.best[xi] = choices.best;
-                t.second[xi] = choices.second;
             }
         }
+        if t.listed[x] == state {
+            continue;
+        }
+        let mut choices = Choices {
+            best: t.best[x],
+            second: t.second[x],
+        };
+        offer(s, o.x, &mut choices, o.r, o.facing, scale);
+        t.best[x] = choices.best;
+        t.second[x] = choices.second;
     }
     // Every chooser's refused edges are stale now (its 1-ring changed, or
     // it was refused and chooses without the refused edge).
@@ -997,6 +967,12 @@ fn commit(s: &mut State, p: u32, b: Best, plan: Plan, q: Quadric) {
     s.boundary[pi] |= s.boundary[ci];
     s.alive[ci] = false;
     s.split_valence[pi] = plan.valence_r as u8;
+    s.valence[pi] = plan.valence_r as u32;
+    for w in [plan.wing_a, plan.wing_b] {
+        if w != NONE {
+            s.valence[w as usize] -= 1;
+        }
+    }
 }
 
 /// Re-evaluates the edges around each merged vertex (only their quadric or
