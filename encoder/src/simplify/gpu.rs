@@ -79,8 +79,8 @@ pub fn simplify_gpu(
     let local = engine.quadric_init(&base)?;
     s.quadrics = local
         .iter()
-        .zip(&s.geometry)
-        .map(|(q, &o)| to_global(q, o))
+        .enumerate()
+        .map(|(v, q)| to_global(q, s.geometry(v as u32)))
         .collect();
 
     let mut alive_count = s.alive.iter().filter(|&&a| a).count();
@@ -285,7 +285,7 @@ fn changes(
                 position: [words[0], words[1], words[2]],
                 flags: words[3],
                 corner_of: s.table.corner_of[v as usize],
-                quadric: to_local(&s.quadrics[v as usize], s.geometry[v as usize]),
+                quadric: to_local(&s.quadrics[v as usize], s.geometry(v)),
             }
         })
         .collect();

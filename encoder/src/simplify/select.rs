@@ -60,7 +60,7 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
         // P, C or the integer midpoint P + ((C - P) >> 1) (SPEC §7.4).
         let mid: [u32; 3] =
             std::array::from_fn(|k| (pp[k] as i64 + ((pc[k] as i64 - pp[k] as i64) >> 1)) as u32);
-        let mut best = (pp, q.error(s.geometry[pi]));
+        let mut best = (pp, q.error(s.geometry(p)));
         for cand in [pc, mid] {
             let e = q.error(s.to_metric(cand));
             if e < best.1 {
@@ -69,7 +69,7 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
         }
         best.0
     } else {
-        let (t, _) = collapse_target(&q, s.geometry[pi], s.geometry[ci], false);
+        let (t, _) = collapse_target(&q, s.geometry(p), s.geometry(c), false);
         let top = ((1u64 << s.bits) - 1) as f64;
         std::array::from_fn(|k| to_grid(t[k] / s.metric[k], top))
     };
