@@ -142,7 +142,6 @@ pub fn simplify_gpu(
             other: w.other,
             error: w.error as f64,
             error_key: w.key,
-            target: w.target,
             corner: NONE,
         };
         let room = alive_count - options.target_vertices;
@@ -159,7 +158,7 @@ pub fn simplify_gpu(
         let mut rejected = 0usize;
         for w in &winners {
             let b = as_best(w);
-            match try_apply_collapse(&mut s, w.v, b, &mut fans) {
+            match try_apply_collapse(&mut s, w.v, b, w.target, &mut fans) {
                 Some((collapse, plan)) => {
                     step_error = step_error.max(b.error);
                     merged.push(w.v);

@@ -20,7 +20,6 @@ pub struct Best {
     /// Error rounded to f32 bits (flat regions flushed to 0) so that equal
     /// errors tie exactly and the tie-breaks decide.
     pub error_key: u32,
-    pub target: [u32; 3],
     /// A corner facing the edge (its slot in the Edge array); [`NONE`] where
     /// the chooser does not track slots (GPU backends).
     pub corner: u32,
@@ -31,7 +30,6 @@ impl Best {
         other: NONE,
         error: f64::INFINITY,
         error_key: u32::MAX,
-        target: [0; 3],
         corner: NONE,
     };
 }
@@ -93,12 +91,15 @@ fn to_grid(x: f64, top: f64) -> u32 {
     i + u32::from(x - f64::from(i) >= 0.5)
 }
 
-/// Cached collapse of the edge facing one corner (the paper's Edge array),
-/// kept at the lower of the edge's two corners ([`State::slot_index`]).
+/// Cached collapse error of the edge facing one corner (the paper's Edge
+/// array), kept at the lower of the edge's two corners
+/// ([`State::slot_index`]). The merged position is not kept: only the few
+/// pairs a step checks need it, and [`evaluate`] gives it again exactly (the
+/// slot is refreshed whenever an end changes). A slot is then 16 bytes, and
+/// the Edge array is the one the passes read most, at random.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EdgeSlot {
     pub error: f64,
-    pub target: [u32; 3],
     /// State number (see [`Known`]) in which the collapse was checked and
     /// found invalid; 0 if it never was since the slot was evaluated.
     pub refused: u32,
@@ -107,7 +108,6 @@ pub struct EdgeSlot {
 impl EdgeSlot {
     pub const FORBIDDEN: EdgeSlot = EdgeSlot {
         error: f64::INFINITY,
-        target: [0; 3],
         refused: 0,
     };
 }
@@ -119,11 +119,7 @@ pub fn edge_slot(s: &State, c: u32) -> EdgeSlot {
         return EdgeSlot::FORBIDDEN;
     }
     match evaluate(s, a, b) {
-        Some((target, error)) => EdgeSlot {
-            error,
-            target,
-            refused: 0,
-        },
+        Some((_, error)) => EdgeSlot { error, refused: 0 },
         None => EdgeSlot::FORBIDDEN,
     }
 }
@@ -266,7 +262,6 @@ impl<'a> Ranking<'a> {
             other: u,
             error: slot.error,
             error_key: key,
-            target: slot.target,
             corner: facing,
         };
         if self.order.before(key, u, &self.best) {
@@ -353,7 +348,6 @@ pub fn offer(s: &State, v: u32, choices: &mut Choices, u: u32, facing: u32, scal
         other: u,
         error: slot.error,
         error_key: key,
-        target: slot.target,
         corner: facing,
     };
     if order.before(key, u, &choices.best) {

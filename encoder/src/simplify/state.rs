@@ -4,7 +4,7 @@ use rayon::prelude::*;
 
 use super::check::{CheckScratch, Plan, check_collapse, check_walked};
 use super::select::{
-    Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, offer, pair_key, pick_edge,
+    Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, evaluate, offer, pair_key, pick_edge,
 };
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
@@ -280,6 +280,8 @@ impl Tracking {
 struct Winner {
     p: u32,
     best: Best,
+    /// Where the merged vertex goes.
+    target: [u32; 3],
     plan: Plan,
     /// Its record and the merged quadric, prepared in parallel with its
     /// check (from the step's mesh, which the other winners do not touch).
@@ -429,7 +431,7 @@ pub fn simplify(
                     &s,
                     w.p,
                     w.best.other,
-                    s.to_metric(w.best.target),
+                    s.to_metric(w.target),
                     &mut CheckScratch::default()
                 ),
                 Ok(w.plan),
@@ -440,7 +442,7 @@ pub fn simplify(
             let fan_c = &buffers.fans[start + np..start + np + nc];
             s.table
                 .collapse_fans(w.p, w.best.other, w.plan.left, w.plan.right, fan_p, fan_c);
-            commit(&mut s, w.p, w.best, w.plan, w.quadric);
+            commit(&mut s, w.p, w.best.other, w.target, w.plan, w.quadric);
             collapses.push(w.record);
             step_error = step_error.max(w.best.error);
         }
@@ -647,6 +649,10 @@ struct Buffers {
     fans: Vec<u32>,
 }
 
+/// A valid check's collapse: record, merged quadric, target and fans
+/// (offset into the chunk's corners, lengths of P's and C's).
+type Prepared = (Collapse, Quadric, [u32; 3], (u32, u32, u32));
+
 /// One chunk's checks: results in order, and for the valid ones the
 /// vertices they block, their prepared records and merged quadrics, and
 /// their fans (offsets into `corners`).
@@ -654,7 +660,7 @@ struct Buffers {
 struct Checked {
     results: Vec<(u32, Result<Plan, ()>)>,
     blocks: Vec<u32>,
-    prepared: Vec<(Collapse, Quadric, (u32, u32, u32))>,
+    prepared: Vec<Prepared>,
     corners: Vec<u32>,
 }
 
@@ -809,17 +815,22 @@ fn step_winners(
                 {
                     continue;
                 }
-                let result = check_walked(s_now, v, c, s_now.to_metric(b.target), &mut scratch);
+                // The merged position, as the slot's evaluation found it.
+                let (target, error) =
+                    evaluate(s_now, v, c).expect("an edge with a finite error has a placement");
+                debug_assert_eq!(error, b.error, "slot of ({v}, {c}) up to date");
+                let result = check_walked(s_now, v, c, s_now.to_metric(target), &mut scratch);
                 if let Ok(plan) = result {
                     out.blocks.extend(scratch.neighbourhood());
                     let (fan_p, fan_c) = scratch.fans();
                     let start = out.corners.len() as u32;
                     out.corners.extend_from_slice(&fan_p.corners);
                     out.corners.extend_from_slice(&fan_c.corners);
-                    let (record, quadric) = prepare(s_now, v, *b, plan);
+                    let (record, quadric) = prepare(s_now, v, *b, target, plan);
                     out.prepared.push((
                         record,
                         quadric,
+                        target,
                         (
                             start,
                             fan_p.corners.len() as u32,
@@ -848,12 +859,13 @@ fn step_winners(
                 match result {
                     Ok(plan) => {
                         found = true;
-                        let &(record, quadric, (start, np, nc)) = prepared
+                        let &(record, quadric, target, (start, np, nc)) = prepared
                             .next()
                             .expect("one prepared collapse per valid check");
                         winners.push(Winner {
                             p,
                             best: b,
+                            target,
                             plan,
                             record,
                             quadric,
@@ -913,25 +925,20 @@ pub(super) fn try_apply_collapse(
     s: &mut State,
     p: u32,
     b: Best,
+    target: [u32; 3],
     fans: &mut [Fan; 2],
 ) -> Option<(Collapse, Plan)> {
     let mut scratch = CheckScratch::default();
-    let plan = check_collapse(s, p, b.other, s.to_metric(b.target), &mut scratch).ok()?;
-    Some((apply_plan(s, p, b, plan, fans), plan))
-}
-
-/// Applies the collapse of `p` and `b.other` that `check_collapse` planned,
-/// returning its record.
-fn apply_plan(s: &mut State, p: u32, b: Best, plan: Plan, fans: &mut [Fan; 2]) -> Collapse {
-    let (record, q) = prepare(s, p, b, plan);
+    let plan = check_collapse(s, p, b.other, s.to_metric(target), &mut scratch).ok()?;
+    let (record, q) = prepare(s, p, b, target, plan);
     s.table.collapse(p, b.other, plan.left, plan.right, fans);
-    commit(s, p, b, plan, q);
-    record
+    commit(s, p, b.other, target, plan, q);
+    Some((record, plan))
 }
 
-/// The record of the collapse of `p` and `b.other` and the merged quadric,
-/// from the mesh before it.
-fn prepare(s: &State, p: u32, b: Best, plan: Plan) -> (Collapse, Quadric) {
+/// The record of the collapse of `p` and `b.other` to `target` and the
+/// merged quadric, from the mesh before it.
+fn prepare(s: &State, p: u32, b: Best, target: [u32; 3], plan: Plan) -> (Collapse, Quadric) {
     let c = b.other;
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
     let weight = q.c[0] + q.c[4] + q.c[7];
@@ -947,7 +954,7 @@ fn prepare(s: &State, p: u32, b: Best, plan: Plan) -> (Collapse, Quadric) {
         wing_b: plan.wing_b,
         position_p: s.positions[p as usize],
         position_c: s.positions[c as usize],
-        position_r: b.target,
+        position_r: target,
         split_valence_p: s.split_valence[p as usize],
         split_valence_c: s.split_valence[c as usize],
         error: b.error,
@@ -957,9 +964,9 @@ fn prepare(s: &State, p: u32, b: Best, plan: Plan) -> (Collapse, Quadric) {
 }
 
 /// The merged vertex's new attributes once the corner table is collapsed.
-fn commit(s: &mut State, p: u32, b: Best, plan: Plan, q: Quadric) {
-    let (pi, ci) = (p as usize, b.other as usize);
-    s.positions[pi] = b.target;
+fn commit(s: &mut State, p: u32, c: u32, target: [u32; 3], plan: Plan, q: Quadric) {
+    let (pi, ci) = (p as usize, c as usize);
+    s.positions[pi] = target;
     s.quadrics[pi] = q;
     s.boundary[pi] |= s.boundary[ci];
     s.alive[ci] = false;
