@@ -283,10 +283,6 @@ struct Winner {
     /// Where the merged vertex goes.
     target: [u32; 3],
     plan: Plan,
-    /// Its record and the merged quadric, prepared in parallel with its
-    /// check (from the step's mesh, which the other winners do not touch).
-    record: Collapse,
-    quadric: Quadric,
     /// The fans of P then C as its check walked them, at `fans` in
     /// [`Buffers::fans`]: applying the collapse needs no walk.
     fans: (u32, u32, u32),
@@ -440,10 +436,13 @@ pub fn simplify(
             let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
             let fan_p = &buffers.fans[start..start + np];
             let fan_c = &buffers.fans[start + np..start + np + nc];
+            // Built from P and C before the collapse, as its check saw them
+            // (no other collapse of the step touches them).
+            let (record, quadric) = prepare(&s, w.p, w.best, w.target, w.plan);
             s.table
                 .collapse_fans(w.p, w.best.other, w.plan.left, w.plan.right, fan_p, fan_c);
-            commit(&mut s, w.p, w.best.other, w.target, w.plan, w.quadric);
-            collapses.push(w.record);
+            commit(&mut s, w.p, w.best.other, w.target, w.plan, quadric);
+            collapses.push(record);
             step_error = step_error.max(w.best.error);
         }
         let t_refresh = std::time::Instant::now();
@@ -649,12 +648,12 @@ struct Buffers {
     fans: Vec<u32>,
 }
 
-/// A valid check's collapse: record, merged quadric, target and fans
-/// (offset into the chunk's corners, lengths of P's and C's).
-type Prepared = (Collapse, Quadric, [u32; 3], (u32, u32, u32));
+/// A valid check's target and fans (offset into the chunk's corners,
+/// lengths of P's and C's).
+type Prepared = ([u32; 3], (u32, u32, u32));
 
 /// One chunk's checks: results in order, and for the valid ones the
-/// vertices they block, their prepared records and merged quadrics, and
+/// vertices they block, their targets, and
 /// their fans (offsets into `corners`).
 #[derive(Default)]
 struct Checked {
@@ -820,16 +819,13 @@ fn step_winners(
                     evaluate(s_now, v, c).expect("an edge with a finite error has a placement");
                 debug_assert_eq!(error, b.error, "slot of ({v}, {c}) up to date");
                 let result = check_walked(s_now, v, c, s_now.to_metric(target), &mut scratch);
-                if let Ok(plan) = result {
+                if result.is_ok() {
                     out.blocks.extend(scratch.neighbourhood());
                     let (fan_p, fan_c) = scratch.fans();
                     let start = out.corners.len() as u32;
                     out.corners.extend_from_slice(&fan_p.corners);
                     out.corners.extend_from_slice(&fan_c.corners);
-                    let (record, quadric) = prepare(s_now, v, *b, target, plan);
                     out.prepared.push((
-                        record,
-                        quadric,
                         target,
                         (
                             start,
@@ -859,7 +855,7 @@ fn step_winners(
                 match result {
                     Ok(plan) => {
                         found = true;
-                        let &(record, quadric, target, (start, np, nc)) = prepared
+                        let &(target, (start, np, nc)) = prepared
                             .next()
                             .expect("one prepared collapse per valid check");
                         winners.push(Winner {
@@ -867,8 +863,6 @@ fn step_winners(
                             best: b,
                             target,
                             plan,
-                            record,
-                            quadric,
                             fans: (base + start, np, nc),
                         });
                     }
