@@ -709,12 +709,16 @@ fn step_winners(
     } = step;
     // Passes that find winners; on jacksboro they add 100 %, 30 %, 4 % and
     // 0.2 % of the first pass's collapses: a fourth is not worth its O(n)
-    // sweeps. A pass whose chosen pairs are all refused does not count (each
-    // such pass refuses edges for good, so they are finitely many).
+    // sweeps. A pass whose chosen pairs are all refused does not count, up
+    // to a few: on badly scaled input (a DEM in degrees and metres) a step
+    // near a raised threshold could otherwise sweep its players for dozens
+    // of passes of one or two refused pairs each; refused ends choose again
+    // at the next step anyway.
     const PASSES: usize = 3;
+    const MAX_PASSES: usize = 2 * PASSES;
     let mut winners: Vec<Winner> = Vec::new();
     let mut refused_now: Vec<u32> = Vec::new();
-    let mut counted = 0;
+    let (mut counted, mut passes) = (0, 0);
     let mut first = true;
     // Only vertices whose request is under S can take part: choosing again
     // among fewer neighbours never gets cheaper (up to requests of equal f32
@@ -881,7 +885,11 @@ fn step_winners(
                 }
             }
         }
+        passes += 1;
         if !found {
+            if passes == MAX_PASSES {
+                break;
+            }
             continue;
         }
         // The winners' endpoints and neighbours leave the game.
@@ -892,7 +900,7 @@ fn step_winners(
         }
         phases.lap("block");
         counted += 1;
-        if counted == PASSES {
+        if counted == PASSES || passes == MAX_PASSES {
             break;
         }
     }
