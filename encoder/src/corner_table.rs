@@ -26,6 +26,45 @@ pub fn prev(c: u32) -> u32 {
     if c.is_multiple_of(3) { c + 2 } else { c - 1 }
 }
 
+/// The items `0..count` that have an edge (`ends(i)`, a pair of vertex ids
+/// below `vertex_count`, in either direction) as `(key, item)` with key
+/// `min << 32 | max`, sorted: what sorting those pairs gives, by a counting
+/// sort on the lower id and sorts of the short runs that share it. Every
+/// 2-manifold vertex owns a few edges, so this is linear where a full sort
+/// was the largest cost of setting up a simplification.
+pub fn by_undirected_edge(
+    vertex_count: usize,
+    count: usize,
+    ends: impl Fn(u32) -> Option<(u32, u32)>,
+) -> Vec<(u64, u32)> {
+    let keys: Vec<Option<u64>> = (0..count as u32)
+        .map(|i| ends(i).map(|(u, v)| (u64::from(u.min(v)) << 32) | u64::from(u.max(v))))
+        .collect();
+    let mut start = vec![0u32; vertex_count + 1];
+    for key in keys.iter().flatten() {
+        start[(key >> 32) as usize + 1] += 1;
+    }
+    for k in 1..start.len() {
+        start[k] += start[k - 1];
+    }
+    let mut fill = start.clone();
+    let mut order = vec![(0u64, 0u32); start[vertex_count] as usize];
+    for (i, key) in keys.iter().enumerate() {
+        if let &Some(key) = key {
+            let slot = &mut fill[(key >> 32) as usize];
+            order[*slot as usize] = (key, i as u32);
+            *slot += 1;
+        }
+    }
+    for w in start.windows(2) {
+        let run = &mut order[w[0] as usize..w[1] as usize];
+        if run.len() > 1 {
+            run.sort_unstable();
+        }
+    }
+    order
+}
+
 /// The corners around one vertex, in fan order, and whether the fan is open.
 #[derive(Default)]
 pub struct Fan {
@@ -40,22 +79,17 @@ impl CornerTable {
     pub fn new(vertex_count: usize, triangles: &[[u32; 3]]) -> CornerTable {
         let vertex: Vec<u32> = triangles.iter().flatten().copied().collect();
         let mut opposite = vec![NONE; vertex.len()];
-        // Key each corner by the undirected edge it faces; the corner's own
-        // direction (from `next` to `prev`) tells the two sides apart.
-        let mut keys: Vec<(u64, u32)> = (0..vertex.len() as u32)
-            .map(|c| {
-                let (u, v) = (vertex[next(c) as usize], vertex[prev(c) as usize]);
-                ((u64::from(u.min(v)) << 32) | u64::from(u.max(v)), c)
-            })
-            .collect();
-        keys.sort_unstable();
+        // Group the corners by the undirected edge they face; the corner's
+        // own direction (from `next` to `prev`) tells the two sides apart.
+        let from = |c: u32| vertex[next(c) as usize];
+        let ends = |c: u32| (from(c), vertex[prev(c) as usize]);
+        let keys = by_undirected_edge(vertex_count, vertex.len(), |c| Some(ends(c)));
         for run in keys.chunk_by(|x, y| x.0 == y.0) {
-            if let [(_, c0), (_, c1)] = *run {
-                let from = |c: u32| vertex[next(c) as usize];
-                if from(c0) != from(c1) {
-                    opposite[c0 as usize] = c1;
-                    opposite[c1 as usize] = c0;
-                }
+            if let [(_, c0), (_, c1)] = *run
+                && from(c0) != from(c1)
+            {
+                opposite[c0 as usize] = c1;
+                opposite[c1 as usize] = c0;
             }
         }
         let mut corner_of = vec![NONE; vertex_count];
@@ -122,6 +156,41 @@ impl CornerTable {
         }
     }
 
+    /// Calls `f` on the corners around vertex `v` in the order [`Self::fan`]
+    /// lists them, without collecting them (the hot loops only look).
+    #[inline]
+    pub fn for_each_corner(&self, v: u32, mut f: impl FnMut(u32)) {
+        let start = self.corner_of[v as usize];
+        if start == NONE {
+            return;
+        }
+        let limit = self.vertex.len();
+        let mut seen = 0;
+        let mut c = start;
+        loop {
+            f(c);
+            seen += 1;
+            let o = self.o(prev(c));
+            if o == NONE {
+                break;
+            }
+            c = prev(o);
+            if c == start || seen > limit {
+                return;
+            }
+        }
+        let mut c = start;
+        loop {
+            let o = self.o(next(c));
+            if o == NONE || seen > limit {
+                return;
+            }
+            c = next(o);
+            f(c);
+            seen += 1;
+        }
+    }
+
     /// Unlinks triangle `t`: its two remaining outer neighbours become each
     /// other's opposites (the edge between them is being folded shut) and the
     /// corners are marked dead. `keep` is the corner of `t` whose facing edge
@@ -154,6 +223,20 @@ impl CornerTable {
         let [fa, fb] = fans;
         self.fan(keep, fa);
         self.fan(gone, fb);
+        self.collapse_fans(keep, gone, left, right, &fa.corners, &fb.corners);
+    }
+
+    /// [`Self::collapse`] given the fans of `keep` and `gone` as they are
+    /// before it (the parallel simplifier has them from its check).
+    pub fn collapse_fans(
+        &mut self,
+        keep: u32,
+        gone: u32,
+        left: u32,
+        right: u32,
+        fan_keep: &[u32],
+        fan_gone: &[u32],
+    ) {
         let doomed = |c: u32| c != NONE && (c / 3 == left / 3 || c / 3 == right / 3);
         // Re-anchor the wing vertices on triangles that survive: the
         // neighbours across their two folded edges.
@@ -170,7 +253,7 @@ impl CornerTable {
                 .unwrap_or(NONE);
             self.corner_of[x as usize] = anchor;
         }
-        for &c in &fb.corners {
+        for &c in fan_gone {
             if !doomed(c) {
                 self.vertex[c as usize] = keep;
             }
@@ -181,10 +264,9 @@ impl CornerTable {
         if right != NONE {
             self.remove_triangle(next(right));
         }
-        self.corner_of[keep as usize] = fa
-            .corners
+        self.corner_of[keep as usize] = fan_keep
             .iter()
-            .chain(&fb.corners)
+            .chain(fan_gone)
             .copied()
             .find(|&c| !doomed(c))
             .unwrap_or(NONE);
@@ -202,6 +284,20 @@ impl CornerTable {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn edges_come_in_key_order() {
+        let pairs: Vec<(u32, u32)> = (0..500u32)
+            .map(|i| ((i * 37) % 23, (i * 11 + 5) % 29))
+            .collect();
+        let ends = |i: u32| (i % 7 != 3).then(|| pairs[i as usize]);
+        let got = by_undirected_edge(29, pairs.len(), ends);
+        let mut want: Vec<(u64, u32)> = (0..pairs.len() as u32)
+            .filter_map(|i| ends(i).map(|(u, v)| (((u.min(v) as u64) << 32) | u.max(v) as u64, i)))
+            .collect();
+        want.sort_unstable();
+        assert_eq!(got, want);
+    }
 
     #[test]
     fn fans_of_a_square() {
@@ -230,5 +326,19 @@ mod tests {
         t.fan(3, &mut fan);
         assert!(fan.boundary);
         assert_eq!(fan.corners.len(), 2);
+    }
+
+    #[test]
+    fn corner_walk_lists_the_fan() {
+        // A hexagon fan around 0 with one triangle missing: open fans too.
+        let tris: Vec<[u32; 3]> = (0..5).map(|i| [0, 1 + i, 1 + (i + 1) % 6]).collect();
+        let t = CornerTable::new(7, &tris);
+        let mut fan = Fan::default();
+        for v in 0..7 {
+            t.fan(v, &mut fan);
+            let mut walked = Vec::new();
+            t.for_each_corner(v, |c| walked.push(c));
+            assert_eq!(walked, fan.corners, "vertex {v}");
+        }
     }
 }

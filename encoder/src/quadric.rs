@@ -186,29 +186,17 @@ pub fn vertex_quadrics(
         return quadrics;
     }
 
-    // Undirected edge key and the corner (3 * triangle + edge slot) using it;
-    // after sorting, a key that appears once is a boundary edge.
-    let mut edges: Vec<(u64, u32)> = triangles
-        .iter()
-        .enumerate()
-        .filter(|(_, t)| valid(t))
-        .flat_map(|(i, t)| {
-            (0..3).map(move |k| {
-                let (u, v) = (t[k], t[(k + 1) % 3]);
-                let key = (u64::from(u.min(v)) << 32) | u64::from(u.max(v));
-                (key, (3 * i + k) as u32)
-            })
-        })
-        .collect();
-    edges.par_sort_unstable();
-    let mut i = 0;
-    while i < edges.len() {
-        let mut j = i + 1;
-        while j < edges.len() && edges[j].0 == edges[i].0 {
-            j += 1;
-        }
-        if j - i == 1 {
-            let corner = edges[i].1 as usize;
+    // Each triangle edge (3 * triangle + edge slot) grouped by undirected
+    // edge in key order; an edge used once is a boundary edge.
+    let ends = |e: u32| {
+        let t = &triangles[e as usize / 3];
+        let k = e as usize % 3;
+        valid(t).then(|| (t[k], t[(k + 1) % 3]))
+    };
+    let edges = crate::corner_table::by_undirected_edge(n, 3 * triangles.len(), ends);
+    for run in edges.chunk_by(|x, y| x.0 == y.0) {
+        if let [(_, corner)] = *run {
+            let corner = corner as usize;
             let t = triangles[corner / 3];
             let k = corner % 3;
             let (u, v, w) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
@@ -217,7 +205,6 @@ pub fn vertex_quadrics(
             quadrics[u as usize] += q;
             quadrics[v as usize] += q;
         }
-        i = j;
     }
     quadrics
 }

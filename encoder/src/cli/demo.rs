@@ -29,13 +29,15 @@ pub fn run(side: usize, output: Option<&std::path::Path>) -> CliResult {
         std::fs::write(path, stream).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     println!(
-        "encoded: {} bytes ({:.2} bits/vertex), {} levels, {} rounds, in {:.2} s ({:.2} M triangles/s)",
+        "encoded: {} bytes ({:.2} bits/vertex), {} levels, {} rounds, in {:.2} s ({:.2} M triangles/s; simplify {:.2} s, emit {:.2} s)",
         stream.len(),
         8.0 * stream.len() as f64 / mesh.positions.len() as f64,
         encoded.level_vertex_counts.len(),
         encoded.rounds,
         seconds,
-        mesh.triangles.len() as f64 / seconds / 1e6
+        mesh.triangles.len() as f64 / seconds / 1e6,
+        encoded.simplify_seconds,
+        encoded.emit_seconds,
     );
     let fail = |e: splitstream_decoder_core::Error| format!("demo stream: {e}");
     let mut ws = OwnedWorkspace::for_stream(stream).map_err(fail)?;

@@ -13,6 +13,8 @@ use splitstream_decoder_core::{
     context, predict, residual,
 };
 
+use rayon::prelude::*;
+
 use super::levels::LevelPlan;
 use crate::corner_table::Fan;
 use crate::quantize::QuantizedMesh;
@@ -126,7 +128,9 @@ fn write_vector(w: &mut SubstreamWriter, plane: &Plane, coded: [i64; 3]) -> bool
 /// Feeds one round from the collapses of one simplification step.
 struct StepSource<'a> {
     collapses: &'a [Collapse],
-    /// For each input id, the index of its collapse in this step (or NONE).
+    /// For each decoder id, the index of its vertex's collapse in this step
+    /// (or NONE): the decoder asks by its own ids, one look-up instead of
+    /// two through `dec2enc` for every candidate.
     current: &'a mut [u32],
     enc2dec: &'a mut [u32],
     dec2enc: &'a mut Vec<u32>,
@@ -153,8 +157,7 @@ impl StepSource<'_> {
 
 impl RecordSource for StepSource<'_> {
     fn flag(&mut self, _state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
-        let id = self.dec2enc[v as usize];
-        let flagged = self.current[id as usize] != NONE;
+        let flagged = self.current[v as usize] != NONE;
         self.subs[slot(substream::FLAGS)].bit_in(context::SINGLE, flagged);
         Ok(flagged)
     }
@@ -169,9 +172,9 @@ impl RecordSource for StepSource<'_> {
     }
 
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
-        let id = self.dec2enc[r as usize];
-        let index = self.current[id as usize] as usize;
+        let index = self.current[r as usize] as usize;
         let col = self.collapses[index];
+        let id = col.p;
         self.pending = Some(index);
         let dec = |enc: u32, map: &[u32]| if enc == NONE { NONE } else { map[enc as usize] };
         let (a, b) = (dec(col.wing_a, self.enc2dec), dec(col.wing_b, self.enc2dec));
@@ -384,6 +387,7 @@ pub fn replay(
     let seed = SeedPayload::new(&base_positions, &base_triangles, &base_deficits);
     let mut levels = Vec::with_capacity(plan.rounds.len());
     let mut current = vec![NONE; n];
+    let mut flagged = Vec::new();
     let mut ring = Ring::default();
     for (l, steps) in plan.rounds.iter().enumerate() {
         let mut subs = vec![SubstreamWriter::default(); 7];
@@ -391,8 +395,11 @@ pub fn replay(
         let mut round_splits = Vec::with_capacity(steps.len());
         for &k in steps {
             let collapses = &s.steps[k];
+            flagged.clear();
             for (i, col) in collapses.iter().enumerate() {
-                current[col.p as usize] = i as u32;
+                let r = enc2dec[col.p as usize];
+                current[r as usize] = i as u32;
+                flagged.push(r);
             }
             let mut source = StepSource {
                 collapses,
@@ -411,8 +418,8 @@ pub fn replay(
                 let why = source.problem.take().unwrap_or_else(|| e.to_string());
                 return Err(ReplayError(format!("step {k}: {why}")));
             }
-            for col in collapses {
-                current[col.p as usize] = NONE;
+            for &r in &flagged {
+                current[r as usize] = NONE;
             }
             round_splits.push(collapses.len() as u32);
         }
@@ -509,12 +516,12 @@ fn check_exact(
     };
     let mut decoded: Vec<[u32; 3]> = state
         .triangles()
-        .iter()
+        .par_iter()
         .map(|t| canonical(t.map(|v| dec2enc[v as usize])))
         .collect();
-    let mut input: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
-    decoded.sort_unstable();
-    input.sort_unstable();
+    let mut input: Vec<[u32; 3]> = mesh.triangles.par_iter().map(|&t| canonical(t)).collect();
+    // Two sorts of every triangle: in parallel, each itself parallel.
+    rayon::join(|| decoded.par_sort_unstable(), || input.par_sort_unstable());
     if decoded != input {
         return Err(ReplayError(
             "decoded triangles differ from the input".into(),

@@ -1,7 +1,7 @@
 //! Whether one collapse keeps the mesh a valid oriented 2-manifold that the
 //! decoder can split back (SPEC §6, §7): link condition with the boundary
 //! ghost, valence limits, wings that keep a fan, no folded triangles.
-//! Read-only, so every vertex can check its candidates in parallel.
+//! Read-only, so the pairs a step chooses can be checked in parallel.
 
 use super::state::{MAX_VALENCE, State};
 use crate::corner_table::{Fan, NONE, next, prev};
@@ -23,11 +23,9 @@ pub struct Plan {
 /// Reusable buffers so the parallel passes do not allocate per vertex.
 #[derive(Default)]
 pub struct CheckScratch {
-    pub fan_v: Fan,
-    pub candidates: Vec<super::select::Candidate>,
     fan_p: Fan,
     fan_c: Fan,
-    fan_x: Fan,
+    pub fan_x: Fan,
     np: Vec<u32>,
     nc: Vec<u32>,
 }
@@ -60,9 +58,50 @@ pub fn check_collapse(
     target: [f64; 3],
     k: &mut CheckScratch,
 ) -> Result<Plan, ()> {
+    s.table.fan(p, &mut k.fan_p);
+    s.table.fan(c, &mut k.fan_c);
+    check_walked(s, p, c, target, k)
+}
+
+impl CheckScratch {
+    /// The fan of P, then (`walk_c`) of C, for [`check_walked`] to use as
+    /// they are.
+    pub fn walk_p(&mut self, s: &State, p: u32) -> &Fan {
+        s.table.fan(p, &mut self.fan_p);
+        &self.fan_p
+    }
+
+    pub fn walk_c(&mut self, s: &State, c: u32) -> &Fan {
+        s.table.fan(c, &mut self.fan_c);
+        &self.fan_c
+    }
+
+    /// The fans of P and C the check used.
+    pub fn fans(&self) -> (&Fan, &Fan) {
+        (&self.fan_p, &self.fan_c)
+    }
+
+    /// After a successful check: P, C and every neighbour of either, the
+    /// vertices the collapse blocks for the rest of its step.
+    pub fn neighbourhood(&self) -> impl Iterator<Item = u32> + '_ {
+        self.np
+            .iter()
+            .chain(&self.nc)
+            .copied()
+            .filter(|&x| x != NONE)
+    }
+}
+
+/// [`check_collapse`] on the fans `k` holds from [`CheckScratch::walk_p`]
+/// and [`CheckScratch::walk_c`].
+pub fn check_walked(
+    s: &State,
+    p: u32,
+    c: u32,
+    target: [f64; 3],
+    k: &mut CheckScratch,
+) -> Result<Plan, ()> {
     let t = &s.table;
-    t.fan(p, &mut k.fan_p);
-    t.fan(c, &mut k.fan_c);
     let left = k
         .fan_p
         .corners
@@ -110,9 +149,12 @@ pub fn check_collapse(
         if w == NONE {
             continue;
         }
-        t.fan(w, &mut k.fan_x);
-        let valence = k.fan_x.corners.len() + if k.fan_x.boundary { 2 } else { 0 };
-        if valence < 4 {
+        if cfg!(debug_assertions) {
+            t.fan(w, &mut k.fan_x);
+            let walked = k.fan_x.corners.len() + if k.fan_x.boundary { 2 } else { 0 };
+            debug_assert_eq!(s.valence[w as usize] as usize, walked, "valence of {w}");
+        }
+        if s.valence[w as usize] < 4 {
             return Err(());
         }
     }

@@ -25,8 +25,8 @@ use splitstream_kernels::gpu::{Api, GpuError};
 
 use super::select::{Best, pair_key};
 use super::state::{
-    Collapse, MAX_VALENCE, Simplification, SimplifyOptions, State, mark_two_rings,
-    mean_edge_length, try_apply_collapse,
+    Collapse, EdgeMeter, MAX_VALENCE, Simplification, SimplifyOptions, State, mark_two_rings,
+    try_apply_collapse,
 };
 use crate::corner_table::{Fan, NONE};
 use crate::quadric::Quadric;
@@ -79,8 +79,8 @@ pub fn simplify_gpu(
     let local = engine.quadric_init(&base)?;
     s.quadrics = local
         .iter()
-        .zip(&s.geometry)
-        .map(|(q, &o)| to_global(q, o))
+        .enumerate()
+        .map(|(v, q)| to_global(q, s.geometry(v as u32)))
         .collect();
 
     let mut alive_count = s.alive.iter().filter(|&&a| a).count();
@@ -91,12 +91,13 @@ pub fn simplify_gpu(
     let mut dirty_list = live.clone();
     let mut dirty = vec![false; n];
     let limit = options.max_error.unwrap_or(f64::INFINITY);
-    let (mut edge, mut edge_measured_at) = (mean_edge_length(&s), alive_count);
+    let mut meter = EdgeMeter::new(&s);
+    let (mut edge, mut edge_measured_at) = (meter.measure(&s), alive_count);
     let mut rejected_total = 0usize;
     let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
     while alive_count > options.target_vertices {
         if alive_count * 5 < edge_measured_at * 4 {
-            edge = mean_edge_length(&s);
+            edge = meter.measure(&s);
             edge_measured_at = alive_count;
         }
         base.cell = (options.subgrid_cells * edge) as f32;
@@ -141,7 +142,7 @@ pub fn simplify_gpu(
             other: w.other,
             error: w.error as f64,
             error_key: w.key,
-            target: w.target,
+            corner: NONE,
         };
         let room = alive_count - options.target_vertices;
         if winners.len() > room {
@@ -157,7 +158,7 @@ pub fn simplify_gpu(
         let mut rejected = 0usize;
         for w in &winners {
             let b = as_best(w);
-            match try_apply_collapse(&mut s, w.v, b, &mut fans) {
+            match try_apply_collapse(&mut s, w.v, b, w.target, &mut fans) {
                 Some((collapse, plan)) => {
                     step_error = step_error.max(b.error);
                     merged.push(w.v);
@@ -283,7 +284,7 @@ fn changes(
                 position: [words[0], words[1], words[2]],
                 flags: words[3],
                 corner_of: s.table.corner_of[v as usize],
-                quadric: to_local(&s.quadrics[v as usize], s.geometry[v as usize]),
+                quadric: to_local(&s.quadrics[v as usize], s.geometry(v)),
             }
         })
         .collect();

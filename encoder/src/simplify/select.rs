@@ -1,6 +1,13 @@
 //! Step a of §2: each vertex's best incident edge, with the sub-grid tie-break.
+//!
+//! Validity is checked lazily: a vertex points at its cheapest edge not known
+//! to be invalid, and only the pairs that step c chooses are checked
+//! (`check_collapse`, in `state`). A refused edge is stamped in its slot with
+//! the state it was refused in and stays refused until a collapse changes the
+//! 1-ring of one of its endpoints, the only thing that can make it valid.
+//! Checking a few chosen pairs instead of every dirty vertex's candidates is
+//! most of the simplifier's speed.
 
-use super::check::{CheckScratch, check_collapse};
 use super::state::State;
 use crate::corner_table::{NONE, next, prev};
 use crate::quadric::collapse_target;
@@ -13,7 +20,9 @@ pub struct Best {
     /// Error rounded to f32 bits (flat regions flushed to 0) so that equal
     /// errors tie exactly and the tie-breaks decide.
     pub error_key: u32,
-    pub target: [u32; 3],
+    /// A corner facing the edge (its slot in the Edge array); [`NONE`] where
+    /// the chooser does not track slots (GPU backends).
+    pub corner: u32,
 }
 
 impl Best {
@@ -21,7 +30,7 @@ impl Best {
         other: NONE,
         error: f64::INFINITY,
         error_key: u32::MAX,
-        target: [0; 3],
+        corner: NONE,
     };
 }
 
@@ -49,7 +58,7 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
         // P, C or the integer midpoint P + ((C - P) >> 1) (SPEC §7.4).
         let mid: [u32; 3] =
             std::array::from_fn(|k| (pp[k] as i64 + ((pc[k] as i64 - pp[k] as i64) >> 1)) as u32);
-        let mut best = (pp, q.error(s.geometry[pi]));
+        let mut best = (pp, q.error(s.geometry(p)));
         for cand in [pc, mid] {
             let e = q.error(s.to_metric(cand));
             if e < best.1 {
@@ -58,24 +67,48 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
         }
         best.0
     } else {
-        let (t, _) = collapse_target(&q, s.geometry[pi], s.geometry[ci], false);
+        let (t, _) = collapse_target(&q, s.geometry(p), s.geometry(c), false);
         let top = ((1u64 << s.bits) - 1) as f64;
-        std::array::from_fn(|k| (t[k] / s.metric[k]).round().clamp(0.0, top) as u32)
+        std::array::from_fn(|k| to_grid(t[k] / s.metric[k], top))
     };
     Some((target, q.error(s.to_metric(target))))
 }
 
-/// Cached collapse of the edge facing one corner (the paper's Edge array).
+/// `x.round().clamp(0.0, top) as u32` (round half away from zero) for a
+/// grid top below 2^32, without the libm call `round` becomes on x86-64
+/// without SSE4.1: three per edge evaluation.
+#[inline]
+fn to_grid(x: f64, top: f64) -> u32 {
+    if x >= top {
+        return top as u32;
+    }
+    // Below 0.5 (NaN included) `round` gives 0 or less.
+    if x.is_nan() || x < 0.5 {
+        return 0;
+    }
+    // 0.5 <= x < top: truncation and the exact fraction round it.
+    let i = x as u32;
+    i + u32::from(x - f64::from(i) >= 0.5)
+}
+
+/// Cached collapse error of the edge facing one corner (the paper's Edge
+/// array), kept at the lower of the edge's two corners
+/// ([`State::slot_index`]). The merged position is not kept: only the few
+/// pairs a step checks need it, and [`evaluate`] gives it again exactly (the
+/// slot is refreshed whenever an end changes). A slot is then 16 bytes, and
+/// the Edge array is the one the passes read most, at random.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EdgeSlot {
     pub error: f64,
-    pub target: [u32; 3],
+    /// State number (see [`Known`]) in which the collapse was checked and
+    /// found invalid; 0 if it never was since the slot was evaluated.
+    pub refused: u32,
 }
 
 impl EdgeSlot {
     pub const FORBIDDEN: EdgeSlot = EdgeSlot {
         error: f64::INFINITY,
-        target: [0; 3],
+        refused: 0,
     };
 }
 
@@ -86,7 +119,7 @@ pub fn edge_slot(s: &State, c: u32) -> EdgeSlot {
         return EdgeSlot::FORBIDDEN;
     }
     match evaluate(s, a, b) {
-        Some((target, error)) => EdgeSlot { error, target },
+        Some((_, error)) => EdgeSlot { error, refused: 0 },
         None => EdgeSlot::FORBIDDEN,
     }
 }
@@ -101,90 +134,274 @@ pub struct Scale {
 }
 
 fn cell_of(p: [f64; 3], cell: f64) -> [i64; 3] {
-    p.map(|x| (x / cell).floor() as i64)
+    p.map(|x| floor_i64(x / cell))
 }
 
-/// The best valid collapse of `v` (§2 step a), from the cached edge slots.
-pub fn best_edge(s: &State, v: u32, scale: Scale, scratch: &mut CheckScratch) -> Best {
-    best_edge_avoiding(s, v, scale, scratch, &[])
+/// `x.floor() as i64`, without the libm call `floor` becomes on x86-64
+/// without SSE4.1 (the cell tie-break runs once per considered edge).
+pub(super) fn floor_i64(x: f64) -> i64 {
+    let i = x as i64;
+    if (i as f64) > x {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
 }
 
-/// [`best_edge`] among the neighbours `u` with `blocked[u] == false`
-/// (`blocked` empty: all of them).
-pub fn best_edge_avoiding(
+/// What the chooser knows about validity and this step's blocked vertices.
+/// States are numbered from 1: state k is the mesh step k - 1 selects on.
+#[derive(Clone, Copy)]
+pub struct Known<'a> {
+    /// The current state.
+    pub state: u32,
+    /// Per vertex, the state since which its 1-ring is what it is now.
+    pub changed: &'a [u32],
+    /// Per vertex, `== state` when a winner of this step blocks it.
+    pub blocked: &'a [u32],
+}
+
+impl Known<'_> {
+    /// Whether a slot's refusal still holds: neither endpoint's 1-ring (fan
+    /// and neighbour positions, all a check reads but the wings' valences,
+    /// which only fall and so cannot make a refused edge valid) changed
+    /// since the refusal.
+    pub fn refused(&self, slot: &EdgeSlot, v: u32, u: u32) -> bool {
+        slot.refused != 0
+            && slot.refused >= self.changed[v as usize]
+            && slot.refused >= self.changed[u as usize]
+    }
+}
+
+/// Order of one vertex's requests: error key, then same sub-grid cell
+/// (Fig. 2), then the minimal coordinates of the other end, then its id.
+/// The tie-break is computed only between equal keys (the sub-grid cell
+/// costs three divisions a vertex).
+struct Order<'a> {
+    s: &'a State,
+    v: u32,
+    scale: Scale,
+    home: std::cell::OnceCell<Option<[i64; 3]>>,
+}
+
+impl<'a> Order<'a> {
+    fn new(s: &'a State, v: u32, scale: Scale) -> Order<'a> {
+        Order {
+            s,
+            v,
+            scale,
+            home: std::cell::OnceCell::new(),
+        }
+    }
+
+    fn tie(&self, u: u32) -> (bool, [u32; 3], u32) {
+        let (s, cell) = (self.s, self.scale.cell);
+        let home = self
+            .home
+            .get_or_init(|| (cell > 0.0).then(|| cell_of(s.geometry(self.v), cell)));
+        let other_cell = home.is_some_and(|h| h != cell_of(s.geometry(u), cell));
+        (other_cell, s.positions[u as usize], u)
+    }
+
+    /// Whether the edge to `u` with key `key` ranks before `b`. Real keys
+    /// stay below u32::MAX, the key of no choice, so [`Best::NONE`] ranks
+    /// last.
+    fn before(&self, key: u32, u: u32, b: &Best) -> bool {
+        if key != b.error_key {
+            key < b.error_key
+        } else {
+            self.tie(u) < self.tie(b.other)
+        }
+    }
+}
+
+fn error_key(error: f64, scale: Scale) -> u32 {
+    if error <= scale.flat {
+        0
+    } else {
+        (error as f32).to_bits()
+    }
+}
+
+/// A vertex's two cheapest choices with different partners, in [`Order`];
+/// `second` is `None` when it is not known (the best was taken from it
+/// since the last full pick).
+#[derive(Clone, Copy, Debug)]
+pub struct Choices {
+    pub best: Best,
+    pub second: Option<Best>,
+}
+
+/// The two cheapest candidates of one vertex seen so far, in [`Order`].
+pub struct Ranking<'a> {
+    order: Order<'a>,
+    best: Best,
+    second: Best,
+}
+
+impl<'a> Ranking<'a> {
+    pub fn new(s: &'a State, v: u32, scale: Scale) -> Ranking<'a> {
+        Ranking {
+            order: Order::new(s, v, scale),
+            best: Best::NONE,
+            second: Best::NONE,
+        }
+    }
+
+    /// Considers the edge to `u` whose slot (held by corner `facing`) is
+    /// `slot`.
+    #[inline]
+    pub fn consider(&mut self, u: u32, facing: u32, slot: &EdgeSlot) {
+        if slot.error == f64::INFINITY {
+            return;
+        }
+        let key = error_key(slot.error, self.order.scale);
+        if key > self.second.error_key || !self.order.before(key, u, &self.second) {
+            return;
+        }
+        let choice = Best {
+            other: u,
+            error: slot.error,
+            error_key: key,
+            corner: facing,
+        };
+        if self.order.before(key, u, &self.best) {
+            self.second = self.best;
+            self.best = choice;
+        } else {
+            self.second = choice;
+        }
+    }
+
+    pub fn choices(&self) -> Choices {
+        Choices {
+            best: self.best,
+            second: Some(self.second),
+        }
+    }
+}
+
+/// §2 step a: the cheapest edge of `v` to a neighbour that is not blocked,
+/// skipping edges known to be invalid (their validity is checked only once
+/// chosen), in [`Rank`] order, and the runner-up with another partner.
+///
+/// `reopened` receives the neighbours `u` whose edge to `v` was refused before
+/// `v`'s 1-ring last changed: that edge may be valid again and `u` should
+/// choose again too.
+pub fn pick_edge(
     s: &State,
     v: u32,
     scale: Scale,
-    scratch: &mut CheckScratch,
-    blocked: &[bool],
-) -> Best {
+    known: Known<'_>,
+    reopened: &mut Vec<u32>,
+) -> Choices {
+    let mut ranking = Ranking::new(s, v, scale);
     if !s.alive[v as usize] {
-        return Best::NONE;
+        return ranking.choices();
     }
-    let mut fan = std::mem::take(&mut scratch.fan_v);
-    s.table.fan(v, &mut fan);
-    let mut candidates = std::mem::take(&mut scratch.candidates);
-    candidates.clear();
-    let home = (scale.cell > 0.0).then(|| cell_of(s.geometry(v), scale.cell));
-    for &c in &fan.corners {
-        // Edge (v, next c) faces prev c; edge (v, prev c) faces next c.
-        for (u, facing) in [(s.table.v(next(c)), prev(c)), (s.table.v(prev(c)), next(c))] {
-            if candidates.iter().any(|x: &Candidate| x.other == u)
-                || blocked.get(u as usize).copied().unwrap_or(false)
-            {
-                continue;
-            }
-            let slot = s.edges[facing as usize];
-            if slot.error == f64::INFINITY {
-                continue;
-            }
-            let error_key = if slot.error <= scale.flat {
-                0
-            } else {
-                (slot.error as f32).to_bits()
-            };
-            let other_cell = home.is_some_and(|h| h != cell_of(s.geometry(u), scale.cell));
-            candidates.push(Candidate {
-                rank: (error_key, other_cell, s.positions[u as usize], u),
-                other: u,
-                best: Best {
-                    other: u,
-                    error: slot.error,
-                    error_key,
-                    target: slot.target,
-                },
-            });
+    let changed_v = known.changed[v as usize];
+    let mut consider = |u: u32, facing: u32| {
+        if known.blocked[u as usize] == known.state {
+            return;
         }
-    }
-    candidates.sort_unstable_by_key(|x| x.rank);
-    let mut found = Best::NONE;
-    for cand in &candidates {
-        let (p, c) = (v.min(cand.other), v.max(cand.other));
-        if check_collapse(s, p, c, s.to_metric(cand.best.target), scratch).is_ok() {
-            found = cand.best;
-            break;
+        let slot = s.slot(facing);
+        if slot.refused != 0 {
+            if known.refused(slot, v, u) {
+                return;
+            }
+            if slot.refused < changed_v {
+                reopened.push(u);
+            }
         }
-    }
-    scratch.fan_v = fan;
-    scratch.candidates = candidates;
-    found
+        ranking.consider(u, facing, slot);
+    };
+    // Every edge of v once: (v, next c) faces prev c for each corner c; on a
+    // boundary the edge (v, prev c) of the fan's open end faces next c and
+    // has no corner of its own.
+    s.table.for_each_corner(v, |c| {
+        consider(s.table.v(next(c)), prev(c));
+        if s.table.o(next(c)) == NONE {
+            consider(s.table.v(prev(c)), next(c));
+        }
+    });
+    ranking.choices()
 }
 
-/// A candidate edge of one vertex, ranked by error, then same sub-grid cell,
-/// then minimal coordinates of the other end (Fig. 2), then id.
-#[derive(Clone, Copy, Debug)]
-pub struct Candidate {
-    rank: (u32, bool, [u32; 3], u32),
-    other: u32,
-    best: Best,
+/// Updates `choices` of `v` with its edge to `u` facing corner `facing`,
+/// an edge whose slot was refreshed (no refusal, nothing blocked): the two
+/// cheapest of the old candidates and the new one. An unknown runner-up
+/// stays unknown unless the new edge beats the best (the old best is then
+/// the runner-up).
+pub fn offer(s: &State, v: u32, choices: &mut Choices, u: u32, facing: u32, scale: Scale) {
+    let slot = s.slot(facing);
+    if slot.error == f64::INFINITY {
+        return;
+    }
+    let key = error_key(slot.error, scale);
+    let bound = choices
+        .second
+        .map_or(choices.best.error_key, |b| b.error_key);
+    if key > bound {
+        return;
+    }
+    let order = Order::new(s, v, scale);
+    let choice = Best {
+        other: u,
+        error: slot.error,
+        error_key: key,
+        corner: facing,
+    };
+    if order.before(key, u, &choices.best) {
+        choices.second = Some(choices.best);
+        choices.best = choice;
+    } else if let Some(second) = choices.second
+        && order.before(key, u, &second)
+    {
+        choices.second = Some(choice);
+    }
 }
 
-impl Default for Candidate {
-    fn default() -> Self {
-        Candidate {
-            rank: (u32::MAX, true, [0; 3], NONE),
-            other: NONE,
-            best: Best::NONE,
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn inline_rounding_matches_libm() {
+        let top = 16383.0;
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            2.5,
+            -1.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+            16382.5,
+            16383.4999,
+            16383.5,
+            1e300,
+            -1e300,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            f64::NAN,
+            4.0e15 + 0.5,
+            -3.2,
+            7.9999999,
+        ];
+        let mut x = 0.1234f64;
+        for _ in 0..10_000 {
+            x = (x * 7919.0 + 0.377).rem_euclid(40_000.0) - 10_000.0;
+            xs.push(x);
+            xs.push(x.floor() + 0.5);
+        }
+        for &x in &xs {
+            assert_eq!(to_grid(x, top), x.round().clamp(0.0, top) as u32, "{x}");
+            let wide = ((1u64 << 31) - 1) as f64;
+            for y in [x, x * 1e5, wide - 0.5, wide - 0.25, wide + 3.0] {
+                assert_eq!(to_grid(y, wide), y.round().clamp(0.0, wide) as u32, "{y}");
+            }
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
         }
     }
 }

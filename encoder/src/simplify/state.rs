@@ -2,8 +2,10 @@
 
 use rayon::prelude::*;
 
-use super::check::{CheckScratch, Plan, check_collapse};
-use super::select::{Best, EdgeSlot, Scale, best_edge, best_edge_avoiding, edge_slot, pair_key};
+use super::check::{CheckScratch, Plan, check_collapse, check_walked};
+use super::select::{
+    Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, evaluate, offer, pair_key, pick_edge,
+};
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
@@ -86,9 +88,13 @@ pub struct Simplification {
 pub(super) struct State {
     pub table: CornerTable,
     pub positions: Vec<[u32; 3]>,
-    pub geometry: Vec<[f64; 3]>,
     pub quadrics: Vec<Quadric>,
     pub boundary: Vec<bool>,
+    /// Valence of each vertex with the boundary ghost counted (triangles,
+    /// plus 2 on a boundary: the fan's extra neighbour and the ghost), kept
+    /// up to date by the collapses so that a check reads the wings' valences
+    /// instead of walking their fans.
+    pub valence: Vec<u32>,
     pub alive: Vec<bool>,
     pub split_valence: Vec<u8>,
     /// Cached collapse of the edge facing each corner.
@@ -106,11 +112,6 @@ impl State {
     pub fn new(mesh: &QuantizedMesh, options: &SimplifyOptions) -> State {
         let n = mesh.positions.len();
         let metric = mesh.metric;
-        let geometry: Vec<[f64; 3]> = mesh
-            .positions
-            .iter()
-            .map(|p| std::array::from_fn(|k| p[k] as f64 * metric[k]))
-            .collect();
         let table = CornerTable::new(n, &mesh.triangles);
         let mut boundary = vec![false; n];
         for (c, &o) in table.opposite.iter().enumerate() {
@@ -120,12 +121,16 @@ impl State {
             }
         }
         let alive: Vec<bool> = table.corner_of.iter().map(|&c| c != NONE).collect();
+        let mut valence: Vec<u32> = boundary.iter().map(|&b| if b { 2 } else { 0 }).collect();
+        for &v in &table.vertex {
+            valence[v as usize] += 1;
+        }
         State {
             quadrics: Vec::new(),
             positions: mesh.positions.clone(),
-            geometry,
             table,
             boundary,
+            valence,
             alive,
             split_valence: vec![LEAF; n],
             edges: Vec::new(),
@@ -136,14 +141,151 @@ impl State {
         }
     }
 
+    /// Metric coordinates of vertex `v`, computed from its grid position
+    /// (three products beat a load from a second, twice as large array).
+    #[inline]
     pub fn geometry(&self, v: u32) -> [f64; 3] {
-        self.geometry[v as usize]
+        self.to_metric(self.positions[v as usize])
+    }
+
+    /// Where the slot of the edge facing corner `c` is kept: at the lower of
+    /// its two corners, so a refresh writes it once.
+    pub fn slot_index(&self, c: u32) -> usize {
+        let o = self.table.o(c);
+        if o != NONE && o < c {
+            o as usize
+        } else {
+            c as usize
+        }
+    }
+
+    /// The slot of the edge facing corner `c`.
+    pub fn slot(&self, c: u32) -> &EdgeSlot {
+        &self.edges[self.slot_index(c)]
     }
 
     /// Metric coordinates of a grid point.
     pub fn to_metric(&self, q: [u32; 3]) -> [f64; 3] {
         std::array::from_fn(|k| q[k] as f64 * self.metric[k])
     }
+}
+
+/// Time spent per phase over the whole simplification, printed under
+/// `SPLITSTREAM_DEBUG`.
+#[derive(Default)]
+struct Phases {
+    at: Option<std::time::Instant>,
+    seconds: Vec<(&'static str, f64)>,
+}
+
+impl Phases {
+    /// Charges the time since the last lap to `name`.
+    fn lap(&mut self, name: &'static str) {
+        let now = std::time::Instant::now();
+        if let Some(at) = self.at {
+            let dt = (now - at).as_secs_f64();
+            match self.seconds.iter_mut().find(|(n, _)| *n == name) {
+                Some((_, s)) => *s += dt,
+                None => self.seconds.push((name, dt)),
+            }
+        }
+        self.at = Some(now);
+    }
+
+    fn report(&self) -> String {
+        let total: f64 = self.seconds.iter().map(|(_, s)| s).sum();
+        let parts: Vec<String> = self
+            .seconds
+            .iter()
+            .map(|(n, s)| format!("{n} {:.0}", s * 1e3))
+            .collect();
+        format!(
+            "simplify phases, ms (total {:.0}): {}",
+            total * 1e3,
+            parts.join(", ")
+        )
+    }
+}
+
+/// Per-vertex bookkeeping of the CPU step loop (the GPU backends keep their
+/// own on the device). The `u32` stamps hold state numbers ([`Known`]), so
+/// none is ever cleared.
+struct Tracking {
+    /// Each vertex's request (§2 step a), chosen without the constraints of
+    /// a step's later passes.
+    best: Vec<Best>,
+    /// The runner-up of each request (another partner), `None` if unknown:
+    /// a vertex whose partner a collapse took falls back on it instead of
+    /// walking its fan.
+    second: Vec<Option<Best>>,
+    /// Requests chosen again within a step (blocked partners, refused
+    /// edges), valid where `repick_at == state`; they never outlive it.
+    repick: Vec<Best>,
+    repick_at: Vec<u32>,
+    /// State since which each vertex's 1-ring is what it is.
+    changed: Vec<u32>,
+    /// `== state`: the vertex was merged (survived as R) at the last step.
+    merged: Vec<u32>,
+    /// Latest state in which one of the vertex's edges was refused (0: none
+    /// since its 1-ring last changed).
+    refusals: Vec<u32>,
+    /// `== state`: a winner of this step blocks the vertex.
+    blocked: Vec<u32>,
+    /// `== state`: the vertex chooses from scratch at this step.
+    listed: Vec<u32>,
+    /// `== state`: the vertex was sorted into choosing or taking offers.
+    sorted: Vec<u32>,
+    /// Pair key of each vertex's admitted request in the current pass,
+    /// `u64::MAX` otherwise (reset after each pass, so never swept whole).
+    keys: Vec<u64>,
+}
+
+impl Tracking {
+    fn new(n: usize) -> Tracking {
+        Tracking {
+            best: vec![Best::NONE; n],
+            second: vec![None; n],
+            repick: vec![Best::NONE; n],
+            repick_at: vec![0; n],
+            changed: vec![0; n],
+            merged: vec![0; n],
+            refusals: vec![0; n],
+            blocked: vec![0; n],
+            // Every vertex is on the first step's list.
+            listed: vec![1; n],
+            sorted: vec![0; n],
+            keys: vec![u64::MAX; n],
+        }
+    }
+
+    fn known(&self, state: u32) -> Known<'_> {
+        Known {
+            state,
+            changed: &self.changed,
+            blocked: &self.blocked,
+        }
+    }
+
+    /// The request of `v` in the current pass of step `state`.
+    fn request(&self, v: u32, state: u32) -> &Best {
+        if self.repick_at[v as usize] == state {
+            &self.repick[v as usize]
+        } else {
+            &self.best[v as usize]
+        }
+    }
+}
+
+/// A collapse chosen and checked in this step, with what applying it needs.
+struct Winner {
+    p: u32,
+    best: Best,
+    /// Where the merged vertex goes.
+    target: [u32; 3],
+    plan: Plan,
+    /// The fans of P then C as its check walked them, at `fans` in
+    /// [`Buffers::fans`]: applying the collapse needs no walk.
+    fans: (u32, u32, u32),
 }
 
 /// Simplifies `mesh` (quantized, checked manifold) with the parallel algorithm.
@@ -153,27 +295,40 @@ pub fn simplify(
     mut progress: impl FnMut(usize),
 ) -> Simplification {
     let n = mesh.positions.len();
+    let mut phases = Phases::default();
+    phases.lap("");
     let mut s = State::new(mesh, options);
-    s.quadrics = vertex_quadrics(&s.geometry, &mesh.triangles, options.boundary_weight);
-    s.edges = (0..s.table.vertex.len() as u32)
-        .into_par_iter()
-        .map(|c| edge_slot(&s, c))
-        .collect();
+    phases.lap("table");
+    let geometry: Vec<[f64; 3]> = (0..n as u32).map(|v| s.geometry(v)).collect();
+    s.quadrics = vertex_quadrics(&geometry, &mesh.triangles, options.boundary_weight);
+    drop(geometry);
+    phases.lap("quadrics");
+    s.edges = initial_slots(&s);
+    phases.lap("slots");
     let mut alive_count = s.alive.iter().filter(|&&a| a).count();
     let mut steps = Vec::new();
     let mut step_errors = Vec::new();
     let mut threshold = 0.0f64;
-    let mut best = vec![Best::NONE; n];
+    let mut t = Tracking::new(n);
     let mut live: Vec<u32> = (0..n as u32).filter(|&v| s.alive[v as usize]).collect();
-    let mut dirty = vec![true; n];
+    // Who chooses at the start of a step (all vertices at the first): see
+    // `refresh_edges` and `step_winners`; `offers` are the edges refreshed
+    // by the last step's collapses, for their other ends.
+    let mut choosers = live.clone();
+    let mut offers: Vec<Offer> = Vec::new();
+    let mut buffers = Buffers::default();
     let limit = options.max_error.unwrap_or(f64::INFINITY);
+    let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
     // The mean edge length sets the sub-grid and the flat threshold; it
     // changes slowly, so it is measured again only when a fifth of the
     // vertices are gone since the last measure (a full pass over the corners).
-    let (mut edge, mut edge_measured_at) = (mean_edge_length(&s), alive_count);
+    let mut meter = EdgeMeter::new(&s);
+    let (mut edge, mut edge_measured_at) = (meter.measure(&s), alive_count);
     while alive_count > options.target_vertices {
+        let state = steps.len() as u32 + 1;
+        phases.lap("loop");
         if alive_count * 5 < edge_measured_at * 4 {
-            edge = mean_edge_length(&s);
+            edge = meter.measure(&s);
             edge_measured_at = alive_count;
         }
         let scale = Scale {
@@ -183,44 +338,74 @@ pub fn simplify(
             flat: 1e-8 * edge.powi(4),
         };
         let t_best = std::time::Instant::now();
-        // Only vertices whose 2-ring changed can have a new best edge; the
-        // passes below run over the live vertices only.
-        let updates: Vec<(u32, Best)> = live
-            .par_iter()
-            .filter(|&&v| dirty[v as usize])
-            .map_init(CheckScratch::default, |scratch, &v| {
-                (v, best_edge(&s, v, scale, scratch))
-            })
+        phases.lap("measure");
+        let offered = take_offers(&s, &mut t, &offers, &mut choosers, scale, state);
+        phases.lap("offers");
+        let reopened = choose(&s, &mut t, &choosers, scale, state);
+        phases.lap("choose");
+        // Neighbours whose refused edge to a changed vertex may be valid
+        // again choose too (they reopen nothing themselves: their own 1-ring
+        // did not change).
+        let again: Vec<u32> = reopened
+            .into_iter()
+            .filter(|&u| std::mem::replace(&mut t.listed[u as usize], state) != state)
             .collect();
-        for (v, b) in updates {
-            best[v as usize] = b;
-        }
+        choose(&s, &mut t, &again, scale, state);
+        let chose = choosers.len() + again.len();
         // Raise S to the admitted quantile of the current candidate errors.
-        let mut errors: Vec<f64> = live
-            .iter()
-            .map(|&v| &best[v as usize])
-            .filter(|b| b.other != NONE)
-            .map(|b| b.error)
-            .collect();
+        let errors = &mut buffers.errors;
+        errors.clear();
+        errors.extend(
+            live.iter()
+                .map(|&v| &t.best[v as usize])
+                .filter(|b| b.other != NONE)
+                .map(|b| b.error),
+        );
         if errors.is_empty() {
             break;
         }
         let q = ((errors.len() - 1) as f64 * options.admit_quantile.clamp(0.0, 1.0)) as usize;
         let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
         threshold = threshold.max(*quantile).min(limit);
+        let largest = errors.iter().copied().fold(0.0f64, f64::max);
+        let smallest = errors.iter().copied().fold(f64::INFINITY, f64::min);
         let t_select = std::time::Instant::now();
-        let mut winners = step_winners(&s, &mut best, &live, threshold, scale);
+        phases.lap("quantile");
+        choosers.clear();
+        let mut winners = step_winners(
+            &mut s,
+            &mut t,
+            &live,
+            Step {
+                state,
+                threshold,
+                scale,
+            },
+            &mut choosers,
+            &mut buffers,
+            &mut phases,
+        );
         // Nothing under S: raise it (the paper's "S is increased"), doubling
         // past the smallest candidate error, until a step finds collapses or
         // S passes every candidate error or the maximum error.
-        let largest = errors.iter().copied().fold(0.0f64, f64::max);
-        let smallest = errors.iter().copied().fold(f64::INFINITY, f64::min);
         while winners.is_empty() && threshold < limit && threshold < largest {
             threshold = (2.0 * threshold)
                 .max(smallest)
                 .max(f64::MIN_POSITIVE)
                 .min(limit);
-            winners = step_winners(&s, &mut best, &live, threshold, scale);
+            winners = step_winners(
+                &mut s,
+                &mut t,
+                &live,
+                Step {
+                    state,
+                    threshold,
+                    scale,
+                },
+                &mut choosers,
+                &mut buffers,
+                &mut phases,
+            );
         }
         if winners.is_empty() {
             break;
@@ -228,32 +413,63 @@ pub fn simplify(
         // Hit the target exactly: keep the cheapest collapses of the last step.
         let room = alive_count - options.target_vertices;
         if winners.len() > room {
-            winners.sort_by_key(|&v| pair_key(&best[v as usize], v));
+            winners.sort_by_key(|w| pair_key(&w.best, w.p));
             winners.truncate(room);
-            winners.sort_unstable();
+            winners.sort_unstable_by_key(|w| w.p);
         }
         let t_apply = std::time::Instant::now();
+        phases.lap("select");
         let mut collapses = Vec::with_capacity(winners.len());
-        let mut fans = [Fan::default(), Fan::default()];
         let mut step_error = 0.0f64;
-        for &p in &winners {
-            let b = best[p as usize];
-            let collapse = apply_collapse(&mut s, p, b, &mut fans);
-            step_error = step_error.max(b.error);
-            collapses.push(collapse);
+        for w in &winners {
+            debug_assert_eq!(
+                check_collapse(
+                    &s,
+                    w.p,
+                    w.best.other,
+                    s.to_metric(w.target),
+                    &mut CheckScratch::default()
+                ),
+                Ok(w.plan),
+                "a winner's check holds after the other collapses of its step"
+            );
+            let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
+            let fan_p = &buffers.fans[start..start + np];
+            let fan_c = &buffers.fans[start + np..start + np + nc];
+            // Built from P and C before the collapse, as its check saw them
+            // (no other collapse of the step touches them).
+            let (record, quadric) = prepare(&s, w.p, w.best, w.target, w.plan);
+            s.table
+                .collapse_fans(w.p, w.best.other, w.plan.left, w.plan.right, fan_p, fan_c);
+            commit(&mut s, w.p, w.best.other, w.target, w.plan, quadric);
+            collapses.push(record);
+            step_error = step_error.max(w.best.error);
         }
         let t_refresh = std::time::Instant::now();
-        refresh_edges(&mut s, &winners);
+        phases.lap("apply");
+        let merged: Vec<u32> = winners.iter().map(|w| w.p).collect();
+        // The next step keeps this scale unless it measures edges again.
+        let left = alive_count - collapses.len();
+        let same_scale = (left * 5 >= edge_measured_at * 4).then_some(scale);
+        refresh_edges(
+            &mut s,
+            &mut t,
+            &merged,
+            state + 1,
+            same_scale,
+            &mut choosers,
+            &mut offers,
+        );
+        phases.lap("refresh");
         live.retain(|&v| s.alive[v as usize]);
-        mark_two_rings(&s, &winners, &mut dirty);
-        if std::env::var_os("SPLITSTREAM_DEBUG").is_some() {
+        phases.lap("retain");
+        if debug {
             let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
             let now = std::time::Instant::now();
             eprintln!(
-                "step {}: alive {alive_count}, collapses {}, dirty {}, ms: best {:.1} select {:.1} apply {:.1} refresh {:.1}",
+                "step {}: alive {alive_count}, collapses {}, chose {chose}, offered {offered}, ms: best {:.1} select {:.1} apply {:.1} refresh {:.1}",
                 steps.len(),
                 winners.len(),
-                dirty.iter().filter(|&&d| d).count(),
                 ms(t_best, t_select),
                 ms(t_select, t_apply),
                 ms(t_apply, t_refresh),
@@ -264,6 +480,9 @@ pub fn simplify(
         steps.push(collapses);
         step_errors.push(step_error);
         progress(n - alive_count);
+    }
+    if debug {
+        eprintln!("{}", phases.report());
     }
     Simplification {
         steps,
@@ -276,128 +495,429 @@ pub fn simplify(
     }
 }
 
+/// Every edge's slot, at the lower of its corners ([`State::slot_index`]);
+/// the other corner's entry is never read.
+fn initial_slots(s: &State) -> Vec<EdgeSlot> {
+    let t = &s.table;
+    (0..t.vertex.len() as u32)
+        .into_par_iter()
+        .map(|c| match t.o(c) {
+            o if o != NONE && o < c => EdgeSlot::FORBIDDEN,
+            _ => edge_slot(s, c),
+        })
+        .collect()
+}
+
+/// A refreshed edge of merged vertex `r`, offered to its other end `x`.
+#[derive(Clone, Copy)]
+struct Offer {
+    x: u32,
+    r: u32,
+    /// A corner facing the edge.
+    facing: u32,
+}
+
+/// Sorts the neighbours of the last step's merged vertices into those that
+/// must choose from scratch (appended to `choosers`) and those whose choices
+/// the refreshed edges update. Returns how many took offers.
+///
+/// A neighbour x of R has the same quadric, position and other neighbours
+/// as before, so its candidates are the old ones without its edges to P and
+/// C, plus its edges to merged vertices, which are offered: the old best
+/// (or, if that went to P or C, the runner-up) and the offers give what
+/// [`pick_edge`] would. Only a vertex that lost both, or has refused edges
+/// (now stale), walks its fan again. Most of a step's changed vertices are
+/// such neighbours, and an offer costs no fan walk.
+fn take_offers(
+    s: &State,
+    t: &mut Tracking,
+    offers: &[Offer],
+    choosers: &mut Vec<u32>,
+    scale: Scale,
+    state: u32,
+) -> usize {
+    let mut offered = 0;
+    let gone =
+        |t: &Tracking, u: u32| u != NONE && (!s.alive[u as usize] || t.merged[u as usize] == state);
+    for o in offers {
+        let x = o.x as usize;
+        if t.sorted[x] != state {
+            t.sorted[x] = state;
+            if t.listed[x] != state {
+                let second = t.second[x];
+                let second_gone = second.is_none_or(|b| gone(t, b.other));
+                if t.refusals[x] != 0 || (gone(t, t.best[x].other) && second_gone) {
+                    t.listed[x] = state;
+                    choosers.push(o.x);
+                } else {
+                    offered += 1;
+                    if gone(t, t.best[x].other) {
+                        // The runner-up is the best of what is left; what
+                        // comes after it is not known.
+                        let b = second.unwrap_or(Best::NONE);
+                        t.best[x] = b;
+                        t.second[x] = (b.other == NONE).then_some(Best::NONE);
+                    } else if second_gone {
+                        t.second[x] = None;
+                    }
+                }
+            }
+        }
+        if t.listed[x] == state {
+            continue;
+        }
+        let mut choices = Choices {
+            best: t.best[x],
+            second: t.second[x],
+        };
+        offer(s, o.x, &mut choices, o.r, o.facing, scale);
+        t.best[x] = choices.best;
+        t.second[x] = choices.second;
+    }
+    // Every chooser's refused edges are stale now (its 1-ring changed, or
+    // it was refused and chooses without the refused edge).
+    for &v in choosers.iter() {
+        if t.changed[v as usize] == state {
+            t.refusals[v as usize] = 0;
+        }
+    }
+    offered
+}
+
+/// §2 step a for `vertices`, in parallel: their requests are replaced.
+/// Returns the neighbours whose refused edges the choosers found reopened.
+fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u32) -> Vec<u32> {
+    let mut reopened = Vec::new();
+    for (picks, chunk_reopened) in pick_all(s, t, vertices, scale, state) {
+        for (v, choices) in picks {
+            t.best[v as usize] = choices.best;
+            t.second[v as usize] = choices.second;
+        }
+        reopened.extend(chunk_reopened);
+    }
+    reopened
+}
+
+/// One chunk's picks (vertex and choices, in order) and reopened neighbours.
+type PickedChunk = (Vec<(u32, Choices)>, Vec<u32>);
+
+/// [`pick_edge`] for each of `vertices`, in parallel: per chunk of
+/// `vertices`, its requests in order and the reopened neighbours.
+fn pick_all(
+    s: &State,
+    t: &Tracking,
+    vertices: &[u32],
+    scale: Scale,
+    state: u32,
+) -> Vec<PickedChunk> {
+    let known = t.known(state);
+    par_chunks_map(vertices, |chunk| {
+        let mut reopened = Vec::new();
+        let picks: Vec<(u32, Choices)> = chunk
+            .iter()
+            .map(|&v| (v, pick_edge(s, v, scale, known, &mut reopened)))
+            .collect();
+        (picks, reopened)
+    })
+}
+
+/// The values `f` gives for `items`, in order, into `out` (cleared first):
+/// the step's large lists keep their capacity from step to step instead of
+/// faulting fresh pages in (a few percent of the run).
+fn par_filter_into<T: Sync, U: Send>(
+    items: &[T],
+    out: &mut Vec<U>,
+    f: impl Fn(&T) -> Option<U> + Sync + Send,
+) {
+    out.clear();
+    for part in par_chunks_map(items, |chunk| {
+        chunk.iter().filter_map(&f).collect::<Vec<U>>()
+    }) {
+        out.extend(part);
+    }
+}
+
+/// Lists a step rebuilds, kept between steps for their capacity.
+#[derive(Default)]
+struct Buffers {
+    errors: Vec<f64>,
+    players: Vec<u32>,
+    again: Vec<u32>,
+    admitted: Vec<(u32, u64)>,
+    /// The fans of the step's winners (see [`Winner::fans`]).
+    fans: Vec<u32>,
+}
+
+/// A valid check's target and fans (offset into the chunk's corners,
+/// lengths of P's and C's).
+type Prepared = ([u32; 3], (u32, u32, u32));
+
+/// One chunk's checks: results in order, and for the valid ones the
+/// vertices they block, their targets, and
+/// their fans (offsets into `corners`).
+#[derive(Default)]
+struct Checked {
+    results: Vec<(u32, Result<Plan, ()>)>,
+    blocks: Vec<u32>,
+    prepared: Vec<Prepared>,
+    corners: Vec<u32>,
+}
+
+/// `f` over consecutive chunks of `items` in parallel, the results in
+/// order. Each chunk fills its own buffers: no allocation per item and no
+/// merging copies (rayon's fold/reduce re-copies at every level).
+fn par_chunks_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&[T]) -> R + Sync + Send) -> Vec<R> {
+    let size = (items.len() / (8 * rayon::current_num_threads())).clamp(512, 16384);
+    items.par_chunks(size).map(f).collect()
+}
+
+/// What one step selects with: its state number, the threshold S and the
+/// scale of the tie-breaks.
+#[derive(Clone, Copy)]
+struct Step {
+    state: u32,
+    threshold: f64,
+    scale: Scale,
+}
+
 /// Steps b and c: reciprocal pairs under the threshold that are local minima
-/// among the requests of their 1-rings. Returns the survivors (lower ids).
+/// among the requests of their 1-rings, each then checked (`check_collapse`);
+/// returns the valid ones in ascending survivor id (the lower id).
 ///
 /// Steps a to c are then repeated on what they left undecided: a vertex
 /// whose partner was taken by a cheaper collapse chooses again among its free
-/// neighbours, and a pair blocked only by a pair that itself lost gets its
-/// turn. The passes grow the step towards a maximal set of independent
-/// collapses in error order, still in parallel; more collapses per step mean
-/// fewer rounds and fewer flags in the stream. Vertices changed here are all
-/// within the 2-ring of a collapse, so they are recomputed next step.
+/// neighbours, the two ends of a refused pair choose again without that edge,
+/// and a pair blocked only by a pair that itself lost gets its turn. The
+/// passes grow the step towards a maximal set of independent collapses in
+/// error order, still in parallel; more collapses per step mean fewer rounds
+/// and fewer flags in the stream. Choices made again here last for the step
+/// only (`Tracking::repick`); the ends of refused pairs are appended to
+/// `refused_ends` to choose from scratch at the next step.
 fn step_winners(
-    s: &State,
-    best: &mut [Best],
+    s: &mut State,
+    t: &mut Tracking,
     live: &[u32],
-    threshold: f64,
-    scale: Scale,
-) -> Vec<u32> {
-    // On jacksboro the passes add 100 %, 30 %, 4 % and 0.2 % of the first
-    // pass's collapses: a fourth pass is not worth its O(n) sweeps.
+    step: Step,
+    refused_ends: &mut Vec<u32>,
+    buffers: &mut Buffers,
+    phases: &mut Phases,
+) -> Vec<Winner> {
+    let Step {
+        state,
+        threshold,
+        scale,
+    } = step;
+    // Passes that find winners; on jacksboro they add 100 %, 30 %, 4 % and
+    // 0.2 % of the first pass's collapses: a fourth is not worth its O(n)
+    // sweeps. A pass whose chosen pairs are all refused does not count, up
+    // to a few: on badly scaled input (a DEM in degrees and metres) a step
+    // near a raised threshold could otherwise sweep its players for dozens
+    // of passes of one or two refused pairs each; refused ends choose again
+    // at the next step anyway.
     const PASSES: usize = 3;
-    let n = best.len();
-    let mut blocked = vec![false; n];
-    let mut winners = Vec::new();
-    for pass in 0..PASSES {
-        if pass > 0 {
-            let updates: Vec<(u32, Best)> = live
-                .par_iter()
-                .copied()
-                .filter(|&v| {
-                    let b = &best[v as usize];
-                    s.alive[v as usize]
-                        && !blocked[v as usize]
-                        && b.other != NONE
-                        && blocked[b.other as usize]
-                })
-                .map_init(CheckScratch::default, |scratch, v| {
-                    (v, best_edge_avoiding(s, v, scale, scratch, &blocked))
-                })
-                .collect();
-            for (v, b) in updates {
-                best[v as usize] = b;
+    const MAX_PASSES: usize = 2 * PASSES;
+    let mut winners: Vec<Winner> = Vec::new();
+    let mut refused_now: Vec<u32> = Vec::new();
+    let (mut counted, mut passes) = (0, 0);
+    let mut first = true;
+    // Only vertices whose request is under S can take part: choosing again
+    // among fewer neighbours never gets cheaper (up to requests of equal f32
+    // key, whose order the tie-breaks decide, not the error).
+    let tr: &Tracking = t;
+    let Buffers {
+        players,
+        again,
+        admitted: admitted_keys,
+        fans,
+        ..
+    } = buffers;
+    fans.clear();
+    par_filter_into(live, players, |&v| {
+        let b = &tr.best[v as usize];
+        (b.other != NONE && b.error <= threshold).then_some(v)
+    });
+    let live = &players[..];
+    loop {
+        if !first {
+            let tr: &Tracking = t;
+            par_filter_into(live, again, |&v| {
+                let b = tr.request(v, state);
+                (tr.blocked[v as usize] != state
+                    && b.other != NONE
+                    && b.error <= threshold
+                    && tr.blocked[b.other as usize] == state)
+                    .then_some(v)
+            });
+            // The ends of a refused pair are never blocked: a winner of the
+            // same pass would be in their 1-ring, and both cannot be local
+            // minima.
+            again.append(&mut refused_now);
+            phases.lap("repick scan");
+            // A vertex still on its unconstrained request whose runner-up is
+            // free takes it: everything else ranks after the runner-up.
+            let known = t.known(state);
+            let mut walk = Vec::new();
+            let mut quick = Vec::new();
+            for &v in again.iter() {
+                let free = |b: &Best| {
+                    b.other == NONE
+                        || (t.blocked[b.other as usize] != state
+                            && !known.refused(s.slot(b.corner), v, b.other))
+                };
+                match t.second[v as usize] {
+                    Some(b) if t.repick_at[v as usize] != state && free(&b) => quick.push((v, b)),
+                    _ => walk.push(v),
+                }
             }
+            let walked = pick_all(s, t, &walk, scale, state);
+            let walked = walked.into_iter().flat_map(|(picks, _)| picks);
+            for (v, b) in quick.into_iter().chain(walked.map(|(v, c)| (v, c.best))) {
+                t.repick[v as usize] = b;
+                t.repick_at[v as usize] = state;
+            }
+            phases.lap("repick");
         }
-        let best_now: &[Best] = best;
-        let admitted = |v: usize| {
-            let b = &best_now[v];
-            !blocked[v]
+        first = false;
+        let tr: &Tracking = t;
+        let admitted = |v: u32| {
+            let b = tr.request(v, state);
+            tr.blocked[v as usize] != state
                 && b.other != NONE
                 && b.error <= threshold
-                && best_now[b.other as usize].other == v as u32
+                && tr.request(b.other, state).other == v
         };
         // One key per pair, taken from its lower endpoint, so that both
         // endpoints compare alike (their cached errors may come from
         // different steps).
-        let admitted_keys: Vec<(u32, u64)> = live
-            .par_iter()
-            .filter(|&&v| admitted(v as usize))
-            .map(|&v| {
-                let low = v.min(best_now[v as usize].other);
-                (v, pair_key(&best_now[low as usize], low))
+        par_filter_into(live, admitted_keys, |&v| {
+            admitted(v).then(|| {
+                let low = v.min(tr.request(v, state).other);
+                (v, pair_key(tr.request(low, state), low))
             })
-            .collect();
-        let mut keys = vec![u64::MAX; n];
-        for &(v, key) in &admitted_keys {
-            keys[v as usize] = key;
+        });
+        for &(v, key) in admitted_keys.iter() {
+            t.keys[v as usize] = key;
         }
-        let chosen: Vec<u32> = admitted_keys
-            .par_iter()
-            .map(|&(v, _)| v)
-            .filter(|&v| {
-                let key = keys[v as usize];
-                let c = best_now[v as usize].other;
-                key != u64::MAX && v < c && is_local_minimum(s, v, c, key, &keys)
-            })
-            .collect();
-        if chosen.is_empty() {
+        phases.lap("admit");
+        let tr: &Tracking = t;
+        let s_now: &State = s;
+        // Local minima, checked; a valid one lists the vertices it blocks
+        // (from the fans its check walked).
+        let checked: Vec<Checked> = par_chunks_map(admitted_keys, |chunk| {
+            let mut scratch = CheckScratch::default();
+            let mut out = Checked::default();
+            for &(v, key) in chunk {
+                let b = tr.request(v, state);
+                let c = b.other;
+                if v > c {
+                    continue;
+                }
+                // C's fan only if P's neighbours do not already beat the pair.
+                if !is_local_minimum(s_now, v, c, key, &tr.keys, scratch.walk_p(s_now, v))
+                    || !is_local_minimum(s_now, v, c, key, &tr.keys, scratch.walk_c(s_now, c))
+                {
+                    continue;
+                }
+                // The merged position, as the slot's evaluation found it.
+                let (target, error) =
+                    evaluate(s_now, v, c).expect("an edge with a finite error has a placement");
+                debug_assert_eq!(error, b.error, "slot of ({v}, {c}) up to date");
+                let result = check_walked(s_now, v, c, s_now.to_metric(target), &mut scratch);
+                if result.is_ok() {
+                    out.blocks.extend(scratch.neighbourhood());
+                    let (fan_p, fan_c) = scratch.fans();
+                    let start = out.corners.len() as u32;
+                    out.corners.extend_from_slice(&fan_p.corners);
+                    out.corners.extend_from_slice(&fan_c.corners);
+                    out.prepared.push((
+                        target,
+                        (
+                            start,
+                            fan_p.corners.len() as u32,
+                            fan_c.corners.len() as u32,
+                        ),
+                    ));
+                }
+                out.results.push((v, result));
+            }
+            out
+        });
+        for &(v, _) in admitted_keys.iter() {
+            t.keys[v as usize] = u64::MAX;
+        }
+        phases.lap("minima+check");
+        if checked.iter().all(|out| out.results.is_empty()) {
             break;
         }
-        // The chosen pairs' endpoints and neighbours leave the game.
-        let touched: Vec<u32> = chosen
-            .par_iter()
-            .flat_map_iter(|&v| {
-                let mut fan = Fan::default();
-                let mut out = Vec::new();
-                for x in [v, best_now[v as usize].other] {
-                    out.push(x);
-                    s.table.fan(x, &mut fan);
-                    out.extend(fan.corners.iter().map(|&k| s.table.v(next(k))));
-                    out.extend(fan.corners.iter().map(|&k| s.table.v(prev(k))));
-                }
-                out
-            })
-            .collect();
-        for x in touched {
-            blocked[x as usize] = true;
-        }
-        winners.extend_from_slice(&chosen);
-    }
-    winners.sort_unstable();
-    winners
-}
-
-fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64]) -> bool {
-    let mut fan = Fan::default();
-    for v in [p, c] {
-        s.table.fan(v, &mut fan);
-        for &corner in &fan.corners {
-            for x in [s.table.v(next(corner)), s.table.v(prev(corner))] {
-                if x != p && x != c && keys[x as usize] < key {
-                    return false;
+        let mut found = false;
+        for out in &checked {
+            let base = fans.len() as u32;
+            fans.extend_from_slice(&out.corners);
+            let mut prepared = out.prepared.iter();
+            for &(p, result) in &out.results {
+                let b = *t.request(p, state);
+                match result {
+                    Ok(plan) => {
+                        found = true;
+                        let &(target, (start, np, nc)) = prepared
+                            .next()
+                            .expect("one prepared collapse per valid check");
+                        winners.push(Winner {
+                            p,
+                            best: b,
+                            target,
+                            plan,
+                            fans: (base + start, np, nc),
+                        });
+                    }
+                    Err(()) => {
+                        let slot = s.slot_index(b.corner);
+                        s.edges[slot].refused = state;
+                        for x in [p, b.other] {
+                            t.refusals[x as usize] = state;
+                            refused_now.push(x);
+                            if t.listed[x as usize] != state + 1 {
+                                t.listed[x as usize] = state + 1;
+                                refused_ends.push(x);
+                            }
+                        }
+                    }
                 }
             }
         }
+        passes += 1;
+        if !found {
+            if passes == MAX_PASSES {
+                break;
+            }
+            continue;
+        }
+        // The winners' endpoints and neighbours leave the game.
+        for out in &checked {
+            for &x in &out.blocks {
+                t.blocked[x as usize] = state;
+            }
+        }
+        phases.lap("block");
+        counted += 1;
+        if counted == PASSES || passes == MAX_PASSES {
+            break;
+        }
     }
-    true
+    winners.sort_unstable_by_key(|w| w.p);
+    winners
 }
 
-/// Applies the collapse chosen by `p`, returning its record.
-fn apply_collapse(s: &mut State, p: u32, b: Best, fans: &mut [Fan; 2]) -> Collapse {
-    try_apply_collapse(s, p, b, fans)
-        .expect("the winner was checked in this step and its neighbourhood is untouched")
-        .0
+/// Whether no neighbour in `fan` (of P or C) other than P and C has an
+/// admitted request with a key below `key`.
+fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64], fan: &Fan) -> bool {
+    let beaten = |x: u32| x != p && x != c && keys[x as usize] < key;
+    // Each neighbour once: the next vertex of every corner, and the previous
+    // one where the fan is open after it.
+    fan.corners.iter().all(|&corner| {
+        !beaten(s.table.v(next(corner)))
+            && (s.table.o(next(corner)) != NONE || !beaten(s.table.v(prev(corner))))
+    })
 }
 
 /// Applies the collapse chosen by `p` if `check_collapse` accepts it,
@@ -407,11 +927,21 @@ pub(super) fn try_apply_collapse(
     s: &mut State,
     p: u32,
     b: Best,
+    target: [u32; 3],
     fans: &mut [Fan; 2],
 ) -> Option<(Collapse, Plan)> {
-    let c = b.other;
     let mut scratch = CheckScratch::default();
-    let plan = check_collapse(s, p, c, s.to_metric(b.target), &mut scratch).ok()?;
+    let plan = check_collapse(s, p, b.other, s.to_metric(target), &mut scratch).ok()?;
+    let (record, q) = prepare(s, p, b, target, plan);
+    s.table.collapse(p, b.other, plan.left, plan.right, fans);
+    commit(s, p, b.other, target, plan, q);
+    Some((record, plan))
+}
+
+/// The record of the collapse of `p` and `b.other` to `target` and the
+/// merged quadric, from the mesh before it.
+fn prepare(s: &State, p: u32, b: Best, target: [u32; 3], plan: Plan) -> (Collapse, Quadric) {
+    let c = b.other;
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
     let weight = q.c[0] + q.c[4] + q.c[7];
     let distance = if weight > 0.0 {
@@ -426,51 +956,107 @@ pub(super) fn try_apply_collapse(
         wing_b: plan.wing_b,
         position_p: s.positions[p as usize],
         position_c: s.positions[c as usize],
-        position_r: b.target,
+        position_r: target,
         split_valence_p: s.split_valence[p as usize],
         split_valence_c: s.split_valence[c as usize],
         error: b.error,
         distance,
     };
-    s.table.collapse(p, c, plan.left, plan.right, fans);
+    (record, q)
+}
+
+/// The merged vertex's new attributes once the corner table is collapsed.
+fn commit(s: &mut State, p: u32, c: u32, target: [u32; 3], plan: Plan, q: Quadric) {
     let (pi, ci) = (p as usize, c as usize);
-    s.positions[pi] = b.target;
-    s.geometry[pi] = s.to_metric(b.target);
+    s.positions[pi] = target;
     s.quadrics[pi] = q;
     s.boundary[pi] |= s.boundary[ci];
     s.alive[ci] = false;
     s.split_valence[pi] = plan.valence_r as u8;
-    Some((record, plan))
+    s.valence[pi] = plan.valence_r as u32;
+    for w in [plan.wing_a, plan.wing_b] {
+        if w != NONE {
+            s.valence[w as usize] -= 1;
+        }
+    }
 }
 
-/// Re-evaluates the edges around each merged vertex: only their quadric or
-/// position changed.
-fn refresh_edges(s: &mut State, merged: &[u32]) {
-    let updates: Vec<(u32, EdgeSlot)> = merged
-        .par_iter()
-        .flat_map_iter(|&r| {
-            let mut fan = Fan::default();
-            s.table.fan(r, &mut fan);
-            let mut out = Vec::with_capacity(4 * fan.corners.len());
-            for &c in &fan.corners {
-                // Edge (r, prev c) faces next c and, across it, the opposite
-                // corner: evaluate it once for both. A boundary edge
-                // (r, next c) has no other side and is evaluated on its own.
-                let slot = edge_slot(s, next(c));
-                out.push((next(c), slot));
-                let across = s.table.o(next(c));
-                if across != NONE {
-                    out.push((across, slot));
+/// Re-evaluates the edges around each merged vertex (only their quadric or
+/// position changed) and stamps the merged vertices and their neighbours as
+/// changed in `next_state` (their 1-rings are new). Their neighbours get the
+/// refreshed edges as offers (into `offers`, see `take_offers`): no other
+/// vertex's request can change.
+///
+/// The merged vertices choose here, from the slots just evaluated, when
+/// `scale` is the next step's (a pick then would see the same fresh slots,
+/// no refusal and nothing blocked); otherwise they are appended to
+/// `choosers`.
+fn refresh_edges(
+    s: &mut State,
+    t: &mut Tracking,
+    merged: &[u32],
+    next_state: u32,
+    scale: Option<Scale>,
+    choosers: &mut Vec<u32>,
+    offers: &mut Vec<Offer>,
+) {
+    let s_now: &State = s;
+    let chunks = par_chunks_map(merged, |chunk| {
+        // About six edges a vertex.
+        let mut updates = Vec::with_capacity(7 * chunk.len());
+        let mut offers = Vec::with_capacity(7 * chunk.len());
+        let mut choices = Vec::with_capacity(if scale.is_some() { chunk.len() } else { 0 });
+        for &r in chunk {
+            let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
+            let mut refresh = |x: u32, facing: u32| {
+                let slot = edge_slot(s_now, facing);
+                updates.push((s_now.slot_index(facing) as u32, slot));
+                offers.push(Offer { x, r, facing });
+                if let Some(ranking) = &mut ranking {
+                    ranking.consider(x, facing, &slot);
                 }
-                if s.table.o(prev(c)) == NONE {
-                    out.push((prev(c), edge_slot(s, prev(c))));
+            };
+            // Edge (r, prev c) faces next c; a boundary edge (r, next c)
+            // faces prev c.
+            s_now.table.for_each_corner(r, |c| {
+                refresh(s_now.table.v(prev(c)), next(c));
+                if s_now.table.o(prev(c)) == NONE {
+                    refresh(s_now.table.v(next(c)), prev(c));
                 }
+            });
+            if let Some(ranking) = ranking {
+                choices.push(ranking.choices());
             }
-            out
-        })
-        .collect();
-    for (c, slot) in updates {
-        s.edges[c as usize] = slot;
+        }
+        (updates, offers, choices)
+    });
+    offers.clear();
+    let mut chosen = Vec::with_capacity(merged.len());
+    for (updates, chunk_offers, choices) in chunks {
+        for (c, slot) in updates {
+            s.edges[c as usize] = slot;
+        }
+        offers.extend(chunk_offers);
+        chosen.extend(choices);
+    }
+    for (i, &r) in merged.iter().enumerate() {
+        let v = r as usize;
+        t.changed[v] = next_state;
+        t.merged[v] = next_state;
+        // Never listed already: merged vertices are not refused ends.
+        t.listed[v] = next_state;
+        match chosen.get(i) {
+            Some(choices) => {
+                t.best[v] = choices.best;
+                t.second[v] = choices.second;
+                // Its edges are all fresh: nothing refused to forget.
+                t.refusals[v] = 0;
+            }
+            None => choosers.push(r),
+        }
+    }
+    for o in offers.iter() {
+        t.changed[o.x as usize] = next_state;
     }
 }
 
@@ -513,20 +1099,49 @@ fn neighbours_of<'a>(s: &'a State, fan: &'a Fan) -> impl Iterator<Item = u32> + 
         .chain(ends.iter().map(|&k| s.table.v(prev(k))))
 }
 
-/// Mean length of the live edges, for the sub-grid cell size.
-pub(super) fn mean_edge_length(s: &State) -> f64 {
-    let t = &s.table;
-    let (sum, count) = (0..t.vertex.len() as u32)
-        .into_par_iter()
-        .filter(|&c| t.v(c) != NONE)
-        .map(|c| {
-            let a = s.geometry(t.v(c));
-            let b = s.geometry(t.v(next(c)));
-            let d = crate::quadric::norm(crate::quadric::sub(a, b));
-            (d, 1usize)
-        })
-        .reduce(|| (0.0, 0), |x, y| (x.0 + y.0, x.1 + y.1));
-    if count == 0 { 1.0 } else { sum / count as f64 }
+/// Mean length of the live edges, for the sub-grid cell size and the flat
+/// threshold. Keeps the list of triangles that were alive at the last
+/// measure, so a measure costs the live triangles, not every corner ever
+/// allocated (the corner array never shrinks: with 43 measures down to the
+/// seed, sweeping it cost more than some whole phases).
+pub(super) struct EdgeMeter {
+    triangles: Vec<u32>,
+}
+
+impl EdgeMeter {
+    pub fn new(s: &State) -> EdgeMeter {
+        EdgeMeter {
+            triangles: (0..(s.table.vertex.len() / 3) as u32).collect(),
+        }
+    }
+
+    pub fn measure(&mut self, s: &State) -> f64 {
+        let t = &s.table;
+        self.triangles.retain(|&k| t.v(3 * k) != NONE);
+        // Fixed chunks summed in order: the same bits whatever the thread
+        // count (a rayon reduce's tree follows the work stealing).
+        let sums: Vec<f64> = self
+            .triangles
+            .par_chunks(4096)
+            .map(|chunk| {
+                let mut sum = 0.0;
+                for &k in chunk {
+                    for c in 3 * k..3 * k + 3 {
+                        let a = s.geometry(t.v(c));
+                        let b = s.geometry(t.v(next(c)));
+                        sum += crate::quadric::norm(crate::quadric::sub(a, b));
+                    }
+                }
+                sum
+            })
+            .collect();
+        let count = 3 * self.triangles.len();
+        if count == 0 {
+            1.0
+        } else {
+            sums.iter().sum::<f64>() / count as f64
+        }
+    }
 }
 
 impl Simplification {
