@@ -5,10 +5,7 @@
 mod levels;
 mod replay;
 
-use rayon::prelude::*;
-use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, StreamParams, assemble_stream, frame_level,
-};
+use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
 use splitstream_decoder_core::{PlanePolicy, PositionMode};
 
 use crate::mesh::Mesh;
@@ -165,22 +162,9 @@ pub fn encode_quantized(
         .map(|l: &LevelPayload| l.vertex_count)
         .collect();
     let rounds = replayed.levels.iter().map(|l| l.round_splits.len()).sum();
-    let replay_seconds = started.elapsed().as_secs_f64();
-    // Levels are framed (entropy coded, chunked) independently: in parallel.
-    let framed = replayed
-        .levels
-        .par_iter()
-        .enumerate()
-        .map(|(k, level)| frame_level(level, (k == 0).then_some(&replayed.seed), &params))
-        .collect();
-    let stream = assemble_stream(&params, &replayed.levels, framed);
-    if std::env::var_os("SPLITSTREAM_DEBUG").is_some() {
-        eprintln!(
-            "emit: replay {:.3} s, framing (entropy coding, chunks) {:.3} s",
-            replay_seconds,
-            started.elapsed().as_secs_f64() - replay_seconds
-        );
-    }
+    // The replay framed (entropy coded, chunked) each level beside the
+    // replay of the next one.
+    let stream = assemble_stream(&params, &replayed.levels, replayed.framed);
     Ok(Encoded {
         stream,
         permutation: replayed.permutation,
