@@ -885,48 +885,28 @@ fn invalid_vectors(s: &mut Specs) {
         "malformed",
         "The reserved field of level 1's first chunk-directory entry not zero (level header CRC recomputed).",
         &["reserved"],
-        {
-            let mut b = subject.clone();
-            b[chunk_entry_at(&subject, 1, 0) + 2] = 1;
-            fix_level_header_crc(&mut b, 1);
-            b
-        },
+        with_level_header_byte(&subject, 1, chunk_entry_at(&subject, 1, 0) + 2, 1),
     );
     s.invalid(
         "plane-policy-reserved",
         "malformed",
         "Level 1's plane policy byte (level header byte 8) set to 5, a reserved value (level header CRC recomputed).",
         &["reserved", "plane-policy"],
-        {
-            let mut b = subject.clone();
-            b[plane_policy_at(&subject, 1)] = 5;
-            fix_level_header_crc(&mut b, 1);
-            b
-        },
+        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1), 5),
     );
     s.invalid(
         "plane-policy-255",
         "malformed",
         "Level 0's plane policy byte set to 255 (level header CRC recomputed).",
         &["reserved", "plane-policy"],
-        {
-            let mut b = subject.clone();
-            b[plane_policy_at(&subject, 0)] = 255;
-            fix_level_header_crc(&mut b, 0);
-            b
-        },
+        with_level_header_byte(&subject, 0, plane_policy_at(&subject, 0), 255),
     );
     s.invalid(
         "reserved-level-header",
         "malformed",
         "Level 1's reserved level header byte 9 (after the plane policy) not zero (level header CRC recomputed).",
         &["reserved", "plane-policy"],
-        {
-            let mut b = subject.clone();
-            b[plane_policy_at(&subject, 1) + 1] = 1;
-            fix_level_header_crc(&mut b, 1);
-            b
-        },
+        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 1, 1),
     );
     s.invalid(
         "unknown-codec",

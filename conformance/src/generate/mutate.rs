@@ -197,6 +197,15 @@ pub fn fix_level_header_crc(s: &mut [u8], k: u16) {
     s[at..at + 4].copy_from_slice(&crc.to_le_bytes());
 }
 
+/// `s` with byte `at` of level `k`'s header set to `value` and that header's
+/// CRC recomputed, so the fault is met past the CRC check.
+pub fn with_level_header_byte(s: &[u8], k: u16, at: usize, value: u8) -> Vec<u8> {
+    let mut b = s.to_vec();
+    b[at] = value;
+    fix_level_header_crc(&mut b, k);
+    b
+}
+
 /// Offset of the split count of round `r` of level `k`.
 pub fn split_count_at(s: &[u8], k: u16, r: usize) -> usize {
     split_counts_at(s, k) + 4 * r
