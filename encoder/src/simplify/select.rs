@@ -103,12 +103,16 @@ pub struct EdgeSlot {
     /// State number (see [`Known`]) in which the collapse was checked and
     /// found invalid; 0 if it never was since the slot was evaluated.
     pub refused: u32,
+    /// State number in which the collapse was last checked and found valid
+    /// (0: never since the slot was evaluated). Kept in the slot's padding.
+    pub valid: u32,
 }
 
 impl EdgeSlot {
     pub const FORBIDDEN: EdgeSlot = EdgeSlot {
         error: f64::INFINITY,
         refused: 0,
+        valid: 0,
     };
 }
 
@@ -119,7 +123,11 @@ pub fn edge_slot(s: &State, c: u32) -> EdgeSlot {
         return EdgeSlot::FORBIDDEN;
     }
     match evaluate(s, a, b) {
-        Some((_, error)) => EdgeSlot { error, refused: 0 },
+        Some((_, error)) => EdgeSlot {
+            error,
+            refused: 0,
+            valid: 0,
+        },
         None => EdgeSlot::FORBIDDEN,
     }
 }
@@ -170,6 +178,15 @@ impl Known<'_> {
             && slot.refused >= self.changed[v as usize]
             && slot.refused >= self.changed[u as usize]
     }
+
+    /// Whether a slot was found valid since the 1-rings of both endpoints
+    /// last changed (a hint: falling wing valences can still make it
+    /// invalid, so winners are checked again).
+    pub fn valid(&self, slot: &EdgeSlot, v: u32, u: u32) -> bool {
+        slot.valid != 0
+            && slot.valid >= self.changed[v as usize]
+            && slot.valid >= self.changed[u as usize]
+    }
 }
 
 /// Order of one vertex's requests: error key, then same sub-grid cell
@@ -214,7 +231,9 @@ impl<'a> Order<'a> {
     }
 }
 
-fn error_key(error: f64, scale: Scale) -> u32 {
+/// The key requests are ordered by: the error rounded to f32 (monotone),
+/// 0 for flat ones.
+pub fn error_key(error: f64, scale: Scale) -> u32 {
     if error <= scale.flat {
         0
     } else {

@@ -4,11 +4,17 @@ use rayon::prelude::*;
 
 use super::check::{CheckScratch, Plan, check_collapse, check_walked};
 use super::select::{
-    Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, evaluate, offer, pair_key, pick_edge,
+    Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, error_key, evaluate, offer,
+    pair_key, pick_edge,
 };
 use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
+
+/// Share of refused checks above which a step checks its players' requests
+/// before they pair up (`validate`): about 0.3 % on the meshes and terrains,
+/// 20 % on a DEM read in degrees and metres.
+const VALIDATE_ABOVE: f64 = 0.02;
 
 /// Split valence stored for vertices that were never produced by a collapse.
 pub const LEAF: u8 = 0xFF;
@@ -317,6 +323,8 @@ pub fn simplify(
     let mut choosers = live.clone();
     let mut offers: Vec<Offer> = Vec::new();
     let mut buffers = Buffers::default();
+    // Recent refused checks and checks (see `VALIDATE_ABOVE`).
+    let mut refusals = (0.0f64, 0.0f64);
     let limit = options.max_error.unwrap_or(f64::INFINITY);
     let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
     // The mean edge length sets the sub-grid and the flat threshold; it
@@ -330,6 +338,17 @@ pub fn simplify(
         if alive_count * 5 < edge_measured_at * 4 {
             edge = meter.measure(&s);
             edge_measured_at = alive_count;
+            // The sub-grid and the flat threshold change with the scale:
+            // every request chooses again under the new one. (Requests kept
+            // from the old scale would compare keys and cells of two scales;
+            // on a DEM in degrees and metres, where the flat threshold is
+            // above most errors and the tie-breaks decide, the steps then
+            // found few collapses each.)
+            for &v in &live {
+                if std::mem::replace(&mut t.listed[v as usize], state) != state {
+                    choosers.push(v);
+                }
+            }
         }
         let scale = Scale {
             cell: options.subgrid_cells * edge,
@@ -352,6 +371,12 @@ pub fn simplify(
             .collect();
         choose(&s, &mut t, &again, scale, state);
         let chose = choosers.len() + again.len();
+        buffers.tally = Tally::default();
+        // Check requests before they pair up only where they are often
+        // invalid (see `validate`): on well-shaped meshes one check in a few
+        // hundred fails, and checking every request would cost more than the
+        // lazy refusals.
+        let validating = refusals.0 > VALIDATE_ABOVE * refusals.1;
         // Raise S to the admitted quantile of the current candidate errors.
         let errors = &mut buffers.errors;
         errors.clear();
@@ -380,6 +405,7 @@ pub fn simplify(
                 state,
                 threshold,
                 scale,
+                validating,
             },
             &mut choosers,
             &mut buffers,
@@ -401,6 +427,7 @@ pub fn simplify(
                     state,
                     threshold,
                     scale,
+                    validating,
                 },
                 &mut choosers,
                 &mut buffers,
@@ -467,15 +494,22 @@ pub fn simplify(
             let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
             let now = std::time::Instant::now();
             eprintln!(
-                "step {}: alive {alive_count}, collapses {}, chose {chose}, offered {offered}, ms: best {:.1} select {:.1} apply {:.1} refresh {:.1}",
+                "step {}: alive {alive_count}, collapses {}, chose {chose}, offered {offered}, validated {} refused {}, ms: best {:.1} select {:.1} apply {:.1} refresh {:.1}",
                 steps.len(),
                 winners.len(),
+                buffers.tally.checks,
+                buffers.tally.refused,
                 ms(t_best, t_select),
                 ms(t_select, t_apply),
                 ms(t_apply, t_refresh),
                 ms(t_refresh, now),
             );
         }
+        // Refusals per check, decaying by half a step.
+        refusals = (
+            0.5 * refusals.0 + buffers.tally.refused as f64,
+            0.5 * refusals.1 + buffers.tally.checks as f64,
+        );
         alive_count -= collapses.len();
         steps.push(collapses);
         step_errors.push(step_error);
@@ -598,6 +632,89 @@ fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u3
     reopened
 }
 
+/// Checks the requests of `vertices` that are not known to be valid and
+/// stamps their slots; a vertex whose request is invalid chooses again
+/// (its request, or its overlay within the step), until every request is
+/// valid or known refused. The ends of a refused overlay request are
+/// appended to `refused_ends` to choose from scratch at the next step.
+/// Counts its checks and refusals in `tally`.
+///
+/// Without it a request is only checked once its pair is chosen: a vertex
+/// whose partner wants another edge keeps an invalid request for as long as
+/// its 1-ring stands, and the neighbours that want it wait with it. On
+/// badly shaped input (a DEM in degrees and metres, where cheap edges often
+/// fold) the steps then find few collapses each.
+fn validate(
+    s: &mut State,
+    t: &mut Tracking,
+    vertices: &[u32],
+    scale: Scale,
+    state: u32,
+    refused_ends: &mut Vec<u32>,
+    tally: &mut Tally,
+) {
+    let mut list: Vec<u32> = Vec::new();
+    let mut first = true;
+    loop {
+        let items = if first { vertices } else { &list[..] };
+        first = false;
+        let tr: &Tracking = t;
+        let s_now: &State = s;
+        let known = tr.known(state);
+        let results: Vec<Vec<(u32, bool)>> = par_chunks_map(items, |chunk| {
+            let mut scratch = CheckScratch::default();
+            let mut out = Vec::new();
+            for &v in chunk {
+                let b = tr.request(v, state);
+                if b.other == NONE || known.valid(s_now.slot(b.corner), v, b.other) {
+                    continue;
+                }
+                let (p, c) = (v.min(b.other), v.max(b.other));
+                let (target, _) =
+                    evaluate(s_now, p, c).expect("an edge with a finite error has a placement");
+                let ok = check_collapse(s_now, p, c, s_now.to_metric(target), &mut scratch).is_ok();
+                out.push((v, ok));
+            }
+            out
+        });
+        let (mut again, mut overlay) = (Vec::new(), Vec::new());
+        for (v, ok) in results.into_iter().flatten() {
+            tally.checks += 1;
+            let b = *t.request(v, state);
+            let slot = s.slot_index(b.corner);
+            if ok {
+                s.edges[slot].valid = state;
+                continue;
+            }
+            s.edges[slot].refused = state;
+            tally.refused += 1;
+            let in_step = t.repick_at[v as usize] == state;
+            if in_step {
+                overlay.push(v);
+            } else {
+                again.push(v);
+            }
+            for x in [v, b.other] {
+                t.refusals[x as usize] = state;
+                if in_step && t.listed[x as usize] != state + 1 {
+                    t.listed[x as usize] = state + 1;
+                    refused_ends.push(x);
+                }
+            }
+        }
+        if again.is_empty() && overlay.is_empty() {
+            return;
+        }
+        choose(s, t, &again, scale, state);
+        let picks = pick_all(s, t, &overlay, scale, state);
+        for (v, c) in picks.into_iter().flat_map(|(picks, _)| picks) {
+            t.repick[v as usize] = c.best;
+        }
+        list = again;
+        list.append(&mut overlay);
+    }
+}
+
 /// One chunk's picks (vertex and choices, in order) and reopened neighbours.
 type PickedChunk = (Vec<(u32, Choices)>, Vec<u32>);
 
@@ -646,6 +763,15 @@ struct Buffers {
     admitted: Vec<(u32, u64)>,
     /// The fans of the step's winners (see [`Winner::fans`]).
     fans: Vec<u32>,
+    /// The step's checks (reset when it starts).
+    tally: Tally,
+}
+
+/// Checks made in a step and how many were refused.
+#[derive(Clone, Copy, Default)]
+struct Tally {
+    checks: usize,
+    refused: usize,
 }
 
 /// A valid check's target and fans (offset into the chunk's corners,
@@ -671,13 +797,15 @@ fn par_chunks_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&[T]) -> R + Sync + 
     items.par_chunks(size).map(f).collect()
 }
 
-/// What one step selects with: its state number, the threshold S and the
-/// scale of the tie-breaks.
+/// What one step selects with: its state number, the threshold S, the
+/// scale of the tie-breaks and whether requests are checked before they
+/// pair up (`validate`).
 #[derive(Clone, Copy)]
 struct Step {
     state: u32,
     threshold: f64,
     scale: Scale,
+    validating: bool,
 }
 
 /// Steps b and c: reciprocal pairs under the threshold that are local minima
@@ -706,6 +834,7 @@ fn step_winners(
         state,
         threshold,
         scale,
+        validating,
     } = step;
     // Passes that find winners; on jacksboro they add 100 %, 30 %, 4 % and
     // 0.2 % of the first pass's collapses: a fourth is not worth its O(n)
@@ -720,23 +849,33 @@ fn step_winners(
     let mut refused_now: Vec<u32> = Vec::new();
     let (mut counted, mut passes) = (0, 0);
     let mut first = true;
-    // Only vertices whose request is under S can take part: choosing again
-    // among fewer neighbours never gets cheaper (up to requests of equal f32
-    // key, whose order the tie-breaks decide, not the error).
+    // Only vertices whose request's key is not above S's can take part:
+    // choosing again among fewer neighbours never gives a lower key. (Not
+    // the error: requests of equal key, all flat ones in particular, are
+    // ordered by the tie-breaks, so a vertex whose request is over S may
+    // choose again an edge of the same key under it; on a flat DEM that is
+    // most of the early steps' collapses.)
+    let threshold_key = error_key(threshold, scale);
     let tr: &Tracking = t;
     let Buffers {
         players,
         again,
         admitted: admitted_keys,
         fans,
+        tally,
         ..
     } = buffers;
     fans.clear();
     par_filter_into(live, players, |&v| {
         let b = &tr.best[v as usize];
-        (b.other != NONE && b.error <= threshold).then_some(v)
+        (b.other != NONE && (b.error <= threshold || b.error_key <= threshold_key)).then_some(v)
     });
     let live = &players[..];
+    // The players' requests are checked before they pair up (see `validate`).
+    if validating {
+        validate(s, t, live, scale, state, refused_ends, tally);
+    }
+    phases.lap("validate");
     loop {
         if !first {
             let tr: &Tracking = t;
@@ -744,7 +883,7 @@ fn step_winners(
                 let b = tr.request(v, state);
                 (tr.blocked[v as usize] != state
                     && b.other != NONE
-                    && b.error <= threshold
+                    && (b.error <= threshold || b.error_key <= threshold_key)
                     && tr.blocked[b.other as usize] == state)
                     .then_some(v)
             });
@@ -776,6 +915,10 @@ fn step_winners(
                 t.repick_at[v as usize] = state;
             }
             phases.lap("repick");
+            if validating {
+                validate(s, t, again, scale, state, refused_ends, tally);
+            }
+            phases.lap("validate");
         }
         first = false;
         let tr: &Tracking = t;
@@ -784,6 +927,7 @@ fn step_winners(
             tr.blocked[v as usize] != state
                 && b.other != NONE
                 && b.error <= threshold
+                && tr.blocked[b.other as usize] != state
                 && tr.request(b.other, state).other == v
         };
         // One key per pair, taken from its lower endpoint, so that both
@@ -796,7 +940,11 @@ fn step_winners(
             })
         });
         for &(v, key) in admitted_keys.iter() {
+            // Both ends: the partner may not be a player (its request's key
+            // can date from another scale).
+            let other = t.request(v, state).other;
             t.keys[v as usize] = key;
+            t.keys[other as usize] = key;
         }
         phases.lap("admit");
         let tr: &Tracking = t;
@@ -843,7 +991,9 @@ fn step_winners(
             out
         });
         for &(v, _) in admitted_keys.iter() {
+            let other = t.request(v, state).other;
             t.keys[v as usize] = u64::MAX;
+            t.keys[other as usize] = u64::MAX;
         }
         phases.lap("minima+check");
         if checked.iter().all(|out| out.results.is_empty()) {
@@ -856,6 +1006,7 @@ fn step_winners(
             let mut prepared = out.prepared.iter();
             for &(p, result) in &out.results {
                 let b = *t.request(p, state);
+                tally.checks += 1;
                 match result {
                     Ok(plan) => {
                         found = true;
@@ -871,6 +1022,7 @@ fn step_winners(
                         });
                     }
                     Err(()) => {
+                        tally.refused += 1;
                         let slot = s.slot_index(b.corner);
                         s.edges[slot].refused = state;
                         for x in [p, b.other] {
