@@ -326,6 +326,10 @@ impl RecordSource for StepSource<'_> {
     }
 }
 
+/// A level's payload and its framed bytes with its largest chunk
+/// (`writer::frame_level`).
+type FramedLevel = (LevelPayload, (Vec<u8>, u32));
+
 /// Replays `s` level by level as planned, returning the level payloads,
 /// each with the plane policy `plane`, or by default the one whose
 /// residuals cost least under `params`.
@@ -394,66 +398,64 @@ pub fn replay(
     // framing entropy-codes it; both run on another thread while the next
     // level replays (same bytes: the replay itself is sequential).
     let seed_ref = &seed;
-    let done = std::thread::scope(
-        |scope| -> Result<Vec<(LevelPayload, (Vec<u8>, u32))>, ReplayError> {
-            let mut choosing = Vec::with_capacity(plan.rounds.len());
-            for (l, steps) in plan.rounds.iter().enumerate() {
-                let mut subs = vec![SubstreamWriter::default(); 7];
-                let mut residuals = policy_residuals();
-                let mut round_splits = Vec::with_capacity(steps.len());
-                for &k in steps {
-                    let collapses = &s.steps[k];
-                    flagged.clear();
-                    for (i, col) in collapses.iter().enumerate() {
-                        let r = enc2dec[col.p as usize];
-                        current[r as usize] = i as u32;
-                        flagged.push(r);
-                    }
-                    let mut source = StepSource {
-                        collapses,
-                        current: &mut current,
-                        enc2dec: &mut enc2dec,
-                        dec2enc: &mut dec2enc,
-                        subs: &mut subs,
-                        residuals: &mut residuals,
-                        mode,
-                        pending: None,
-                        swapped: false,
-                        problem: None,
-                    };
-                    let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
-                    if let Err(e) = result {
-                        let why = source.problem.take().unwrap_or_else(|| e.to_string());
-                        return Err(ReplayError(format!("step {k}: {why}")));
-                    }
-                    for &r in &flagged {
-                        current[r as usize] = NONE;
-                    }
-                    round_splits.push(collapses.len() as u32);
+    let done = std::thread::scope(|scope| -> Result<Vec<FramedLevel>, ReplayError> {
+        let mut choosing = Vec::with_capacity(plan.rounds.len());
+        for (l, steps) in plan.rounds.iter().enumerate() {
+            let mut subs = vec![SubstreamWriter::default(); 7];
+            let mut residuals = policy_residuals();
+            let mut round_splits = Vec::with_capacity(steps.len());
+            for &k in steps {
+                let collapses = &s.steps[k];
+                flagged.clear();
+                for (i, col) in collapses.iter().enumerate() {
+                    let r = enc2dec[col.p as usize];
+                    current[r as usize] = i as u32;
+                    flagged.push(r);
                 }
-                let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
-                let geometric_error = plan.errors[l];
-                choosing.push(scope.spawn(move || {
-                    let plane = choose_policy(&mut subs, residuals, params, plane)
-                        .map_err(|why| ReplayError(format!("level {l}: {why}")))?;
-                    let level = LevelPayload {
-                        round_splits,
-                        plane,
-                        substreams: subs,
-                        vertex_count,
-                        triangle_count,
-                        geometric_error,
-                    };
-                    let framed = frame_level(&level, (l == 0).then_some(seed_ref), params);
-                    Ok((level, framed))
-                }));
+                let mut source = StepSource {
+                    collapses,
+                    current: &mut current,
+                    enc2dec: &mut enc2dec,
+                    dec2enc: &mut dec2enc,
+                    subs: &mut subs,
+                    residuals: &mut residuals,
+                    mode,
+                    pending: None,
+                    swapped: false,
+                    problem: None,
+                };
+                let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
+                if let Err(e) = result {
+                    let why = source.problem.take().unwrap_or_else(|| e.to_string());
+                    return Err(ReplayError(format!("step {k}: {why}")));
+                }
+                for &r in &flagged {
+                    current[r as usize] = NONE;
+                }
+                round_splits.push(collapses.len() as u32);
             }
-            choosing
-                .into_iter()
-                .map(|h| h.join().expect("choosing a plane policy does not panic"))
-                .collect()
-        },
-    )?;
+            let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
+            let geometric_error = plan.errors[l];
+            choosing.push(scope.spawn(move || {
+                let plane = choose_policy(&mut subs, residuals, params, plane)
+                    .map_err(|why| ReplayError(format!("level {l}: {why}")))?;
+                let level = LevelPayload {
+                    round_splits,
+                    plane,
+                    substreams: subs,
+                    vertex_count,
+                    triangle_count,
+                    geometric_error,
+                };
+                let framed = frame_level(&level, (l == 0).then_some(seed_ref), params);
+                Ok((level, framed))
+            }));
+        }
+        choosing
+            .into_iter()
+            .map(|h| h.join().expect("choosing a plane policy does not panic"))
+            .collect()
+    })?;
     check_exact(mesh, &state, &dec2enc)?;
     let final_hash = state.state_hash();
     let (levels, framed) = done.into_iter().unzip();
