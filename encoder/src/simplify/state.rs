@@ -397,29 +397,11 @@ pub fn simplify(
         let t_select = std::time::Instant::now();
         phases.lap("quantile");
         choosers.clear();
-        let mut winners = step_winners(
-            &mut s,
-            &mut t,
-            &live,
-            Step {
-                state,
-                threshold,
-                scale,
-                validating,
-            },
-            &mut choosers,
-            &mut buffers,
-            &mut phases,
-        );
         // Nothing under S: raise it (the paper's "S is increased"), doubling
         // past the smallest candidate error, until a step finds collapses or
         // S passes every candidate error or the maximum error.
-        while winners.is_empty() && threshold < limit && threshold < largest {
-            threshold = (2.0 * threshold)
-                .max(smallest)
-                .max(f64::MIN_POSITIVE)
-                .min(limit);
-            winners = step_winners(
+        let mut winners = loop {
+            let found = step_winners(
                 &mut s,
                 &mut t,
                 &live,
@@ -433,7 +415,15 @@ pub fn simplify(
                 &mut buffers,
                 &mut phases,
             );
-        }
+            let can_raise = threshold < limit && threshold < largest;
+            if !found.is_empty() || !can_raise {
+                break found;
+            }
+            threshold = (2.0 * threshold)
+                .max(smallest)
+                .max(f64::MIN_POSITIVE)
+                .min(limit);
+        };
         if winners.is_empty() {
             break;
         }
