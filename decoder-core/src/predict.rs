@@ -278,6 +278,16 @@ pub struct Plane {
 impl Plane {
     /// The plane of a split with statistics `means` under `policy`.
     pub fn new(policy: PlanePolicy, means: &ArcMeans) -> Plane {
+        match policy {
+            PlanePolicy::Off => Plane::with_normal(policy, [0; 3]),
+            _ => Plane::with_normal(policy, normal(means)),
+        }
+    }
+
+    /// The plane of a split whose shifted normal `n` (SPEC §7.4
+    /// `plane_of`) is known, under `policy` (`n` is ignored under `off`).
+    /// An encoder trying every policy computes `n` once.
+    pub fn with_normal(policy: PlanePolicy, n: [i64; 3]) -> Plane {
         let (normal, axis) = match policy {
             PlanePolicy::Off => {
                 return Plane {
@@ -289,7 +299,6 @@ impl Plane {
                 };
             }
             PlanePolicy::Dominant => {
-                let n = normal(means);
                 let m = n.map(|x| x.unsigned_abs());
                 // The largest component, the lowest axis on ties.
                 let j = if m[1] > m[0] {
@@ -301,7 +310,7 @@ impl Plane {
                 };
                 (n, j)
             }
-            PlanePolicy::Axis(a) => (normal(means), (a as usize).min(2)),
+            PlanePolicy::Axis(a) => (n, (a as usize).min(2)),
         };
         let order = [(axis + 1) % 3, (axis + 2) % 3, axis];
         let contexts = match policy {
@@ -578,6 +587,30 @@ mod tests {
                 [1 << 30, -(1 << 30), 5],
             ] {
                 assert_eq!(plane.decode(plane.encode(r)), r, "{policy:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_known_normal_gives_the_same_plane() {
+        for (wing_edge, arc_2) in [
+            (Some([3, -9, 2]), [1, 1, 7]),
+            (Some([5, 0, 0]), [0, 5, 0]),
+            (Some([-4, 4, -4]), [4, 4, -4]),
+            (None, [4, 4, 4]),
+        ] {
+            let means = ArcMeans {
+                arc_2,
+                wing_edge,
+                ..ArcMeans::default()
+            };
+            let n = Plane::new(PlanePolicy::Dominant, &means).normal;
+            for policy in PlanePolicy::ALL {
+                assert_eq!(
+                    Plane::with_normal(policy, n),
+                    Plane::new(policy, &means),
+                    "{policy:?}"
+                );
             }
         }
     }

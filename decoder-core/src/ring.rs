@@ -85,8 +85,8 @@ impl MeshState<'_> {
             }
         }
         let first = (0..n).min_by_key(|&i| ring.vertices[i]).unwrap_or(0);
-        ring.vertices[..n].rotate_left(first);
-        ring.corners[..n].rotate_left(first);
+        rotate_left(&mut ring.vertices[..n], first);
+        rotate_left(&mut ring.corners[..n], first);
         ring.len = n;
         Ok(())
     }
@@ -126,6 +126,37 @@ impl MeshState<'_> {
             }
             c = next(o);
             m += 1;
+        }
+    }
+}
+
+/// `v.rotate_left(k)` by three reversals: rings are a handful of entries,
+/// where the standard rotation's call to `memmove` costs more than the
+/// rotation itself.
+#[inline]
+fn rotate_left(v: &mut [u32], k: usize) {
+    if k == 0 || k >= v.len() {
+        return;
+    }
+    v[..k].reverse();
+    v[k..].reverse();
+    v.reverse();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rotate_left;
+
+    #[test]
+    fn rotation_by_reversals_is_rotate_left() {
+        for n in 0..12u32 {
+            for k in 0..n as usize {
+                let mut a: [u32; 12] = core::array::from_fn(|i| i as u32);
+                let mut b = a;
+                rotate_left(&mut a[..n as usize], k);
+                b[..n as usize].rotate_left(k);
+                assert_eq!(a, b, "n {n}, k {k}");
+            }
         }
     }
 }

@@ -157,6 +157,21 @@ pub struct StreamParams {
     pub chunk_limit: u32,
 }
 
+impl Default for StreamParams {
+    /// The reference encoder's defaults on a unit grid: optimal positions,
+    /// 14 bits, rANS in 4 lanes, chunks of 16 KiB.
+    fn default() -> Self {
+        StreamParams {
+            position_mode: PositionMode::Optimal,
+            bits: 14,
+            origin: [0.0; 3],
+            scale: [1.0; 3],
+            codec: ChunkCodec::Rans { lanes: 4 },
+            chunk_limit: 16 * 1024,
+        }
+    }
+}
+
 /// The seed mesh of level 0 (SPEC §6.3): counts and substreams 8..=10.
 #[derive(Clone, Debug, Default)]
 pub struct SeedPayload {
@@ -302,6 +317,28 @@ pub fn frame_level(
     seed: Option<&SeedPayload>,
     params: &StreamParams,
 ) -> (Vec<u8>, u32) {
+    frame_level_with(level, seed, params, &one_by_one)
+}
+
+/// Runs `job(i)` for every chunk `i` in `0..n` and returns the chunks in
+/// that order: how [`frame_level_with`] codes a substream's chunks, which
+/// are independent of each other.
+pub type ChunkMap<'a> = &'a (dyn Fn(usize, &(dyn Fn(usize) -> Chunk + Sync)) -> Vec<Chunk> + Sync);
+
+/// The [`ChunkMap`] of [`frame_level`]: one chunk after the other.
+pub fn one_by_one(n: usize, job: &(dyn Fn(usize) -> Chunk + Sync)) -> Vec<Chunk> {
+    (0..n).map(job).collect()
+}
+
+/// [`frame_level`], coding each substream's chunks with `map` (an encoder
+/// with threads passes one that codes them in parallel: the bytes are the
+/// same).
+pub fn frame_level_with(
+    level: &LevelPayload,
+    seed: Option<&SeedPayload>,
+    params: &StreamParams,
+    map: ChunkMap<'_>,
+) -> (Vec<u8>, u32) {
     let limit = params.chunk_limit.max(1) as usize;
     let mut directory = Vec::new();
     let mut payload = Vec::new();
@@ -316,7 +353,7 @@ pub fn frame_level(
         .flat_map(|s| s.substreams.iter().enumerate())
         .map(|(i, s)| (substream::BASE_POSITIONS + i as u8, s));
     for (id, sub) in rounds.chain(base) {
-        let chunks = substream_chunks(sub, id, limit, params.codec);
+        let chunks = substream_chunks(sub, id, limit, params.codec, map);
         for chunk in chunks {
             let mut entry = [0u8; CHUNK_ENTRY_LEN];
             entry[0] = id;
@@ -355,21 +392,24 @@ fn substream_chunks(
     id: u8,
     limit: usize,
     chunk_codec: ChunkCodec,
+    map: ChunkMap<'_>,
 ) -> Vec<Chunk> {
     match chunk_codec {
-        ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None),
-        ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l)),
+        ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None, map),
+        ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l), map),
         ChunkCodec::Rans { lanes } => {
-            let rans = rans_chunks(sub.symbols(), limit, id, lanes as usize);
-            let deflate = byte_chunks(sub.as_bytes(), limit, Some(10));
+            let rans = rans_chunks(sub.symbols(), limit, id, lanes as usize, map);
             let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
+            let deflate = byte_chunks(sub.as_bytes(), limit, Some(10), map);
             if size(&rans) < size(&deflate) {
                 rans
             } else {
                 deflate
             }
         }
-        ChunkCodec::RansAlways { lanes } => rans_chunks(sub.symbols(), limit, id, lanes as usize),
+        ChunkCodec::RansAlways { lanes } => {
+            rans_chunks(sub.symbols(), limit, id, lanes as usize, map)
+        }
     }
 }
 
@@ -378,14 +418,14 @@ fn substream_chunks(
 /// (the plane policies of SPEC §7.4) by their real cost.
 pub fn coded_len(sub: &SubstreamWriter, id: u8, params: &StreamParams) -> usize {
     let limit = params.chunk_limit.max(1) as usize;
-    substream_chunks(sub, id, limit, params.codec)
+    substream_chunks(sub, id, limit, params.codec, &one_by_one)
         .iter()
         .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)
         .sum()
 }
 
 /// One coded chunk before framing.
-struct Chunk {
+pub struct Chunk {
     codec: u8,
     raw_len: u32,
     stored: Vec<u8>,
@@ -393,36 +433,40 @@ struct Chunk {
 
 /// Byte-codec chunks of at most `limit` raw bytes; deflated at `level` where
 /// that is smaller than storing.
-fn byte_chunks(bytes: &[u8], limit: usize, level: Option<u8>) -> Vec<Chunk> {
-    bytes
-        .chunks(limit)
-        .map(|raw| {
-            let packed = level.map(|l| miniz_oxide::deflate::compress_to_vec(raw, l));
-            match packed {
-                Some(p) if p.len() < raw.len() => Chunk {
-                    codec: codec::DEFLATE,
-                    raw_len: raw.len() as u32,
-                    stored: p,
-                },
-                _ => Chunk {
-                    codec: codec::STORED,
-                    raw_len: raw.len() as u32,
-                    stored: raw.to_vec(),
-                },
-            }
-        })
-        .collect()
+fn byte_chunks(bytes: &[u8], limit: usize, level: Option<u8>, map: ChunkMap<'_>) -> Vec<Chunk> {
+    map(bytes.len().div_ceil(limit), &|i| {
+        let raw = &bytes[i * limit..bytes.len().min((i + 1) * limit)];
+        let packed = level.map(|l| miniz_oxide::deflate::compress_to_vec(raw, l));
+        match packed {
+            Some(p) if p.len() < raw.len() => Chunk {
+                codec: codec::DEFLATE,
+                raw_len: raw.len() as u32,
+                stored: p,
+            },
+            _ => Chunk {
+                codec: codec::STORED,
+                raw_len: raw.len() as u32,
+                stored: raw.to_vec(),
+            },
+        }
+    })
 }
 
 /// rANS chunks of at most `limit` values each (SPEC §5.5).
-fn rans_chunks(symbols: &[Symbol], limit: usize, id: u8, lanes: usize) -> Vec<Chunk> {
+fn rans_chunks(
+    symbols: &[Symbol],
+    limit: usize,
+    id: u8,
+    lanes: usize,
+    map: ChunkMap<'_>,
+) -> Vec<Chunk> {
     let contexts = substream::CONTEXTS[id as usize] as usize;
-    symbols
-        .chunks(limit)
-        .map(|values| Chunk {
+    map(symbols.len().div_ceil(limit), &|i| {
+        let values = &symbols[i * limit..symbols.len().min((i + 1) * limit)];
+        Chunk {
             codec: codec::RANS,
             raw_len: values.len() as u32,
             stored: encode_chunk(values, contexts, lanes),
-        })
-        .collect()
+        }
+    })
 }

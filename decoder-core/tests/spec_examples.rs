@@ -9,12 +9,10 @@ use splitstream_decoder_core::{Fnv1a, PlanePolicy, PositionMode, crc32};
 
 fn params() -> StreamParams {
     StreamParams {
-        position_mode: PositionMode::Optimal,
         bits: 8,
-        origin: [0.0; 3],
-        scale: [1.0; 3],
         codec: ChunkCodec::Stored,
         chunk_limit: 4,
+        ..StreamParams::default()
     }
 }
 

@@ -7,9 +7,9 @@ use indicatif::{ProgressBar, ProgressStyle};
 use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::Mesh;
-use splitstream_encoder::emit::{EncodeOptions, encode};
+use splitstream_encoder::emit::{EncodeOptions, SEED_VERTICES, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
-use splitstream_encoder::quantize::Units;
+use splitstream_encoder::quantize::{Quantization, Units};
 
 use super::{BackendArg, CliResult, Codec, PlaneArg, Position, QuantizationArg};
 
@@ -132,7 +132,8 @@ pub fn run(a: Args) -> CliResult {
         backend: a.backend.into(),
         plane: a.plane.policy(),
     };
-    if !a.geographic && looks_geographic(&mesh) {
+    let degrees_unconverted = !a.geographic && looks_geographic(&mesh);
+    if degrees_unconverted {
         eprintln!(
             "note: x and y look like longitude/latitude in degrees; pass --geographic to measure errors in metres"
         );
@@ -147,6 +148,20 @@ pub fn run(a: Args) -> CliResult {
     let encoded =
         encode(&mesh, &options, |done| bar.set_position(done as u64)).map_err(|e| e.to_string())?;
     bar.finish_and_clear();
+    if encoded.rounds == 0 && n > SEED_VERTICES {
+        // Seen on a DEM in degrees quantized with one step for degrees and
+        // metres: x and y fell on a handful of steps, every triangle was
+        // degenerate and no collapse passed its checks.
+        let hint = if degrees_unconverted && options.quantization == Quantization::Uniform {
+            "with --quantization uniform, x and y in degrees fall on a few steps of the height's \
+             scale and every triangle degenerates: pass --geographic, or use --quantization per-axis"
+        } else {
+            "the quantized mesh may be degenerate: try more --bits"
+        };
+        eprintln!(
+            "note: no collapse passed its checks, so the stream holds the whole mesh in level 0 ({hint})"
+        );
+    }
     std::fs::write(&a.output, &encoded.stream)
         .map_err(|e| format!("{}: {e}", a.output.display()))?;
     if let Some(path) = &a.permutation {

@@ -3,6 +3,7 @@
 //! split record is written exactly as that procedure asks for it.
 
 mod levels;
+mod policies;
 mod replay;
 
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};

@@ -5,7 +5,7 @@ use splitstream_decoder_core::corner_refs;
 use splitstream_decoder_core::limits::{LEAF, NONE, substream};
 use splitstream_decoder_core::symbols::split_valence_symbol;
 use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, coded_len, frame_level,
+    Chunk, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level_with,
 };
 use splitstream_decoder_core::{
     CornerRefs, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource, Ring,
@@ -13,9 +13,12 @@ use splitstream_decoder_core::{
     context, predict, residual,
 };
 
+use std::sync::mpsc;
+
 use rayon::prelude::*;
 
 use super::levels::LevelPlan;
+use super::policies::{SplitResiduals, choose_policy, code_policies};
 use crate::corner_table::Fan;
 use crate::quantize::QuantizedMesh;
 use crate::simplify::{Collapse, Simplification};
@@ -94,39 +97,6 @@ impl Memory {
     }
 }
 
-/// A level's residual substreams under one plane policy (SPEC §7.4): the
-/// encoder writes every policy's and keeps the cheapest.
-#[derive(Clone, Default)]
-struct PolicyResiduals {
-    edge: SubstreamWriter,
-    /// Optimal mode's second vector (the placement substream).
-    placement: SubstreamWriter,
-    /// Every coded value fits in 32 bits.
-    usable: bool,
-}
-
-fn policy_residuals() -> Vec<PolicyResiduals> {
-    vec![
-        PolicyResiduals {
-            usable: true,
-            ..PolicyResiduals::default()
-        };
-        PlanePolicy::ALL.len()
-    ]
-}
-
-/// Writes `coded` (a residual vector under `plane`) in the plane's order
-/// and contexts; `false` when a value does not fit in 32 bits.
-fn write_vector(w: &mut SubstreamWriter, plane: &Plane, coded: [i64; 3]) -> bool {
-    if coded.iter().any(|&x| i32::try_from(x).is_err()) {
-        return false;
-    }
-    for axis in plane.order() {
-        w.signed_in(plane.context(axis), coded[axis] as i32);
-    }
-    true
-}
-
 /// Feeds one round from the collapses of one simplification step.
 struct StepSource<'a> {
     collapses: &'a [Collapse],
@@ -137,8 +107,9 @@ struct StepSource<'a> {
     enc2dec: &'a mut [u32],
     dec2enc: &'a mut Vec<u32>,
     subs: &'a mut [SubstreamWriter],
-    /// The residual substreams of every plane policy, in `PlanePolicy::ALL` order.
-    residuals: &'a mut [PolicyResiduals],
+    /// The round's residual vectors, coded under every plane policy on
+    /// another thread (`policies`).
+    residuals: &'a mut Vec<SplitResiduals>,
     mode: PositionMode,
     pending: Option<usize>,
     /// Whether the pending split gives the collapse's C index R (SPEC §7.4).
@@ -250,22 +221,18 @@ impl RecordSource for StepSource<'_> {
         let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] + b[i]) };
         let (origin, p_wide, c_wide) = (wide(parent), wide(p), wide(c));
         let mode = self.mode;
-        let mut consistent = true;
-        match mode {
+        let consistent;
+        let (first, second) = match mode {
             PositionMode::Optimal => {
                 let p_hat = predict(&means, mode, Target::P);
                 let c_hat = predict(&means, mode, Target::C);
                 let rs = residual(sub(p_wide, origin), p_hat);
                 let rt = residual(sub(c_wide, origin), c_hat);
-                for (policy, out) in PlanePolicy::ALL.iter().zip(self.residuals.iter_mut()) {
-                    let plane = Plane::new(*policy, &means);
-                    let (cs, ct) = (plane.encode(rs), plane.encode(rt));
-                    // What the decoder will compute from the coded values.
-                    consistent &= add(origin, add_residual(p_hat, plane.decode(cs))) == p_wide
-                        && add(origin, add_residual(c_hat, plane.decode(ct))) == c_wide;
-                    out.usable &= write_vector(&mut out.edge, &plane, cs);
-                    out.usable &= write_vector(&mut out.placement, &plane, ct);
-                }
+                // What the decoder will compute from the residuals (each
+                // plane policy's coding is checked to give them back).
+                consistent = add(origin, add_residual(p_hat, rs)) == p_wide
+                    && add(origin, add_residual(c_hat, rt)) == c_wide;
+                (rs, rt)
             }
             PositionMode::Constrained => {
                 let e = sub(c_wide, p_wide);
@@ -285,15 +252,17 @@ impl RecordSource for StepSource<'_> {
                 let target = Target::of_code(code).expect("codes 0..=2");
                 let prediction = predict(&means, mode, target);
                 let r = residual(x, prediction);
-                for (policy, out) in PlanePolicy::ALL.iter().zip(self.residuals.iter_mut()) {
-                    let plane = Plane::new(*policy, &means);
-                    let coded = plane.encode(r);
-                    let decoded = add_residual(prediction, plane.decode(coded));
-                    consistent &= constrained_positions(parent, code, decoded) == (p_wide, c_wide);
-                    out.usable &= write_vector(&mut out.edge, &plane, coded);
-                }
+                consistent = constrained_positions(parent, code, add_residual(prediction, r))
+                    == (p_wide, c_wide);
+                (r, [0; 3])
             }
-        }
+        };
+        self.residuals.push(SplitResiduals {
+            normal: Plane::new(PlanePolicy::Dominant, &means).normal,
+            first,
+            second,
+            id,
+        });
         if !consistent {
             return Err(self.fail(format!(
                 "the residuals of {id} do not decode to its positions"
@@ -394,15 +363,20 @@ pub fn replay(
     let mut current = vec![NONE; n];
     let mut flagged = Vec::new();
     let mut ring = Ring::default();
-    // Choosing a level's plane policy codes its residuals five ways, and
-    // framing entropy-codes it; both run on another thread while the next
-    // level replays (same bytes: the replay itself is sequential).
+    // A level's residuals are coded under the five plane policies on one
+    // thread while the level replays; choosing the policy and framing the
+    // level run on another while the next level replays (same bytes: the
+    // replay itself is sequential).
     let seed_ref = &seed;
     let done = std::thread::scope(|scope| -> Result<Vec<FramedLevel>, ReplayError> {
         let mut choosing = Vec::with_capacity(plan.rounds.len());
         for (l, steps) in plan.rounds.iter().enumerate() {
             let mut subs = vec![SubstreamWriter::default(); 7];
-            let mut residuals = policy_residuals();
+            // The level's residuals go round by round to a thread that
+            // codes them under every plane policy.
+            let (batches, coded_batches) = mpsc::channel();
+            let coder = scope.spawn(move || code_policies(coded_batches, mode, plane));
+            let mut residuals = Vec::new();
             let mut round_splits = Vec::with_capacity(steps.len());
             for &k in steps {
                 let collapses = &s.steps[k];
@@ -433,12 +407,21 @@ pub fn replay(
                     current[r as usize] = NONE;
                 }
                 round_splits.push(collapses.len() as u32);
+                // A closed channel means the coder failed: its error is
+                // reported when it is joined.
+                let _ = batches.send(std::mem::take(&mut residuals));
             }
             let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
             let geometric_error = plan.errors[l];
+            drop(batches);
             choosing.push(scope.spawn(move || {
+                let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
+                let residuals = coder
+                    .join()
+                    .expect("coding residuals does not panic")
+                    .map_err(level_error)?;
                 let plane = choose_policy(&mut subs, residuals, params, plane)
-                    .map_err(|why| ReplayError(format!("level {l}: {why}")))?;
+                    .map_err(|why| level_error(why.to_string()))?;
                 let level = LevelPayload {
                     round_splits,
                     plane,
@@ -447,7 +430,12 @@ pub fn replay(
                     triangle_count,
                     geometric_error,
                 };
-                let framed = frame_level(&level, (l == 0).then_some(seed_ref), params);
+                // The level's chunks are coded in parallel (same bytes).
+                let parallel = |n: usize, job: &(dyn Fn(usize) -> Chunk + Sync)| {
+                    (0..n).into_par_iter().map(job).collect()
+                };
+                let framed =
+                    frame_level_with(&level, (l == 0).then_some(seed_ref), params, &parallel);
                 Ok((level, framed))
             }));
         }
@@ -466,63 +454,6 @@ pub fn replay(
         permutation: dec2enc,
         final_hash,
     })
-}
-
-/// Puts the cheapest usable policy's residual substreams (or those of
-/// `forced`) into `subs` (ids 6 and 7; in constrained mode id 7 holds the
-/// placement codes, which do not depend on the policy) and returns that
-/// policy. Ties go to the earlier policy of `PlanePolicy::ALL` (`off` first).
-fn choose_policy(
-    subs: &mut [SubstreamWriter],
-    residuals: Vec<PolicyResiduals>,
-    params: &StreamParams,
-    forced: Option<PlanePolicy>,
-) -> Result<PlanePolicy, String> {
-    use rayon::prelude::*;
-    let optimal = params.position_mode == PositionMode::Optimal;
-    // Under the rANS codec the policies are ranked by their rANS cost alone:
-    // framing may still deflate the chosen residuals where that is smaller,
-    // but deflating all five (at level 10) took a third of the replay on the
-    // 1M terrain and never changed the ranking on the real meshes.
-    let ranking = match params.codec {
-        ChunkCodec::Rans { lanes } => StreamParams {
-            codec: ChunkCodec::RansAlways { lanes },
-            ..*params
-        },
-        _ => *params,
-    };
-    let params = &ranking;
-    let costs: Vec<Option<usize>> = residuals
-        .par_iter()
-        .zip(PlanePolicy::ALL)
-        .map(|(r, policy)| {
-            if forced.is_some_and(|f| f != policy) {
-                return None;
-            }
-            r.usable.then(|| {
-                if forced.is_some() {
-                    return 0;
-                }
-                let edge = coded_len(&r.edge, substream::EDGE, params);
-                let placement = if optimal {
-                    coded_len(&r.placement, substream::PLACEMENT, params)
-                } else {
-                    0
-                };
-                edge + placement
-            })
-        })
-        .collect();
-    let best = (0..costs.len())
-        .filter(|&i| costs[i].is_some())
-        .min_by_key(|&i| (costs[i], i))
-        .ok_or("a position residual does not fit in 32 bits under any plane policy")?;
-    let chosen = residuals.into_iter().nth(best).expect("index of a policy");
-    subs[slot(substream::EDGE)] = chosen.edge;
-    if optimal {
-        subs[slot(substream::PLACEMENT)] = chosen.placement;
-    }
-    Ok(PlanePolicy::ALL[best])
 }
 
 /// decode(encode(M)) == M: the refined state, mapped back to input ids, has

@@ -1,0 +1,219 @@
+//! A level's position residuals under every plane policy (SPEC §7.4), and
+//! the choice of the cheapest.
+//!
+//! The replay records each split's residual vectors once, with the split's
+//! plane normal; coding them under the five policies runs on another thread,
+//! batch by batch while the replay goes on, so that it stays off the
+//! replay's critical path. The values written are the same as if each split
+//! had been coded five ways on the spot.
+
+use std::sync::mpsc::Receiver;
+
+use splitstream_decoder_core::limits::substream;
+use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, SubstreamWriter, coded_len};
+use splitstream_decoder_core::{Plane, PlanePolicy, PositionMode};
+
+use rayon::prelude::*;
+
+/// One split's residual vectors before a plane policy is applied, as the
+/// replay computes them (`predict::residual`: 32-bit values).
+#[derive(Clone, Copy, Debug)]
+pub struct SplitResiduals {
+    /// The split's shifted plane normal (`Plane::new(Dominant, …).normal`).
+    pub normal: [i64; 3],
+    /// The edge substream's vector.
+    pub first: [i64; 3],
+    /// Optimal mode's second vector (the placement substream); unused in
+    /// constrained mode.
+    pub second: [i64; 3],
+    /// The collapse's vertex, for error messages.
+    pub id: u32,
+}
+
+/// A level's residual substreams under one plane policy.
+#[derive(Clone, Default)]
+pub struct PolicyResiduals {
+    pub edge: SubstreamWriter,
+    /// Optimal mode's second vector (the placement substream).
+    pub placement: SubstreamWriter,
+    /// Every coded value fits in 32 bits.
+    pub usable: bool,
+}
+
+/// Codes the batches arriving on `batches` (a level's splits in split
+/// order) under every policy, or only `forced`; returns the substreams in
+/// `PlanePolicy::ALL` order (unused policies stay empty and unusable).
+pub fn code_policies(
+    batches: Receiver<Vec<SplitResiduals>>,
+    mode: PositionMode,
+    forced: Option<PlanePolicy>,
+) -> Result<Vec<PolicyResiduals>, String> {
+    let mut out: Vec<PolicyResiduals> = PlanePolicy::ALL
+        .iter()
+        .map(|&p| PolicyResiduals {
+            usable: forced.is_none_or(|f| f == p),
+            ..PolicyResiduals::default()
+        })
+        .collect();
+    let optimal = mode == PositionMode::Optimal;
+    for batch in batches {
+        for (policy, residuals) in PlanePolicy::ALL.iter().zip(out.iter_mut()) {
+            if forced.is_some_and(|f| f != *policy) {
+                continue;
+            }
+            for split in &batch {
+                let plane = Plane::with_normal(*policy, split.normal);
+                residuals.usable &= write_vector(&mut residuals.edge, &plane, split.first, split)?;
+                if optimal {
+                    residuals.usable &=
+                        write_vector(&mut residuals.placement, &plane, split.second, split)?;
+                }
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Writes residual vector `r` under `plane`, in the plane's order and
+/// contexts; `Ok(false)` when a coded value does not fit in 32 bits.
+fn write_vector(
+    w: &mut SubstreamWriter,
+    plane: &Plane,
+    r: [i64; 3],
+    split: &SplitResiduals,
+) -> Result<bool, String> {
+    let coded = plane.encode(r);
+    // What the decoder will compute from the coded values.
+    if plane.decode(coded) != r {
+        return Err(format!(
+            "the residuals of {} do not decode to its positions",
+            split.id
+        ));
+    }
+    if coded.iter().any(|&x| i32::try_from(x).is_err()) {
+        return Ok(false);
+    }
+    for axis in plane.order() {
+        w.signed_in(plane.context(axis), coded[axis] as i32);
+    }
+    Ok(true)
+}
+
+/// Puts the cheapest usable policy's residual substreams (or those of
+/// `forced`) into `subs` (a level's substreams from id 1: ids 6 and 7; in
+/// constrained mode id 7 holds the placement codes, which do not depend on
+/// the policy, and is left alone) and returns that policy. Ties go to the
+/// earlier policy of `PlanePolicy::ALL` (`off` first).
+pub fn choose_policy(
+    subs: &mut [SubstreamWriter],
+    residuals: Vec<PolicyResiduals>,
+    params: &StreamParams,
+    forced: Option<PlanePolicy>,
+) -> Result<PlanePolicy, String> {
+    let optimal = params.position_mode == PositionMode::Optimal;
+    // Under the rANS codec the policies are ranked by their rANS cost alone:
+    // framing may still deflate the chosen residuals where that is smaller,
+    // but deflating all five (at level 10) took a third of the replay on the
+    // 1M terrain and never changed the ranking on the real meshes.
+    let ranking = match params.codec {
+        ChunkCodec::Rans { lanes } => StreamParams {
+            codec: ChunkCodec::RansAlways { lanes },
+            ..*params
+        },
+        _ => *params,
+    };
+    let params = &ranking;
+    let costs: Vec<Option<usize>> = residuals
+        .par_iter()
+        .zip(PlanePolicy::ALL)
+        .map(|(r, policy)| {
+            if forced.is_some_and(|f| f != policy) {
+                return None;
+            }
+            r.usable.then(|| {
+                if forced.is_some() {
+                    return 0;
+                }
+                let edge = coded_len(&r.edge, substream::EDGE, params);
+                let placement = if optimal {
+                    coded_len(&r.placement, substream::PLACEMENT, params)
+                } else {
+                    0
+                };
+                edge + placement
+            })
+        })
+        .collect();
+    let best = (0..costs.len())
+        .filter(|&i| costs[i].is_some())
+        .min_by_key(|&i| (costs[i], i))
+        .ok_or("a position residual does not fit in 32 bits under any plane policy")?;
+    let chosen = residuals.into_iter().nth(best).expect("index of a policy");
+    subs[(substream::EDGE - substream::FLAGS) as usize] = chosen.edge;
+    if optimal {
+        subs[(substream::PLACEMENT - substream::FLAGS) as usize] = chosen.placement;
+    }
+    Ok(PlanePolicy::ALL[best])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::mpsc;
+
+    fn batches(splits: &[SplitResiduals]) -> Receiver<Vec<SplitResiduals>> {
+        let (tx, rx) = mpsc::channel();
+        // Two batches: the coder must run on across them.
+        let (a, b) = splits.split_at(splits.len() / 2);
+        tx.send(a.to_vec()).unwrap();
+        tx.send(b.to_vec()).unwrap();
+        rx
+    }
+
+    fn splits() -> Vec<SplitResiduals> {
+        (0..40)
+            .map(|i| SplitResiduals {
+                normal: [i % 5 - 2, 7, -(i % 3)],
+                first: [i, -2 * i, 3],
+                second: [1 - i, i % 4, -i],
+                id: i as u32,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn every_policy_codes_what_coding_each_split_on_the_spot_gives() {
+        let splits = splits();
+        let coded = code_policies(batches(&splits), PositionMode::Optimal, None).unwrap();
+        for (policy, residuals) in PlanePolicy::ALL.iter().zip(&coded) {
+            assert!(residuals.usable);
+            let (mut edge, mut placement) =
+                (SubstreamWriter::default(), SubstreamWriter::default());
+            for s in &splits {
+                let plane = Plane::with_normal(*policy, s.normal);
+                for (w, r) in [(&mut edge, s.first), (&mut placement, s.second)] {
+                    let c = plane.encode(r);
+                    for axis in plane.order() {
+                        w.signed_in(plane.context(axis), c[axis] as i32);
+                    }
+                }
+            }
+            assert_eq!(residuals.edge.as_bytes(), edge.as_bytes(), "{policy:?}");
+            assert_eq!(residuals.edge.symbols(), edge.symbols(), "{policy:?}");
+            assert_eq!(residuals.placement.as_bytes(), placement.as_bytes());
+        }
+    }
+
+    #[test]
+    fn a_forced_policy_is_the_only_one_coded() {
+        let forced = PlanePolicy::ALL[2];
+        let coded =
+            code_policies(batches(&splits()), PositionMode::Constrained, Some(forced)).unwrap();
+        for (policy, residuals) in PlanePolicy::ALL.iter().zip(&coded) {
+            assert_eq!(residuals.usable, *policy == forced);
+            assert_eq!(residuals.edge.as_bytes().is_empty(), *policy != forced);
+            // Constrained mode: the placement substream holds codes, not residuals.
+            assert!(residuals.placement.as_bytes().is_empty());
+        }
+    }
+}
