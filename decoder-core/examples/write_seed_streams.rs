@@ -16,50 +16,23 @@ mod streams;
 
 use std::path::PathBuf;
 
+use splitstream_decoder_core::handmade::{Rec, level, params, tetra_split};
 use splitstream_decoder_core::limits::LEAF;
-use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
-};
-use splitstream_decoder_core::{PlanePolicy, PositionMode, context};
+use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, write_stream};
 use streams::{BaseMesh, Choices};
 
-fn params(codec: ChunkCodec) -> StreamParams {
-    StreamParams {
-        position_mode: PositionMode::Optimal,
-        bits: 8,
-        origin: [0.0; 3],
-        scale: [1.0; 3],
-        codec,
-        chunk_limit: 4,
-    }
-}
-
-/// One optimal-mode split record level (as in tests/handmade.rs): wing
-/// ranks `o`, `d` among 3 eligible ring entries, P and C leaves, residuals
-/// `e` and `m` under the plane policy `off`.
+/// A level of one split record of [`tetra_split`]'s shape (wing ranks `o`,
+/// `d` among 3 eligible ring entries, P and C leaves, C of valence 4) with
+/// residuals `e` and `m` under the plane policy `off`.
 fn one_split(o: u8, d: u8, e: [i32; 3], m: [i32; 3], v: u32, t: u32) -> LevelPayload {
-    // Rings of 3 leaves here, C of valence 4: the rANS contexts follow
-    // (SPEC §5.5.5).
-    let mut s = vec![SubstreamWriter::default(); 7];
-    s[0].bit(true);
-    s[1].byte_in(context::wing(3), o);
-    s[2].byte_in(context::wing(3), d);
-    s[3].byte(0);
-    s[4].byte_in(context::deficit_c(LEAF, 4), 0);
-    for (k, &x) in e.iter().enumerate() {
-        s[5].signed_in(k as u8, x);
-    }
-    for (k, &x) in m.iter().enumerate() {
-        s[6].signed_in(k as u8, x);
-    }
-    LevelPayload {
-        round_splits: vec![1],
-        plane: PlanePolicy::Off,
-        substreams: s,
-        vertex_count: v,
-        triangle_count: t,
-        geometric_error: 0.0,
-    }
+    let rec = Rec {
+        o,
+        d,
+        e,
+        t: m,
+        ..tetra_split()
+    };
+    level(&[true], vec![1], &[rec], v, t)
 }
 
 /// The hand-made streams: tetrahedron with one split (stored and deflate),

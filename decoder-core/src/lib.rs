@@ -28,6 +28,8 @@ pub mod context;
 pub mod corner_refs;
 mod decoder;
 mod error;
+#[cfg(feature = "alloc")]
+pub mod handmade;
 mod hash;
 mod header;
 mod inflate;

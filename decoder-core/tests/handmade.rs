@@ -1,81 +1,17 @@
 //! Hand-made streams (SPEC §6, §7): a tetrahedron with one split, a
 //! triangle with a boundary split, and the errors SPEC §10 requires.
 
+use splitstream_decoder_core::Error;
+use splitstream_decoder_core::handmade::{
+    Rec, bowtie, level, octahedron, params, tetrahedron, tetrahedron_with, triangle,
+};
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::decode_all;
-use splitstream_decoder_core::writer::{
-    ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
-};
-use splitstream_decoder_core::{Error, PlanePolicy, PositionMode, context};
+use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, write_stream};
 
-fn params(codec: ChunkCodec) -> StreamParams {
-    StreamParams {
-        position_mode: PositionMode::Optimal,
-        bits: 8,
-        origin: [0.0; 3],
-        scale: [1.0; 3],
-        codec,
-        chunk_limit: 4,
-    }
-}
-
-fn base(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
-    SeedPayload::new(positions, triangles, deficits).into_level(1.0)
-}
-
-/// One optimal-mode split record as coded (SPEC §7.4), under the plane
-/// policy `off`: the wing ranks `o`, `d` among the `m` ring entries that may
-/// be wings, the split-valence symbols of P and C (0: leaf), and the
-/// residuals of P and C. `valence_c` (C's valence after the split) only
-/// selects a rANS context (SPEC §5.5.5).
-struct Rec {
-    m: usize,
-    o: u8,
-    d: u8,
-    sp: u8,
-    sc: u8,
-    valence_c: usize,
-    e: [i32; 3],
-    t: [i32; 3],
-}
-
-fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> LevelPayload {
-    let mut s = vec![SubstreamWriter::default(); 7];
-    for &f in flags {
-        s[0].bit(f);
-    }
-    for r in recs {
-        s[1].byte_in(context::wing(r.m), r.o);
-        s[2].byte_in(context::wing(r.m), r.d);
-        s[3].byte(r.sp);
-        let deficit_p = if r.sp == 0 { LEAF } else { 0 };
-        s[4].byte_in(context::deficit_c(deficit_p, r.valence_c), r.sc);
-        for k in 0..3 {
-            s[5].signed_in(k as u8, r.e[k]);
-        }
-        for k in 0..3 {
-            s[6].signed_in(k as u8, r.t[k]);
-        }
-    }
-    LevelPayload {
-        round_splits: rounds,
-        plane: PlanePolicy::Off,
-        substreams: s,
-        vertex_count: v,
-        triangle_count: t,
-        geometric_error: 0.0,
-    }
-}
-
-fn tetrahedron() -> LevelPayload {
-    base(
-        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
-        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        &[0, LEAF, LEAF, LEAF],
-    )
-}
-
-/// Splits vertex 0 (ring 1, 3, 2) with wings 1 and 3, P keeping wedge (0,1,3).
+/// [`splitstream_decoder_core::handmade::tetra_split`] with residuals
+/// worked out by hand: vertex 0 (ring 1, 3, 2) splits with wings 1 and 3, P
+/// keeping wedge (0,1,3).
 fn tetra_split() -> Rec {
     // Predictions (SPEC §7.4), relative to R = (0, 0, 0): wing mean
     // m_W = (5, 0, 5), arc 1 has no interior entry (m_I1 = 0), arc 2 holds
@@ -83,14 +19,9 @@ fn tetra_split() -> Rec {
     // (0, -1, 0), so P = (0, 0, 0) takes e = (0, 1, 0); Ĉ = (m_W + 4 m_I2 -
     // m_I1) >> 4 = (0, 2, 0), so C = (2, 2, 2) takes t = (2, 0, 2).
     Rec {
-        m: 3,
-        o: 0,
-        d: 1,
-        sp: 0,
-        sc: 0,
-        valence_c: 4,
         e: [0, 1, 0],
         t: [2, 0, 2],
+        ..splitstream_decoder_core::handmade::tetra_split()
     }
 }
 
@@ -147,11 +78,7 @@ fn tetrahedron_one_split() {
 #[test]
 fn boundary_split_with_a_ghost_wing() {
     // One triangle; vertex 0's ring is (ghost, 1, 2). Wings: ghost and 1.
-    let b = base(
-        &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
-        &[[0, 1, 2]],
-        &[0, LEAF, LEAF],
-    );
+    let b = triangle(&[0, LEAF, LEAF]);
     let rec = Rec {
         // m_W = (10, 0, 0) (the ghost is no real wing), m_I1 = 0, m_I2 =
         // (0, 10, 0): P̂ = (0, -1, 0), Ĉ = (0, 2, 0); P = (0, 0, 0), C = (0, 4, 0).
@@ -192,11 +119,7 @@ fn a_round_start_candidate_is_no_wing() {
     // Vertices 0 and 1 are adjacent candidates: 1's flag is inferred once 0
     // is flagged, and 1 may not be a wing (SPEC §7.4). Vertex 0's ring
     // (1, 3, 2) has m = 2 entries that may be wings: ranks 0 and 2 name none.
-    let b = base(
-        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
-        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        &[0, 0, LEAF, LEAF],
-    );
+    let b = tetrahedron_with(&[0, 0, LEAF, LEAF]);
     let rec = Rec {
         m: 2,
         d: 2,
@@ -267,11 +190,7 @@ fn flag_of_a_neighbour_of_a_flagged_vertex_is_inferred() {
     // Vertices 0 and 1 are adjacent candidates. Once 0 is flagged, 1's flag
     // is not read (SPEC §7.2): a second flag bit is left over as padding
     // that is not zero, and the round has one split where two are declared.
-    let b = base(
-        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
-        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        &[0, 0, LEAF, LEAF],
-    );
+    let b = tetrahedron_with(&[0, 0, LEAF, LEAF]);
     let err = decode_err(&[
         b,
         level(
@@ -289,11 +208,7 @@ fn flag_of_a_neighbour_of_a_flagged_vertex_is_inferred() {
 fn inferred_flag_leaves_the_neighbour_a_candidate() {
     // Vertices 0 and 2 are adjacent candidates; 0 splits (wings 1 and 3) and
     // 2's flag is inferred 0, so one flag bit codes the whole round.
-    let b = base(
-        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
-        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-        &[0, LEAF, 0, LEAF],
-    );
+    let b = tetrahedron_with(&[0, LEAF, 0, LEAF]);
     // Vertex 2 was a candidate at round start: it may not be a wing, so
     // m = 2 (it still counts in the arc means).
     let rec = || Rec {
@@ -309,31 +224,6 @@ fn inferred_flag_leaves_the_neighbour_a_candidate() {
         assert_eq!(mesh.positions.len(), 5);
         assert_eq!(mesh.positions[4], [2, 2, 2]);
     }
-}
-
-/// The octahedron: 0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z.
-fn octahedron(deficits: &[u8]) -> LevelPayload {
-    base(
-        &[
-            [20, 10, 10],
-            [0, 10, 10],
-            [10, 20, 10],
-            [10, 0, 10],
-            [10, 10, 20],
-            [10, 10, 0],
-        ],
-        &[
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
-        ],
-        deficits,
-    )
 }
 
 #[test]
@@ -388,28 +278,7 @@ fn corrupt_bytes_are_caught_by_checksums() {
 #[test]
 fn non_manifold_base_is_rejected() {
     // Two tetrahedra sharing vertex 0 only: a bowtie vertex.
-    let b = base(
-        &[
-            [0, 0, 0],
-            [1, 0, 0],
-            [0, 1, 0],
-            [0, 0, 1],
-            [9, 0, 0],
-            [0, 9, 0],
-            [0, 0, 9],
-        ],
-        &[
-            [0, 2, 1],
-            [0, 1, 3],
-            [0, 3, 2],
-            [1, 2, 3],
-            [0, 5, 4],
-            [0, 4, 6],
-            [0, 6, 5],
-            [4, 5, 6],
-        ],
-        &[LEAF; 7],
-    );
+    let b = bowtie();
     let stream = write_stream(&params(ChunkCodec::Stored), &[b]);
     assert_eq!(
         decode_all(&stream, false).unwrap_err().class(),

@@ -387,16 +387,7 @@ fn grid(n: u32) -> Vec<[u32; 3]> {
 }
 
 fn octahedron() -> Vec<[u32; 3]> {
-    vec![
-        [0, 2, 4],
-        [2, 1, 4],
-        [1, 3, 4],
-        [3, 0, 4],
-        [2, 0, 5],
-        [1, 2, 5],
-        [3, 1, 5],
-        [0, 3, 5],
-    ]
+    splitstream_decoder_core::handmade::OCTA_TRIANGLES.to_vec()
 }
 
 fn run_random(base: Vec<[u32; 3]>, seed: u64) -> usize {

@@ -2,14 +2,14 @@
 //! manifest entry come from here, deterministically (same bytes on every
 //! run and machine). Run it with `conformance/generate.sh`.
 
-mod handmade;
 mod meshes;
 mod mutate;
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
-use splitstream_decoder_core::limits::codec;
+use splitstream_decoder_core::handmade;
+use splitstream_decoder_core::limits::{LEAF, codec};
 use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
 use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
 use splitstream_decoder_core::{
@@ -1090,7 +1090,7 @@ fn invalid_vectors(s: &mut Specs) {
                 m: 2,
                 ..tetra_split()
             };
-            build(handmade::solve(rec, 0, 4, [0, 0, 0], [4, 0, 2], &build))
+            build(handmade::solve(rec, 0, 4, [0, 0, 0], [4, 0, 2], &build).expect("the record decodes"))
         },
     );
     s.invalid(
@@ -1135,11 +1135,7 @@ fn invalid_vectors(s: &mut Specs) {
         "valence-overflow",
         "Base tetrahedron vertex of valence 3 with deficit 253 (split valence 256 > 255).",
         &["handmade", "valence", "base-only"],
-        hand(&[base(
-            &handmade::TETRA_POSITIONS,
-            &handmade::TETRA_TRIANGLES,
-            &[253, 255, 255, 255],
-        )]),
+        hand(&[handmade::tetrahedron_with(&[253, LEAF, LEAF, LEAF])]),
     );
     s.invalid(
         "valence-overflow-split",
@@ -1182,7 +1178,7 @@ fn invalid_vectors(s: &mut Specs) {
                 sp: 253,
                 ..tetra_split()
             };
-            build(handmade::solve(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build))
+            build(handmade::solve(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build).expect("the record decodes"))
         },
     );
     s.invalid(
@@ -1190,28 +1186,7 @@ fn invalid_vectors(s: &mut Specs) {
         "non-manifold",
         "Base mesh of two tetrahedra sharing one vertex (two fans at a vertex).",
         &["handmade", "base-only", "manifold"],
-        hand(&[base(
-            &[
-                [0, 0, 0],
-                [1, 0, 0],
-                [0, 1, 0],
-                [0, 0, 1],
-                [9, 0, 0],
-                [0, 9, 0],
-                [0, 0, 9],
-            ],
-            &[
-                [0, 2, 1],
-                [0, 1, 3],
-                [0, 3, 2],
-                [1, 2, 3],
-                [0, 5, 4],
-                [0, 4, 6],
-                [0, 6, 5],
-                [4, 5, 6],
-            ],
-            &[255; 7],
-        )]),
+        hand(&[handmade::bowtie()]),
     );
     s.invalid(
         "non-manifold-flipped-face",
@@ -1242,17 +1217,12 @@ fn invalid_vectors(s: &mut Specs) {
         &["handmade", "positions"],
         {
             let build = |rec: Rec| hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)]);
-            let rec = handmade::solve(tetra_split(), 0, 4, [0, 0, 0], [300, 2, 2], &build);
+            let rec = handmade::solve(tetra_split(), 0, 4, [0, 0, 0], [300, 2, 2], &build)
+                .expect("the record decodes");
             build(rec)
         },
     );
-    let triangle = || {
-        base(
-            &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
-            &[[0, 1, 2]],
-            &[255; 3],
-        )
-    };
+    let triangle = || handmade::triangle(&[LEAF; 3]);
     for (name, bytes, what) in [
         (
             "varint-not-minimal",

@@ -20,6 +20,7 @@
 
 #![allow(dead_code)]
 
+use splitstream_decoder_core::handmade;
 use splitstream_decoder_core::limits::{LEAF, NONE};
 use splitstream_decoder_core::symbols::{deficit_of, split_valence_symbol};
 use splitstream_decoder_core::writer::{
@@ -74,29 +75,24 @@ pub struct BaseMesh {
 pub fn tetrahedron() -> BaseMesh {
     BaseMesh {
         name: "tetrahedron",
-        positions: vec![[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
-        triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        positions: handmade::TETRA_POSITIONS.to_vec(),
+        triangles: handmade::TETRA_TRIANGLES.to_vec(),
     }
 }
 
 pub fn triangle() -> BaseMesh {
     BaseMesh {
         name: "triangle",
-        positions: vec![[0, 0, 0], [10, 0, 0], [0, 10, 0]],
+        positions: handmade::TRIANGLE_POSITIONS.to_vec(),
         triangles: vec![[0, 1, 2]],
     }
 }
 
 pub fn octahedron() -> BaseMesh {
-    // 0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z.
-    let positions = vec![
-        [20, 10, 10],
-        [0, 10, 10],
-        [10, 20, 10],
-        [10, 0, 10],
-        [10, 10, 20],
-        [10, 10, 0],
-    ];
+    // 0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z; the triangles in
+    // octant order (not handmade::OCTA_TRIANGLES' order, which would change
+    // the seed streams).
+    let positions = handmade::OCTA_POSITIONS.to_vec();
     let mut triangles = Vec::new();
     for sx in [1i32, -1] {
         for sy in [1i32, -1] {

@@ -1,13 +1,25 @@
-//! Streams built record by record with decoder-core's `writer`, as in
-//! decoder-core/tests/handmade.rs and SPEC Appendix A: the smallest legal
-//! streams, and faults that no encoder would write.
+//! Streams built record by record with [`crate::writer`] (SPEC Appendix A):
+//! the smallest legal streams, and faults that no encoder would write. The
+//! conformance generator, this crate's tests and the fuzz seed corpus build
+//! their hand-made streams here, so a record means the same bytes in all
+//! three; another implementation's test suite can use it the same way.
+//! Needs the `alloc` feature.
+//!
+//! Every stream here has 8 bits per axis, unit scale, optimal position mode
+//! and 4-byte chunks ([`params`]), so that every substream spans chunks.
 
-use splitstream_decoder_core::limits::LEAF;
-use splitstream_decoder_core::owned::decode_all;
-use splitstream_decoder_core::writer::{
+use alloc::vec;
+use alloc::vec::Vec;
+
+use crate::Error;
+use crate::context;
+use crate::header::PositionMode;
+use crate::limits::LEAF;
+use crate::owned::decode_all;
+use crate::predict::PlanePolicy;
+use crate::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{PlanePolicy, PositionMode, context};
 
 /// 8 bits per axis, unit scale, 4-byte chunks: every substream spans chunks.
 pub fn params(codec: ChunkCodec) -> StreamParams {
@@ -21,8 +33,18 @@ pub fn params(codec: ChunkCodec) -> StreamParams {
     }
 }
 
-/// A base level holding only a seed mesh (ids 8..=10); `write_stream`
-/// frames it as level 0.
+/// [`params`] with stored chunks.
+pub fn stored() -> StreamParams {
+    params(ChunkCodec::Stored)
+}
+
+/// [`params`] with deflate chunks (level 6).
+pub fn deflated() -> StreamParams {
+    params(ChunkCodec::Deflate(6))
+}
+
+/// A base level holding only a seed mesh (substream ids 8..=10);
+/// [`write_stream`] frames it as level 0.
 pub fn base(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> LevelPayload {
     SeedPayload::new(positions, triangles, deficits).into_level(1.0)
 }
@@ -44,9 +66,8 @@ pub fn with_raw_substream(mut level: LevelPayload, index: usize, bytes: &[u8]) -
 /// placement substream (C's). `valence_c` (C's valence right after the
 /// split) and `axis` (the plane's predicted axis, `None` under the policy
 /// `off`) only select the order and rANS contexts of the values (SPEC
-/// §5.5.5). Records built here start with zero residuals; [`solve`] sets
-/// them for wanted positions of P and C.
-#[derive(Clone, Copy)]
+/// §5.5.5). [`solve`] sets the residuals for wanted positions of P and C.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Rec {
     pub m: u8,
     pub o: u8,
@@ -64,7 +85,12 @@ pub struct Rec {
 /// decoded with trial residuals and corrected by what each axis missed,
 /// until both land (at most four probes: under a plane policy the predicted
 /// axis also moves with the other two, SPEC §7.4), whatever the
-/// prediction, as long as the residuals are added to it.
+/// prediction, as long as the residuals are added to it. A wanted position
+/// outside the grid keeps the last correction.
+///
+/// # Errors
+/// The error of the first probe when it does not decode: the record is
+/// wrong in more than its residuals.
 pub fn solve(
     rec: Rec,
     r: usize,
@@ -72,7 +98,7 @@ pub fn solve(
     p: [i32; 3],
     cpos: [i32; 3],
     build: &dyn Fn(Rec) -> Vec<u8>,
-) -> Rec {
+) -> Result<Rec, Error> {
     // The first probe is biased so that P and C stay inside the 8-bit grid
     // whatever the predictions are.
     const BIAS: i32 = 64;
@@ -84,25 +110,23 @@ pub fn solve(
     for probe_index in 0..4 {
         let probe = match decode_all(&build(trial), false) {
             Ok(probe) => probe,
-            // A wanted position outside the grid: the correction stands.
-            Err(_) if probe_index > 0 => return trial,
-            Err(e) => panic!("the first probe does not decode: {e}"),
+            Err(_) if probe_index > 0 => return Ok(trial),
+            Err(e) => return Err(e),
         };
         let (gp, gc) = (probe.positions[r], probe.positions[c]);
         if (gp, gc) == (p.map(|x| x as u32), cpos.map(|x| x as u32)) {
-            return trial;
+            return Ok(trial);
         }
         for k in 0..3 {
             trial.e[k] += p[k] - gp[k] as i32;
             trial.t[k] += cpos[k] - gc[k] as i32;
         }
     }
-    // A wanted position outside the grid: the last correction stands.
-    trial
+    Ok(trial)
 }
 
-/// A refinement level (ids 1..=7) in optimal mode under `plane`, values in
-/// the order and contexts SPEC §5.5 and §7.4 give them.
+/// A refinement level (substream ids 1..=7) in optimal mode under `plane`,
+/// values in the order and contexts SPEC §5.5 and §7.4 give them.
 pub fn level_with(
     plane: PlanePolicy,
     flags: &[bool],
@@ -148,6 +172,7 @@ pub fn level(flags: &[bool], rounds: Vec<u32>, recs: &[Rec], v: u32, t: u32) -> 
     level_with(PlanePolicy::Off, flags, rounds, recs, v, t)
 }
 
+/// The tetrahedron of SPEC Appendix A.
 pub const TETRA_POSITIONS: [[u32; 3]; 4] = [[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]];
 pub const TETRA_TRIANGLES: [[u32; 3]; 4] = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
 
@@ -166,8 +191,13 @@ pub fn tetrahedron_two_candidates() -> LevelPayload {
     base(&TETRA_POSITIONS, &TETRA_TRIANGLES, &[0, 0, LEAF, LEAF])
 }
 
+/// A tetrahedron with the candidates given by `deficits`.
+pub fn tetrahedron_with(deficits: &[u8]) -> LevelPayload {
+    base(&TETRA_POSITIONS, &TETRA_TRIANGLES, deficits)
+}
+
 /// Splits vertex 0 (ring 1, 3, 2, every entry a leaf: m = 3) with wings 1
-/// and 3, P keeping wedge (0,1,3); both halves leaves.
+/// and 3, P keeping wedge (0,1,3); both halves leaves; zero residuals.
 pub fn tetra_split() -> Rec {
     Rec {
         m: 3,
@@ -199,68 +229,96 @@ pub fn tetra_stream(codec: ChunkCodec) -> Vec<u8> {
         axis: Some(0),
         ..tetra_split()
     };
-    build(solve(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build))
+    build(solved(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build))
 }
 
-/// The octahedron (0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z) with
-/// `deficits`.
+/// The octahedron: 0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z.
+pub const OCTA_POSITIONS: [[u32; 3]; 6] = [
+    [20, 10, 10],
+    [0, 10, 10],
+    [10, 20, 10],
+    [10, 0, 10],
+    [10, 10, 20],
+    [10, 10, 0],
+];
+pub const OCTA_TRIANGLES: [[u32; 3]; 8] = [
+    [0, 2, 4],
+    [2, 1, 4],
+    [1, 3, 4],
+    [3, 0, 4],
+    [2, 0, 5],
+    [1, 2, 5],
+    [3, 1, 5],
+    [0, 3, 5],
+];
+
+/// The octahedron with `deficits`.
 pub fn octahedron(deficits: &[u8]) -> LevelPayload {
+    base(&OCTA_POSITIONS, &OCTA_TRIANGLES, deficits)
+}
+
+/// One triangle: vertex 0's ring is (ghost, 1, 2).
+pub const TRIANGLE_POSITIONS: [[u32; 3]; 3] = [[0, 0, 0], [10, 0, 0], [0, 10, 0]];
+
+/// One triangle (0, 1, 2) with `deficits`: vertex 0's ring is
+/// (ghost, 1, 2).
+pub fn triangle(deficits: &[u8]) -> LevelPayload {
+    base(&[[0, 0, 0], [10, 0, 0], [0, 10, 0]], &[[0, 1, 2]], deficits)
+}
+
+/// Two tetrahedra sharing vertex 0 only (a bowtie vertex: two fans), all
+/// leaves: a base mesh SPEC §6 rejects as non-manifold.
+pub fn bowtie() -> LevelPayload {
     base(
         &[
-            [20, 10, 10],
-            [0, 10, 10],
-            [10, 20, 10],
-            [10, 0, 10],
-            [10, 10, 20],
-            [10, 10, 0],
+            [0, 0, 0],
+            [1, 0, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [9, 0, 0],
+            [0, 9, 0],
+            [0, 0, 9],
         ],
         &[
-            [0, 2, 4],
-            [2, 1, 4],
-            [1, 3, 4],
-            [3, 0, 4],
-            [2, 0, 5],
-            [1, 2, 5],
-            [3, 1, 5],
-            [0, 3, 5],
+            [0, 2, 1],
+            [0, 1, 3],
+            [0, 3, 2],
+            [1, 2, 3],
+            [0, 5, 4],
+            [0, 4, 6],
+            [0, 6, 5],
+            [4, 5, 6],
         ],
-        deficits,
+        &[LEAF; 7],
     )
 }
 
 /// One triangle; vertex 0 (ring: ghost, 1, 2) splits with the ghost as a
 /// wing: P = (0,0,0), C = (0,4,0).
 pub fn boundary_ghost_wing_stream() -> Vec<u8> {
-    let b = base(
-        &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
-        &[[0, 1, 2]],
-        &[0, LEAF, LEAF],
-    );
+    let b = triangle(&[0, LEAF, LEAF]);
     let build = |rec: Rec| {
         write_stream(
-            &params(ChunkCodec::Stored),
+            &stored(),
             &[b.clone(), level(&[true], vec![1], &[rec], 4, 2)],
         )
     };
-    build(solve(tetra_split(), 0, 3, [0, 0, 0], [0, 4, 0], &build))
+    build(solved(tetra_split(), 0, 3, [0, 0, 0], [0, 4, 0], &build))
 }
 
 /// A single triangle, base only: the smallest legal stream.
 pub fn single_triangle_stream() -> Vec<u8> {
-    write_stream(
-        &params(ChunkCodec::Stored),
-        &[base(
-            &[[0, 0, 0], [10, 0, 0], [0, 10, 0]],
-            &[[0, 1, 2]],
-            &[LEAF; 3],
-        )],
-    )
+    write_stream(&stored(), &[triangle(&[LEAF; 3])])
 }
 
-pub fn stored() -> StreamParams {
-    params(ChunkCodec::Stored)
-}
-
-pub fn deflated() -> StreamParams {
-    params(ChunkCodec::Deflate(6))
+/// [`solve`] for the records of this module, which are known to decode.
+fn solved(
+    rec: Rec,
+    r: usize,
+    c: usize,
+    p: [i32; 3],
+    cpos: [i32; 3],
+    build: &dyn Fn(Rec) -> Vec<u8>,
+) -> Rec {
+    solve(rec, r, c, p, cpos, build).expect("a hand-made record of this module decodes")
 }
