@@ -212,6 +212,12 @@ pub fn tetra_split() -> Rec {
     }
 }
 
+/// The level of one round of one split `rec` on a tetrahedron base: 5
+/// vertices and 6 triangles after it, plane policy `off`.
+pub fn tetra_split_level(rec: Rec) -> LevelPayload {
+    level(&[true], vec![1], &[rec], 5, 6)
+}
+
 /// The one-split tetrahedron of SPEC Appendix A (5 vertices, 6 triangles):
 /// plane policy `dominant` (the predicted axis is x), P = (0,0,0),
 /// C = (2,2,2).

@@ -3,7 +3,8 @@
 
 use splitstream_decoder_core::Error;
 use splitstream_decoder_core::handmade::{
-    Rec, bowtie, level, octahedron, params, tetrahedron, tetrahedron_with, triangle,
+    Rec, bowtie, level, octahedron, params, tetra_split_level, tetrahedron, tetrahedron_with,
+    triangle,
 };
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::decode_all;
@@ -48,10 +49,7 @@ fn tetrahedron_one_split() {
     ] {
         let stream = write_stream(
             &params(codec),
-            &[
-                tetrahedron(),
-                level(&[true], vec![1], &[tetra_split()], 5, 6),
-            ],
+            &[tetrahedron(), tetra_split_level(tetra_split())],
         );
         let mesh = decode_all(&stream, true).unwrap();
         assert_eq!(
@@ -106,11 +104,11 @@ fn decode_err(levels: &[LevelPayload]) -> Error {
 fn ring_offset_out_of_range() {
     let mut rec = tetra_split();
     rec.o = 2; // o' + d' = 3 = m
-    let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
+    let err = decode_err(&[tetrahedron(), tetra_split_level(rec)]);
     assert_eq!(err, Error::RingOffsetOutOfRange);
     let mut rec = tetra_split();
     rec.d = 0;
-    let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
+    let err = decode_err(&[tetrahedron(), tetra_split_level(rec)]);
     assert_eq!(err, Error::RingOffsetOutOfRange);
 }
 
@@ -125,7 +123,7 @@ fn a_round_start_candidate_is_no_wing() {
         d: 2,
         ..tetra_split()
     };
-    let err = decode_err(&[b.clone(), level(&[true], vec![1], &[rec], 5, 6)]);
+    let err = decode_err(&[b.clone(), tetra_split_level(rec)]);
     assert_eq!(err, Error::RingOffsetOutOfRange);
     // Ranks 0 and 1 name vertices 3 and 2: P gets the wedge (0, 3, 2).
     // m_W = (0, 5, 5), m_I2 = (10, 0, 0): P̂ = (-1, 0, 0), Ĉ = (2, 0, 0).
@@ -136,7 +134,7 @@ fn a_round_start_candidate_is_no_wing() {
     };
     let stream = write_stream(
         &params(ChunkCodec::RansAlways { lanes: 1 }),
-        &[b, level(&[true], vec![1], &[rec], 5, 6)],
+        &[b, tetra_split_level(rec)],
     );
     let mesh = decode_all(&stream, true).unwrap();
     assert_eq!(mesh.triangles[4], [0, 4, 3]);
@@ -151,7 +149,7 @@ fn split_valences_out_of_range() {
         sc: 1,
         ..tetra_split()
     };
-    let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
+    let err = decode_err(&[tetrahedron(), tetra_split_level(rec)]);
     assert_eq!(err, Error::SplitValenceOutOfRange);
     assert_eq!(err.class(), "valence-overflow");
     // Symbols 254 and 255 are split valences above 255.
@@ -160,7 +158,7 @@ fn split_valences_out_of_range() {
             sp,
             ..tetra_split()
         };
-        let err = decode_err(&[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)]);
+        let err = decode_err(&[tetrahedron(), tetra_split_level(rec)]);
         assert_eq!(err, Error::SplitValenceOutOfRange);
     }
     // Symbol 253 is split valence 255: deficit 252 for P of valence 3.
@@ -170,7 +168,7 @@ fn split_valences_out_of_range() {
     };
     let stream = write_stream(
         &params(ChunkCodec::Stored),
-        &[tetrahedron(), level(&[true], vec![1], &[rec], 5, 6)],
+        &[tetrahedron(), tetra_split_level(rec)],
     );
     let mesh = decode_all(&stream, true).unwrap();
     assert_eq!(mesh.deficits[0], 252);
@@ -216,10 +214,7 @@ fn inferred_flag_leaves_the_neighbour_a_candidate() {
         ..tetra_split()
     };
     for codec in [ChunkCodec::Stored, ChunkCodec::RansAlways { lanes: 2 }] {
-        let stream = write_stream(
-            &params(codec),
-            &[b.clone(), level(&[true], vec![1], &[rec()], 5, 6)],
-        );
+        let stream = write_stream(&params(codec), &[b.clone(), tetra_split_level(rec())]);
         let mesh = decode_all(&stream, true).unwrap();
         assert_eq!(mesh.positions.len(), 5);
         assert_eq!(mesh.positions[4], [2, 2, 2]);
@@ -249,10 +244,7 @@ fn valence_overflow_on_a_wing() {
 fn corrupt_bytes_are_caught_by_checksums() {
     let stream = write_stream(
         &params(ChunkCodec::Deflate(6)),
-        &[
-            tetrahedron(),
-            level(&[true], vec![1], &[tetra_split()], 5, 6),
-        ],
+        &[tetrahedron(), tetra_split_level(tetra_split())],
     );
     for at in 0..stream.len() {
         let mut bad = stream.clone();

@@ -21,7 +21,7 @@ use splitstream_encoder::emit::{EncodeOptions, encode};
 use crate::builtin;
 use crate::manifest::{FinalMesh, Manifest, SUITE_VERSION, Vector, hex};
 use crate::protocol::Verdict;
-use handmade::{Rec, base, level, tetra_split};
+use handmade::{Rec, base, level, tetra_split, tetra_split_level};
 use mutate::*;
 
 /// The generated set: the manifest and each file's bytes (paths relative
@@ -1041,7 +1041,7 @@ fn invalid_vectors(s: &mut Specs) {
         {
             let mut rec = tetra_split();
             rec.o = 2;
-            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+            hand(&[tetra(), tetra_split_level(rec)])
         },
     );
     s.invalid(
@@ -1052,7 +1052,7 @@ fn invalid_vectors(s: &mut Specs) {
         {
             let mut rec = tetra_split();
             rec.d = 0;
-            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+            hand(&[tetra(), tetra_split_level(rec)])
         },
     );
     s.invalid(
@@ -1068,7 +1068,7 @@ fn invalid_vectors(s: &mut Specs) {
             };
             hand(&[
                 handmade::tetrahedron_two_candidates(),
-                level(&[true], vec![1], &[rec], 5, 6),
+                tetra_split_level(rec),
             ])
         },
     );
@@ -1082,7 +1082,7 @@ fn invalid_vectors(s: &mut Specs) {
                     &handmade::stored(),
                     &[
                         handmade::tetrahedron_two_candidates(),
-                        level(&[true], vec![1], &[rec], 5, 6),
+                        tetra_split_level(rec),
                     ],
                 )
             };
@@ -1090,7 +1090,9 @@ fn invalid_vectors(s: &mut Specs) {
                 m: 2,
                 ..tetra_split()
             };
-            build(handmade::solve(rec, 0, 4, [0, 0, 0], [4, 0, 2], &build).expect("the record decodes"))
+            let rec = handmade::solve(rec, 0, 4, [0, 0, 0], [4, 0, 2], &build)
+                .expect("the record decodes");
+            build(rec)
         },
     );
     s.invalid(
@@ -1147,7 +1149,7 @@ fn invalid_vectors(s: &mut Specs) {
                 sp: 254,
                 ..tetra_split()
             };
-            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+            hand(&[tetra(), tetra_split_level(rec)])
         },
     );
     s.invalid(
@@ -1160,7 +1162,7 @@ fn invalid_vectors(s: &mut Specs) {
                 sc: 1,
                 ..tetra_split()
             };
-            hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)])
+            hand(&[tetra(), tetra_split_level(rec)])
         },
     );
     s.valid(
@@ -1171,14 +1173,16 @@ fn invalid_vectors(s: &mut Specs) {
             let build = |rec: Rec| {
                 write_stream(
                     &handmade::stored(),
-                    &[tetra(), level(&[true], vec![1], &[rec], 5, 6)],
+                    &[tetra(), tetra_split_level(rec)],
                 )
             };
             let rec = Rec {
                 sp: 253,
                 ..tetra_split()
             };
-            build(handmade::solve(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build).expect("the record decodes"))
+            let rec = handmade::solve(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build)
+                .expect("the record decodes");
+            build(rec)
         },
     );
     s.invalid(
@@ -1216,7 +1220,7 @@ fn invalid_vectors(s: &mut Specs) {
         "A split placing C at x = 300 with 8 bits per axis.",
         &["handmade", "positions"],
         {
-            let build = |rec: Rec| hand(&[tetra(), level(&[true], vec![1], &[rec], 5, 6)]);
+            let build = |rec: Rec| hand(&[tetra(), tetra_split_level(rec)]);
             let rec = handmade::solve(tetra_split(), 0, 4, [0, 0, 0], [300, 2, 2], &build)
                 .expect("the record decodes");
             build(rec)
@@ -1293,7 +1297,7 @@ fn rans_vectors(s: &mut Specs) {
         "The flags substream, rANS-coded, holds the value 2 for a one-bit field (SPEC §5.5).",
         &["rans", "handmade"],
         {
-            let mut lvl = level(&[true], vec![1], &[tetra_split()], 5, 6);
+            let mut lvl = tetra_split_level(tetra_split());
             let mut w = splitstream_decoder_core::writer::SubstreamWriter::default();
             w.varint(2);
             lvl.substreams[0] = w;
