@@ -21,6 +21,9 @@ use crate::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
 
+/// Why [`solve`] cannot fail on this module's own records.
+const DECODES: &str = "a hand-made record of this module decodes";
+
 /// 8 bits per axis, unit scale, 4-byte chunks: every substream spans chunks.
 pub fn params(codec: ChunkCodec) -> StreamParams {
     StreamParams {
@@ -235,7 +238,8 @@ pub fn tetra_stream(codec: ChunkCodec) -> Vec<u8> {
         axis: Some(0),
         ..tetra_split()
     };
-    build(solved(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build))
+    let rec = solve(rec, 0, 4, [0, 0, 0], [2, 2, 2], &build).expect(DECODES);
+    build(rec)
 }
 
 /// The octahedron: 0 = +x, 1 = -x, 2 = +y, 3 = -y, 4 = +z, 5 = -z.
@@ -309,22 +313,11 @@ pub fn boundary_ghost_wing_stream() -> Vec<u8> {
             &[b.clone(), level(&[true], vec![1], &[rec], 4, 2)],
         )
     };
-    build(solved(tetra_split(), 0, 3, [0, 0, 0], [0, 4, 0], &build))
+    let rec = solve(tetra_split(), 0, 3, [0, 0, 0], [0, 4, 0], &build).expect(DECODES);
+    build(rec)
 }
 
 /// A single triangle, base only: the smallest legal stream.
 pub fn single_triangle_stream() -> Vec<u8> {
     write_stream(&stored(), &[triangle(&[LEAF; 3])])
-}
-
-/// [`solve`] for the records of this module, which are known to decode.
-fn solved(
-    rec: Rec,
-    r: usize,
-    c: usize,
-    p: [i32; 3],
-    cpos: [i32; 3],
-    build: &dyn Fn(Rec) -> Vec<u8>,
-) -> Rec {
-    solve(rec, r, c, p, cpos, build).expect("a hand-made record of this module decodes")
 }
