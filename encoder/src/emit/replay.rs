@@ -137,10 +137,10 @@ impl RecordSource for StepSource<'_> {
 
     fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
         // Exactly the flags flag() will give: the candidates that collapse
-        // in this step.
+        // in this step. (`current` is indexed by decoder id, as in flag();
+        // indexing it by encoder id warmed the fans of unrelated vertices.)
         upcoming.iter().enumerate().fold(0, |bits, (i, &v)| {
-            let id = self.dec2enc[v as usize];
-            bits | ((self.current[id as usize] != NONE) as u64) << i
+            bits | ((self.current[v as usize] != NONE) as u64) << i
         })
     }
 
@@ -495,4 +495,48 @@ fn check_exact(
         ));
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The warm-up hint must name exactly the candidates `flag` then flags,
+    /// with decoder and encoder ids apart (a hint read through the wrong
+    /// map still decodes the same, but warms the fans of other vertices).
+    #[test]
+    fn likely_flags_are_the_flags() {
+        let n = 8usize;
+        // Decoder id d is encoder id 7 - d.
+        let mut dec2enc: Vec<u32> = (0..n as u32).rev().collect();
+        let mut enc2dec: Vec<u32> = (0..n as u32).rev().collect();
+        // Decoder ids 1, 2 and 6 collapse in this step.
+        let mut current = vec![NONE; n];
+        for (i, d) in [1usize, 2, 6].into_iter().enumerate() {
+            current[d] = i as u32;
+        }
+        let mut subs = vec![SubstreamWriter::default(); 7];
+        let mut residuals = Vec::new();
+        let mut source = StepSource {
+            collapses: &[],
+            current: &mut current,
+            enc2dec: &mut enc2dec,
+            dec2enc: &mut dec2enc,
+            subs: &mut subs,
+            residuals: &mut residuals,
+            mode: PositionMode::Optimal,
+            pending: None,
+            swapped: false,
+            problem: None,
+        };
+        let mut memory = Memory::new(n, 8, 4, 4);
+        let state = memory.state(8);
+        let upcoming: Vec<u32> = (0..n as u32).collect();
+        let likely = source.likely_flags(&state, &upcoming);
+        for (i, &v) in upcoming.iter().enumerate() {
+            let flagged = source.flag(&state, v).unwrap();
+            assert_eq!(likely >> i & 1 == 1, flagged, "decoder id {v}");
+        }
+        assert_eq!(likely, 0b0100_0110);
+    }
 }
