@@ -52,14 +52,19 @@ pub fn base(positions: &[[u32; 3]], triangles: &[[u32; 3]], deficits: &[u8]) -> 
     SeedPayload::new(positions, triangles, deficits).into_level(1.0)
 }
 
-/// Replaces substream `index` of `level` by raw bytes.
-pub fn with_raw_substream(mut level: LevelPayload, index: usize, bytes: &[u8]) -> LevelPayload {
+/// Replaces substream `index` of `level` by raw bytes; `None` when the
+/// level has no substream `index`.
+pub fn with_raw_substream(
+    mut level: LevelPayload,
+    index: usize,
+    bytes: &[u8],
+) -> Option<LevelPayload> {
     let mut s = SubstreamWriter::default();
     for &b in bytes {
         s.byte(b);
     }
-    level.substreams[index] = s;
-    level
+    *level.substreams.get_mut(index)? = s;
+    Some(level)
 }
 
 /// One optimal-mode split record as coded (SPEC §7.4): the wing ranks `o`
@@ -92,8 +97,9 @@ pub struct Rec {
 /// outside the grid keeps the last correction.
 ///
 /// # Errors
-/// The error of the first probe when it does not decode: the record is
-/// wrong in more than its residuals.
+/// The error of the first probe when it does not decode (the record is
+/// wrong in more than its residuals); [`Error::NoSuchVertex`] when the
+/// decoded mesh has no vertex `r` or `c`.
 pub fn solve(
     rec: Rec,
     r: usize,
@@ -116,7 +122,9 @@ pub fn solve(
             Err(_) if probe_index > 0 => return Ok(trial),
             Err(e) => return Err(e),
         };
-        let (gp, gc) = (probe.positions[r], probe.positions[c]);
+        let (Some(&gp), Some(&gc)) = (probe.positions.get(r), probe.positions.get(c)) else {
+            return Err(Error::NoSuchVertex);
+        };
         if (gp, gc) == (p.map(|x| x as u32), cpos.map(|x| x as u32)) {
             return Ok(trial);
         }
@@ -320,4 +328,46 @@ pub fn boundary_ghost_wing_stream() -> Vec<u8> {
 /// A single triangle, base only: the smallest legal stream.
 pub fn single_triangle_stream() -> Vec<u8> {
     write_stream(&stored(), &[triangle(&[LEAF; 3])])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn build(rec: Rec) -> Vec<u8> {
+        write_stream(&stored(), &[tetrahedron(), tetra_split_level(rec)])
+    }
+
+    #[test]
+    fn solve_places_p_and_c() {
+        let rec = solve(tetra_split(), 0, 4, [1, 2, 3], [7, 5, 9], &build).unwrap();
+        let mesh = decode_all(&build(rec), true).unwrap();
+        assert_eq!(mesh.positions[0], [1, 2, 3]);
+        assert_eq!(mesh.positions[4], [7, 5, 9]);
+        let mesh = decode_all(&tetra_stream(ChunkCodec::Deflate(6)), true).unwrap();
+        assert_eq!((mesh.positions[0], mesh.positions[4]), ([0; 3], [2; 3]));
+    }
+
+    #[test]
+    fn solve_reports_what_it_cannot_do() {
+        let bad = Rec {
+            o: 2,
+            ..tetra_split()
+        };
+        assert_eq!(
+            solve(bad, 0, 4, [0; 3], [2; 3], &build),
+            Err(Error::RingOffsetOutOfRange)
+        );
+        assert_eq!(
+            solve(tetra_split(), 0, 5, [0; 3], [2; 3], &build),
+            Err(Error::NoSuchVertex)
+        );
+    }
+
+    #[test]
+    fn raw_substreams_replace_only_existing_ones() {
+        let level = with_raw_substream(triangle(&[LEAF; 3]), 1, &[0, 1, 2]).unwrap();
+        assert_eq!(level.substreams[1].as_bytes(), &[0, 1, 2]);
+        assert!(with_raw_substream(triangle(&[LEAF; 3]), 3, &[0]).is_none());
+    }
 }

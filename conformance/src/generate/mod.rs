@@ -1249,7 +1249,8 @@ fn invalid_vectors(s: &mut Specs) {
             "malformed",
             &format!("Base triangle substream with {what}."),
             &["handmade", "varint"],
-            hand(&[handmade::with_raw_substream(triangle(), 1, bytes)]),
+            hand(&[handmade::with_raw_substream(triangle(), 1, bytes)
+                .expect("a base level has a triangle substream (1)")]),
         );
     }
 }
