@@ -278,10 +278,9 @@ pub fn octahedron(deficits: &[u8]) -> LevelPayload {
 /// One triangle: vertex 0's ring is (ghost, 1, 2).
 pub const TRIANGLE_POSITIONS: [[u32; 3]; 3] = [[0, 0, 0], [10, 0, 0], [0, 10, 0]];
 
-/// One triangle (0, 1, 2) with `deficits`: vertex 0's ring is
-/// (ghost, 1, 2).
+/// One triangle (0, 1, 2) with `deficits`.
 pub fn triangle(deficits: &[u8]) -> LevelPayload {
-    base(&[[0, 0, 0], [10, 0, 0], [0, 10, 0]], &[[0, 1, 2]], deficits)
+    base(&TRIANGLE_POSITIONS, &[[0, 1, 2]], deficits)
 }
 
 /// Two tetrahedra sharing vertex 0 only (a bowtie vertex: two fans), all
