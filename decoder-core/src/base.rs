@@ -1,17 +1,18 @@
 //! Loading the base mesh and building its adjacency (SPEC §6.3).
 //!
 //! The base mesh arrives as plain triangles; this checks that it is a
-//! consistently oriented 2-manifold (possibly with boundary) and builds the
-//! opposite-corner table without allocating: a counting sort of the corners
-//! by vertex runs in the opposite table's memory, used as `u32` scratch, and
-//! the opposites found there are packed into references at the end.
+//! consistently oriented 2-manifold (possibly with boundary) and builds its
+//! adjacency without allocating: a counting sort of the corners by vertex
+//! runs in the swing table's memory, used as `u32` scratch; the opposite
+//! corners found there are turned into the swing table (`state.rs`) at the
+//! end.
 
 use crate::Error;
 use crate::limits::{LEAF, MAX_SPLIT_VALENCE, NONE};
 use crate::state::{MeshState, next, prev};
 
 impl MeshState<'_> {
-    /// `u32`s of scratch the base build needs in the opposite table's
+    /// `u32`s of scratch the base build needs in the swing table's
     /// memory: the opposites, the corners sorted by vertex and the start of
     /// each vertex's run (SPEC §9: `6 T0 + V0 + 1`).
     pub fn base_scratch_len(vertices: u32, triangles: u32) -> usize {
@@ -27,7 +28,7 @@ impl MeshState<'_> {
         let nc = 3 * nt;
         if vertices > self.vertex_capacity()
             || triangles > self.triangle_capacity()
-            || self.opposite.scratch().len() < Self::base_scratch_len(vertices, triangles)
+            || self.swing.scratch().len() < Self::base_scratch_len(vertices, triangles)
         {
             return Err(Error::CapacityExceeded);
         }
@@ -39,7 +40,7 @@ impl MeshState<'_> {
                 return Err(Error::NonManifold("degenerate triangle"));
             }
         }
-        let (opposite, scratch) = self.opposite.scratch().split_at_mut(nc);
+        let (opposite, scratch) = self.swing.scratch().split_at_mut(nc);
         let (list, start) = scratch.split_at_mut(nc);
         let start = &mut start[..nv + 1];
         let corners = &self.corners[..nc];
@@ -104,7 +105,10 @@ impl MeshState<'_> {
                 return Err(Error::ValenceOverflow);
             }
         }
-        self.opposite.pack(nc);
+        // swing[c] = next(opposite[next(c)]), packed in place.
+        let after = |o: u32| if o == NONE { NONE } else { next(o) };
+        self.swing
+            .pack_triangles(nt, |[o0, o1, o2]| [after(o1), after(o2), after(o0)]);
         self.vertex_count = vertices;
         self.triangle_count = triangles;
         self.candidates.fill(0);

@@ -1,5 +1,6 @@
-//! Packed arrays of corner references: the opposite-corner table and the
-//! corner of each vertex (SPEC §9).
+//! Packed arrays of corner references: the swing table (the next corner
+//! of the same vertex around its fan, see `state.rs`) and the corner of each
+//! vertex (SPEC §9).
 //!
 //! A corner reference is a corner index or [`NONE`]. When every corner index
 //! of a layout fits in 24 bits (three times the triangle capacity at most
@@ -90,17 +91,20 @@ impl<'ws> CornerRefs<'ws> {
         bytemuck::try_cast_slice_mut(&mut self.bytes[..4 * words]).unwrap_or(&mut [])
     }
 
-    /// Turns the first `n` `u32`s of [`CornerRefs::scratch`] into the first
-    /// `n` entries, in place (entry i's bytes never pass u32 i's, so a
-    /// forward pass reads every `u32` before overwriting it).
-    pub(crate) fn pack(&mut self, n: usize) {
-        if self.width == 4 {
-            return;
-        }
-        for i in 0..n.min(self.bytes.len() / 4) {
-            let b = &self.bytes[4 * i..4 * i + 4];
-            let v = u32::from_le_bytes([b[0], b[1], b[2], b[3]]);
-            self.set(i as u32, v);
+    /// Turns the first `3 n` `u32`s of [`CornerRefs::scratch`] into the
+    /// first `3 n` entries, in place, triangle by triangle: the three
+    /// entries of a triangle are `f` of its three `u32`s. (Entry i's bytes
+    /// never pass u32 i's, and a triangle's three u32s are read before its
+    /// entries are written, so a forward pass reads every `u32` first.)
+    pub(crate) fn pack_triangles(&mut self, n: usize, f: impl Fn([u32; 3]) -> [u32; 3]) {
+        for t in 0..n.min(self.bytes.len() / 12) {
+            let b = &self.bytes[12 * t..12 * t + 12];
+            let word =
+                |i: usize| u32::from_le_bytes([b[4 * i], b[4 * i + 1], b[4 * i + 2], b[4 * i + 3]]);
+            let entries = f([word(0), word(1), word(2)]);
+            for (i, &e) in entries.iter().enumerate() {
+                self.set((3 * t + i) as u32, e);
+            }
         }
     }
 }
@@ -130,13 +134,16 @@ mod tests {
 
     #[test]
     fn pack_turns_u32s_into_entries() {
-        let mut bytes = [0u8; 4 * 5];
-        let mut refs = CornerRefs::new(&mut bytes, 3);
-        let values = [5, NONE, 0, 0xFF_FFFE, 3];
-        refs.scratch()[..5].copy_from_slice(&values);
-        refs.pack(5);
-        for (i, &v) in values.iter().enumerate() {
-            assert_eq!(refs.get(i as u32), v);
+        for width in [3, 4] {
+            let mut bytes = [0u8; 4 * 6 + 1];
+            let mut refs = CornerRefs::new(&mut bytes, width);
+            let values = [5, NONE, 0, 0xFF_FFFE, 3, 9];
+            refs.scratch()[..6].copy_from_slice(&values);
+            refs.pack_triangles(2, |[a, b, c]| [b, c, a]);
+            let expected = [NONE, 0, 5, 3, 9, 0xFF_FFFE];
+            for (i, &v) in expected.iter().enumerate() {
+                assert_eq!(refs.get(i as u32), v, "width {width}, entry {i}");
+            }
         }
     }
 

@@ -114,6 +114,11 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
         &self.state
     }
 
+    /// A speed setting: see [`MeshState::set_fans_ahead_from`].
+    pub fn set_fans_ahead_from(&mut self, vertices: u32) {
+        self.state.set_fans_ahead_from(vertices);
+    }
+
     pub fn positions(&self) -> &[[u32; 3]] {
         self.state.positions()
     }

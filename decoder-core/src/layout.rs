@@ -25,7 +25,7 @@ pub struct Layout {
     pub max_chunk_len: u32,
     ranges: [(u64, u64); 7],
     chunk_buffer_len: u64,
-    /// Bytes per corner reference (opposites, a corner per vertex): 3 when
+    /// Bytes per corner reference (the swing table, a corner per vertex): 3 when
     /// every corner index fits in 24 bits, else 4 (SPEC §9).
     pub corner_ref_width: usize,
     /// Total bytes, from an 8-aligned start.
@@ -111,7 +111,7 @@ impl Layout {
         let (region, _) = rest.split_at_mut(self.total as usize);
         let (positions, rest) = take(region, r[0], 0);
         let (corners, rest) = take(rest, r[1], r[0].1);
-        let (opposite, rest) = take(rest, r[2], r[1].1);
+        let (swing, rest) = take(rest, r[2], r[1].1);
         let (vertex_corner, rest) = take(rest, r[3], r[2].1);
         let (deficit, rest) = take(rest, r[4], r[3].1);
         let (candidates, rest) = take(rest, r[5], r[4].1);
@@ -126,7 +126,7 @@ impl Layout {
         let memory = StateMemory {
             positions: cast(positions)?,
             corners: cast(corners)?,
-            opposite: CornerRefs::new(opposite, self.corner_ref_width),
+            swing: CornerRefs::new(swing, self.corner_ref_width),
             vertex_corner: CornerRefs::new(vertex_corner, self.corner_ref_width),
             deficit,
             candidates: cast(candidates)?,

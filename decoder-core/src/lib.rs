@@ -69,7 +69,7 @@ pub use predict::{
 };
 pub use rans::token_of;
 pub use ring::Ring;
-pub use round::{RecordSource, RoundStats};
+pub use round::{FANS_AHEAD_FROM_VERTICES, RecordSource, RoundStats};
 pub use split::{SplitOutcome, SplitRecord};
 pub use state::{MeshState, StateMemory, next, prev};
 pub use symbols::WingCandidates;

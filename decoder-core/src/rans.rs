@@ -11,15 +11,30 @@
 use crate::Error;
 use crate::bytes::u32_at;
 use crate::limits::rans::{
-    DIRECT_TOKENS, PROB_BITS, PROB_SCALE, RAW_BITS_STEP, STATE_LOW, TABLE_WORDS, TOKENS,
+    DIRECT_TOKENS, MAX_CONTEXTS, MAX_LANES, PROB_BITS, PROB_SCALE, RAW_BITS_STEP, STATE_LOW,
+    TABLE_WORDS, TOKENS,
 };
 
-/// Words per context in the table area: token count, then `TOKENS + 1`
-/// cumulative frequencies.
-const CONTEXT_WORDS: usize = TOKENS + 2;
+/// Cumulative frequencies kept per context: `cum[0..=n]` for at most
+/// `TOKENS` tokens, then entries equal to `PROB_SCALE` (above every slot),
+/// so that a scan for a slot's token always stops inside the table.
+const CUM_LEN: usize = 48;
+const _: () = assert!(CUM_LEN > TOKENS + 1);
 
-/// Words of one lane in the lane area: state, cursor, end (level offsets).
+/// A slot's token is looked up in one of this many equal buckets of the
+/// `PROB_SCALE` slots, then found by a short forward scan.
+const BUCKET_BITS: u32 = 6;
+const BUCKETS: usize = 1 << BUCKET_BITS;
+
+/// `u32` words of one lane: state, cursor, end (offsets in the level).
 pub const LANE_WORDS: usize = 3;
+
+// A context's cumulative frequencies (u16) and bucket index (u8) take no
+// more room than the `TOKENS + 2` words per context that SPEC §9 gives a
+// rANS slot.
+const _: () = assert!(MAX_CONTEXTS * (2 * CUM_LEN + BUCKETS) <= 4 * TABLE_WORDS);
+const _: () = assert!((2 * MAX_CONTEXTS * CUM_LEN).is_multiple_of(4));
+const _: () = assert!(MAX_LANES.is_power_of_two());
 
 /// Raw bits that follow `token`, and the value they complete (§5.5.1).
 #[inline]
@@ -62,51 +77,6 @@ fn varint(bytes: &[u8], at: &mut usize, end: usize) -> Result<u32, Error> {
     Err(bad)
 }
 
-/// Parses the tables of `contexts` contexts at `bytes[*at..end]` into
-/// `table` (§5.5.2): per context a token count `n` (0: unused), then `n`
-/// counts, normalised here to frequencies summing to `PROB_SCALE`.
-pub fn read_tables(
-    bytes: &[u8],
-    at: &mut usize,
-    end: usize,
-    contexts: usize,
-    table: &mut [u32],
-) -> Result<(), Error> {
-    for c in 0..contexts {
-        let t = &mut table[c * CONTEXT_WORDS..(c + 1) * CONTEXT_WORDS];
-        if *at >= end {
-            return Err(Error::InvalidRansChunk("tables run past the chunk"));
-        }
-        let n = bytes[*at] as usize;
-        *at += 1;
-        if n > TOKENS {
-            return Err(Error::InvalidRansChunk("more tokens than the code has"));
-        }
-        t[0] = n as u32;
-        if n == 0 {
-            continue;
-        }
-        // Counts into t[1..=n]; then frequencies; then cumulative in t[1..=n+1].
-        for i in 0..n {
-            t[1 + i] = varint(bytes, at, end)?;
-        }
-        if t[n] == 0 {
-            return Err(Error::InvalidRansChunk("last token count is zero"));
-        }
-        normalise(&mut t[1..=n])?;
-        let mut cum = 0u32;
-        for i in 0..n {
-            let f = t[1 + i];
-            t[1 + i] = cum;
-            cum += f;
-        }
-        t[1 + n] = cum;
-        // Entries past cum[n] read as "above every slot" (decode_value).
-        t[2 + n..].fill(PROB_SCALE);
-    }
-    Ok(())
-}
-
 /// Turns counts into frequencies summing to `PROB_SCALE`, in place
 /// (§5.5.2): each nonzero count gets `max(1, count × PROB_SCALE / total)`,
 /// then the largest frequency (the first of equals) absorbs the difference.
@@ -138,123 +108,246 @@ pub fn normalise(counts: &mut [u32]) -> Result<(), Error> {
     Ok(())
 }
 
-/// Reads the lane directory and each lane's initial state (§5.5.3); fills
-/// `lanes` with (state, cursor, end) per lane.
-pub fn open_lanes(
-    bytes: &[u8],
-    mut at: usize,
-    end: usize,
-    values: u32,
-    lanes: &mut [u32],
-) -> Result<(), Error> {
-    for lane in lanes.chunks_exact_mut(LANE_WORDS) {
-        lane[2] = varint(bytes, &mut at, end)?;
+/// The decoding state of one rANS chunk (§5.5.2–§5.5.4), kept in a
+/// substream slot's memory: per context its token count, cumulative
+/// frequencies and a bucket index from slots to tokens, and per lane its
+/// state, cursor and end. Lanes take values in turn (value `i` of the chunk
+/// in lane `i mod lane_count`).
+pub struct ChunkDecoder<'b> {
+    /// Tokens of each context's table; 0 for an unused table.
+    tokens: [u8; MAX_CONTEXTS],
+    /// `CUM_LEN` cumulative frequencies per context.
+    cums: &'b mut [[u16; CUM_LEN]; MAX_CONTEXTS],
+    /// Per context, the token of the first slot of each bucket.
+    buckets: &'b mut [[u8; BUCKETS]; MAX_CONTEXTS],
+    /// State, cursor, end of each lane (room for the most lanes a stream
+    /// may have, SPEC §9; the first `lane_count` are used).
+    lanes: &'b mut [[u32; LANE_WORDS]; MAX_LANES as usize],
+    lane_count: usize,
+    /// Lane of the next value.
+    lane: usize,
+}
+
+impl<'b> ChunkDecoder<'b> {
+    /// A decoder of chunks with `lane_count` lanes over `words`, or `None`
+    /// when they are fewer than the tables and lanes need (SPEC §9:
+    /// `TABLE_WORDS + LANE_WORDS × lane_count`).
+    pub fn new(words: &'b mut [u32], lane_count: usize) -> Option<ChunkDecoder<'b>> {
+        if lane_count == 0
+            || lane_count > MAX_LANES as usize
+            || words.len() < TABLE_WORDS + LANE_WORDS * MAX_LANES as usize
+        {
+            return None;
+        }
+        let (table, lanes) = words.split_at_mut(TABLE_WORDS);
+        let (cums, buckets) = table.split_at_mut(MAX_CONTEXTS * CUM_LEN / 2);
+        let buckets = &mut buckets[..MAX_CONTEXTS * BUCKETS / 4];
+        let cums: &mut [[u16; CUM_LEN]] = bytemuck::try_cast_slice_mut(cums).ok()?;
+        let buckets: &mut [[u8; BUCKETS]] = bytemuck::try_cast_slice_mut(buckets).ok()?;
+        let lanes: &mut [[u32; LANE_WORDS]] =
+            bytemuck::try_cast_slice_mut(&mut lanes[..LANE_WORDS * MAX_LANES as usize]).ok()?;
+        Some(ChunkDecoder {
+            tokens: [0; MAX_CONTEXTS],
+            cums: cums.try_into().ok()?,
+            buckets: buckets.try_into().ok()?,
+            lanes: lanes.try_into().ok()?,
+            lane_count,
+            lane: 0,
+        })
     }
-    for (i, lane) in lanes.chunks_exact_mut(LANE_WORDS).enumerate() {
-        let len = lane[2] as usize;
-        let has_values = (i as u32) < values;
-        let lane_end = at
-            .checked_add(len)
-            .filter(|&e| e <= end)
-            .ok_or(Error::InvalidRansChunk("lanes run past the chunk"))?;
-        if !has_values {
-            if len != 0 {
-                return Err(Error::InvalidRansChunk("bytes in a lane without values"));
+
+    /// Reads a chunk's tables for `contexts` contexts and its lane
+    /// directory, from `bytes[at..end]`, for a chunk of `values` values
+    /// (§5.5.2, §5.5.3).
+    pub fn open(
+        &mut self,
+        bytes: &[u8],
+        mut at: usize,
+        end: usize,
+        contexts: usize,
+        values: u32,
+    ) -> Result<(), Error> {
+        self.read_tables(bytes, &mut at, end, contexts)?;
+        self.open_lanes(bytes, at, end, values)
+    }
+
+    /// Parses the tables of `contexts` contexts at `bytes[*at..end]`
+    /// (§5.5.2): per context a token count `n` (0: unused), then `n`
+    /// counts, normalised here to frequencies summing to `PROB_SCALE`.
+    fn read_tables(
+        &mut self,
+        bytes: &[u8],
+        at: &mut usize,
+        end: usize,
+        contexts: usize,
+    ) -> Result<(), Error> {
+        self.tokens = [0; MAX_CONTEXTS];
+        for c in 0..contexts.min(MAX_CONTEXTS) {
+            if *at >= end {
+                return Err(Error::InvalidRansChunk("tables run past the chunk"));
             }
-            lane.copy_from_slice(&[STATE_LOW, at as u32, at as u32]);
-            continue;
+            let n = bytes[*at] as usize;
+            *at += 1;
+            if n > TOKENS {
+                return Err(Error::InvalidRansChunk("more tokens than the code has"));
+            }
+            if n == 0 {
+                continue;
+            }
+            let mut counts = [0u32; TOKENS];
+            for count in &mut counts[..n] {
+                *count = varint(bytes, at, end)?;
+            }
+            if counts[n - 1] == 0 {
+                return Err(Error::InvalidRansChunk("last token count is zero"));
+            }
+            normalise(&mut counts[..n])?;
+            let cum = &mut self.cums[c];
+            let bucket = &mut self.buckets[c];
+            let mut sum = 0u32;
+            for (t, &f) in counts[..n].iter().enumerate() {
+                cum[t] = sum as u16;
+                // Buckets whose first slot falls in this token's range.
+                let first = (sum as usize).div_ceil(1 << BUCKET_BITS);
+                sum += f;
+                let last = (sum as usize).div_ceil(1 << BUCKET_BITS);
+                bucket[first..last].fill(t as u8);
+            }
+            // Past cum[n] every entry reads as "above every slot".
+            cum[n..].fill(PROB_SCALE as u16);
+            self.tokens[c] = n as u8;
         }
-        if len < 4 {
-            return Err(Error::InvalidRansChunk("lane shorter than its state"));
-        }
-        let state = u32_at(bytes, at)?;
-        if !(STATE_LOW..STATE_LOW << 8).contains(&state) {
-            return Err(Error::InvalidRansChunk("lane state out of range"));
-        }
-        lane.copy_from_slice(&[state, (at + 4) as u32, lane_end as u32]);
-        at = lane_end;
+        Ok(())
     }
-    if at != end {
-        return Err(Error::InvalidRansChunk("bytes after the last lane"));
+
+    /// Reads the lane directory and each lane's initial state (§5.5.3).
+    fn open_lanes(
+        &mut self,
+        bytes: &[u8],
+        mut at: usize,
+        end: usize,
+        values: u32,
+    ) -> Result<(), Error> {
+        let lanes = &mut self.lanes[..self.lane_count];
+        for lane in lanes.iter_mut() {
+            lane[2] = varint(bytes, &mut at, end)?;
+        }
+        for (i, lane) in lanes.iter_mut().enumerate() {
+            let len = lane[2] as usize;
+            let has_values = (i as u32) < values;
+            let lane_end = at
+                .checked_add(len)
+                .filter(|&e| e <= end)
+                .ok_or(Error::InvalidRansChunk("lanes run past the chunk"))?;
+            if !has_values {
+                if len != 0 {
+                    return Err(Error::InvalidRansChunk("bytes in a lane without values"));
+                }
+                *lane = [STATE_LOW, at as u32, at as u32];
+                continue;
+            }
+            if len < 4 {
+                return Err(Error::InvalidRansChunk("lane shorter than its state"));
+            }
+            let state = u32_at(bytes, at)?;
+            if !(STATE_LOW..STATE_LOW << 8).contains(&state) {
+                return Err(Error::InvalidRansChunk("lane state out of range"));
+            }
+            *lane = [state, (at + 4) as u32, lane_end as u32];
+            at = lane_end;
+        }
+        if at != end {
+            return Err(Error::InvalidRansChunk("bytes after the last lane"));
+        }
+        self.lane = 0;
+        Ok(())
+    }
+
+    /// Whether every lane ended exactly: state back at `STATE_LOW`, every
+    /// byte read.
+    pub fn exhausted(&self) -> bool {
+        self.lanes[..self.lane_count]
+            .iter()
+            .all(|l| l[0] == STATE_LOW && l[1] == l[2])
+    }
+
+    /// Decodes the next value, in `context`, from the next lane
+    /// (§5.5.1, §5.5.4); `bytes` are the level's.
+    #[inline(always)]
+    pub fn decode(&mut self, bytes: &[u8], context: usize) -> Result<u32, Error> {
+        // Contexts are below MAX_CONTEXTS (a power of two) by construction.
+        let context = context & (MAX_CONTEXTS - 1);
+        let n = self.tokens[context] as usize;
+        if n == 0 {
+            return Err(Error::InvalidRansChunk(
+                "value in a context without a table",
+            ));
+        }
+        // lane < lane_count <= MAX_LANES, a power of two.
+        let lane = &mut self.lanes[self.lane & (MAX_LANES as usize - 1)];
+        self.lane = if self.lane + 1 >= self.lane_count {
+            0
+        } else {
+            self.lane + 1
+        };
+        let cum = &self.cums[context];
+        let mut x = lane[0];
+        let slot = x & (PROB_SCALE - 1);
+        // The token t with cum[t] <= slot < cum[t + 1]: the bucket names the
+        // token of its first slot; a bucket spanning several tokens is
+        // scanned forward (cum[n] and the entries after it exceed every
+        // slot, so the scan stops below n).
+        let mut t = self.buckets[context][(slot >> BUCKET_BITS) as usize] as usize;
+        while t + 1 < CUM_LEN && cum[t + 1] as u32 <= slot {
+            t += 1;
+        }
+        if t + 1 >= CUM_LEN {
+            return Err(Error::InvalidRansChunk("slot beyond the table"));
+        }
+        let start = cum[t] as u32;
+        let freq = cum[t + 1] as u32 - start;
+        x = freq * (x >> PROB_BITS) + slot - start;
+        renormalise(bytes, lane, &mut x)?;
+        let token = t as u32;
+        let extra = token_bits(token);
+        if extra == 0 {
+            lane[0] = x;
+            return Ok(token);
+        }
+        let mut low = 0u32;
+        let mut done = 0;
+        while done < extra {
+            let step = (extra - done).min(RAW_BITS_STEP);
+            low |= (x & ((1 << step) - 1)) << done;
+            x >>= step;
+            renormalise(bytes, lane, &mut x)?;
+            done += step;
+        }
+        lane[0] = x;
+        Ok((1 << extra) | low)
+    }
+}
+
+/// Pulls bytes into the state `x` of `lane` until it is normalised again.
+#[inline(always)]
+fn renormalise(bytes: &[u8], lane: &mut [u32; LANE_WORDS], x: &mut u32) -> Result<(), Error> {
+    while *x < STATE_LOW {
+        let at = lane[1];
+        match bytes.get(at as usize) {
+            Some(&b) if at < lane[2] => {
+                *x = (*x << 8) | b as u32;
+                lane[1] = at + 1;
+            }
+            _ => return Err(Error::InvalidRansChunk("lane ran out of bytes")),
+        }
     }
     Ok(())
 }
-
-/// Whether every lane ended exactly: state back at `STATE_LOW`, every byte read.
-pub fn lanes_exhausted(lanes: &[u32]) -> bool {
-    lanes
-        .chunks_exact(LANE_WORDS)
-        .all(|l| l[0] == STATE_LOW && l[1] == l[2])
-}
-
-/// Pulls bytes into `lane`'s state until it is normalised again.
-#[inline]
-fn renormalise(bytes: &[u8], lane: &mut [u32]) -> Result<(), Error> {
-    while lane[0] < STATE_LOW {
-        if lane[1] >= lane[2] {
-            return Err(Error::InvalidRansChunk("lane ran out of bytes"));
-        }
-        lane[0] = (lane[0] << 8) | bytes[lane[1] as usize] as u32;
-        lane[1] += 1;
-    }
-    Ok(())
-}
-
-/// Decodes one value in `context` from `lane` (§5.5.1, §5.5.4).
-#[inline]
-pub fn decode_value(
-    bytes: &[u8],
-    table: &[u32],
-    context: usize,
-    lane: &mut [u32],
-) -> Result<u32, Error> {
-    let t = &table[context * CONTEXT_WORDS..(context + 1) * CONTEXT_WORDS];
-    if t[0] == 0 {
-        return Err(Error::InvalidRansChunk(
-            "value in a context without a table",
-        ));
-    }
-    let x = lane[0];
-    let slot = x & (PROB_SCALE - 1);
-    // The token t with cum[t] <= slot < cum[t + 1] is the number of
-    // cumulative frequencies cum[1..] at most slot (cum is non-decreasing,
-    // and `read_tables` sets the entries past cum[n] to PROB_SCALE > slot).
-    // Counting, rather than searching, has no branch to mispredict; the
-    // count runs over n rounded up to 4 entries.
-    let cum = &t[1..];
-    let counted = ((t[0] as usize + 3) & !3).min(TOKENS);
-    let mut token = 0u32;
-    for quad in cum[1..=counted].chunks_exact(4) {
-        token += quad.iter().map(|&c| (c <= slot) as u32).sum::<u32>();
-    }
-    let token = token as usize;
-    let token = token.min(TOKENS - 1);
-    let (start, freq) = (cum[token], cum[token + 1] - cum[token]);
-    lane[0] = freq * (x >> PROB_BITS) + slot - start;
-    renormalise(bytes, lane)?;
-    let token = token as u32;
-    let extra = token_bits(token);
-    if extra == 0 {
-        return Ok(token);
-    }
-    let mut low = 0u32;
-    let mut done = 0;
-    while done < extra {
-        let step = (extra - done).min(RAW_BITS_STEP);
-        low |= (lane[0] & ((1 << step) - 1)) << done;
-        lane[0] >>= step;
-        renormalise(bytes, lane)?;
-        done += step;
-    }
-    Ok((1 << extra) | low)
-}
-
-const _: () = assert!(TABLE_WORDS == crate::limits::rans::MAX_CONTEXTS * CONTEXT_WORDS);
 
 #[cfg(all(test, feature = "alloc"))]
 mod tests {
     use super::*;
-    use crate::limits::rans::{MAX_CONTEXTS, TABLE_WORDS};
+    use crate::limits::rans::{MAX_CONTEXTS, MAX_LANES, TABLE_WORDS};
     use crate::rans_writer::{Symbol, encode_chunk};
     use alloc::vec;
     use alloc::vec::Vec;
@@ -267,28 +360,14 @@ mod tests {
         n_contexts: usize,
         lanes: usize,
     ) -> Result<Vec<u32>, Error> {
-        let mut table = vec![0u32; TABLE_WORDS];
-        let mut lane_words = vec![0u32; LANE_WORDS * lanes];
-        let mut at = 0;
-        read_tables(payload, &mut at, payload.len(), n_contexts, &mut table)?;
-        open_lanes(
-            payload,
-            at,
-            payload.len(),
-            contexts.len() as u32,
-            &mut lane_words,
-        )?;
+        let mut words = vec![0u32; TABLE_WORDS + LANE_WORDS * MAX_LANES as usize];
+        let mut chunk = ChunkDecoder::new(&mut words, lanes).expect("room");
+        chunk.open(payload, 0, payload.len(), n_contexts, contexts.len() as u32)?;
         let mut out = Vec::new();
-        for (i, &ctx) in contexts.iter().enumerate() {
-            let l = (i % lanes) * LANE_WORDS;
-            out.push(decode_value(
-                payload,
-                &table,
-                ctx as usize,
-                &mut lane_words[l..l + LANE_WORDS],
-            )?);
+        for &ctx in contexts {
+            out.push(chunk.decode(payload, ctx as usize)?);
         }
-        if !lanes_exhausted(&lane_words) {
+        if !chunk.exhausted() {
             return Err(Error::InvalidRansChunk("a lane did not end exactly"));
         }
         Ok(out)

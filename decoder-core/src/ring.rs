@@ -20,6 +20,8 @@ pub struct Ring {
     /// `corners[i]` is the corner of `R` in wedge `W_i = (R, r_i, r_{i+1})`,
     /// [`NONE`] when the wedge is virtual (it touches the ghost).
     corners: [u32; MAX_SPLIT_VALENCE],
+    /// Fans walked ahead of their splits (see [`FansAhead`]).
+    pub(crate) ahead: FansAhead,
 }
 
 impl Default for Ring {
@@ -28,6 +30,46 @@ impl Default for Ring {
             len: 0,
             vertices: [NONE; MAX_SPLIT_VALENCE],
             corners: [NONE; MAX_SPLIT_VALENCE],
+            ahead: FansAhead::default(),
+        }
+    }
+}
+
+/// Fans of a round's upcoming splits, walked together before those splits
+/// (`round.rs`): walking many fans in lockstep lets their cache misses
+/// overlap, where one fan's walk is a chain of dependent loads. A fan walked
+/// ahead is still the fan its vertex has when it splits: a split only
+/// changes the fans of its own ring, whose vertices do not split in the
+/// same round (SPEC §7.2). Only closed fans of up to [`FAN_LEN`] wedges are
+/// kept; any other ring is walked when its vertex splits.
+#[derive(Clone)]
+pub(crate) struct FansAhead {
+    /// Vertices whose fans are held, ascending, [`NONE`] past the last.
+    pub(crate) owner: [u32; FANS],
+    /// Wedges of each fan held; 0 when it was not kept.
+    pub(crate) len: [u8; FANS],
+    /// Each fan's neighbours and the owner's corner in each wedge, in walk
+    /// order (not yet rotated to the canonical start).
+    pub(crate) vertices: [[u32; FAN_LEN]; FANS],
+    pub(crate) corners: [[u32; FAN_LEN]; FANS],
+    /// The first slot that may hold a vertex not yet asked for.
+    pub(crate) cursor: usize,
+}
+
+/// Fans walked ahead at once.
+pub(crate) const FANS: usize = 24;
+/// Longest fan kept when walked ahead (typical valences; longer rings are
+/// walked when their vertex splits).
+pub(crate) const FAN_LEN: usize = 12;
+
+impl Default for FansAhead {
+    fn default() -> Self {
+        FansAhead {
+            owner: [NONE; FANS],
+            len: [0; FANS],
+            vertices: [[NONE; FAN_LEN]; FANS],
+            corners: [[NONE; FAN_LEN]; FANS],
+            cursor: 0,
         }
     }
 }
@@ -58,12 +100,52 @@ impl Ring {
     }
 }
 
+impl Ring {
+    /// Takes the ring of `r` from the fans walked ahead, if it is there:
+    /// rotated to its canonical start (SPEC §7.1, the smallest neighbour).
+    /// Vertices are asked for in ascending order.
+    fn take_ahead(&mut self, r: u32) -> bool {
+        let a = &mut self.ahead;
+        while a.cursor < FANS && a.owner[a.cursor] < r {
+            a.cursor += 1;
+        }
+        if a.cursor == FANS || a.owner[a.cursor] != r {
+            return false;
+        }
+        let i = a.cursor;
+        let k = (a.len[i] as usize).min(FAN_LEN);
+        if k == 0 {
+            return false;
+        }
+        let (vertices, corners) = (&a.vertices[i][..k], &a.corners[i][..k]);
+        let mut first = 0;
+        for (j, &v) in vertices.iter().enumerate() {
+            if v < vertices[first] {
+                first = j;
+            }
+        }
+        // Element-wise copies: a handful of entries, where `copy_from_slice`
+        // would call `memcpy`.
+        let mut j = first;
+        for (v, c) in self.vertices[..k].iter_mut().zip(&mut self.corners[..k]) {
+            *v = vertices[j];
+            *c = corners[j];
+            j = if j + 1 == k { 0 } else { j + 1 };
+        }
+        self.len = k;
+        true
+    }
+}
+
 impl MeshState<'_> {
     /// Fills `ring` with the canonical ring of `r` (SPEC §7.1). Fails with
     /// [`Error::ValenceOverflow`] when the ring is longer than 255.
     pub fn ring(&self, r: u32, ring: &mut Ring) -> Result<(), Error> {
         if r >= self.vertex_count {
             return Err(Error::NoSuchVertex);
+        }
+        if ring.take_ahead(r) {
+            return Ok(());
         }
         let start = self.vertex_corner.get(r);
         let mut c = start;
@@ -75,11 +157,10 @@ impl MeshState<'_> {
             ring.corners[n] = c;
             ring.vertices[n] = self.vertex_at(next(c));
             n += 1;
-            let o = self.opposite.get(next(c));
-            if o == NONE {
+            c = self.swing.get(c);
+            if c == NONE {
                 return self.boundary_ring(start, ring);
             }
-            c = next(o);
             if c == start {
                 break;
             }
@@ -92,15 +173,16 @@ impl MeshState<'_> {
     }
 
     fn boundary_ring(&self, start: u32, ring: &mut Ring) -> Result<(), Error> {
-        // Walk clockwise to the first wedge after the gap.
+        // Walk clockwise to the first wedge after the gap: the wedge before
+        // the one at corner c is at next(swing[next(c)]) (state.rs).
         let mut first = start;
         let mut steps = 0;
         loop {
-            let o = self.opposite.get(prev(first));
-            if o == NONE {
+            let s = self.swing.get(next(first));
+            if s == NONE {
                 break;
             }
-            first = prev(o);
+            first = next(s);
             steps += 1;
             if steps == MAX_SPLIT_VALENCE {
                 return Err(Error::ValenceOverflow);
@@ -117,14 +199,14 @@ impl MeshState<'_> {
             }
             ring.corners[m] = c;
             ring.vertices[m] = self.vertex_at(next(c));
-            let o = self.opposite.get(next(c));
-            if o == NONE {
+            let s = self.swing.get(c);
+            if s == NONE {
                 ring.vertices[m + 1] = self.vertex_at(prev(c));
                 ring.corners[m + 1] = NONE;
                 ring.len = m + 2;
                 return Ok(());
             }
-            c = next(o);
+            c = s;
             m += 1;
         }
     }

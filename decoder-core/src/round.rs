@@ -9,19 +9,18 @@
 
 use crate::Error;
 use crate::limits::NONE;
-use crate::ring::Ring;
+use crate::ring::{FAN_LEN, FANS, FansAhead, Ring};
 use crate::split::{SplitOutcome, SplitRecord};
 use crate::state::{MeshState, next};
 
-/// Flagged vertices whose fans are warmed together (see `warm_fans`).
+/// Candidates taken together, whose likely flagged ones have their fans
+/// walked ahead at once (see `walk_fans`).
 const WARM_BATCH: usize = 32;
-/// Wedges walked per fan when warming: typical valences, not the maximum.
-const WARM_STEPS: usize = 12;
-/// Fans are warmed only from this vertex count on: a smaller state (about
-/// 58 bytes a vertex, SPEC §9) stays in the caches, and walking its fans
-/// twice costs more than it saves (measured on this project's meshes:
-/// 17 % slower at 26k vertices, 4 % faster at 139k, 24 % at 1M).
-const WARM_FROM_VERTICES: u32 = 1 << 16;
+/// By default fans are walked ahead only from this vertex count on
+/// ([`MeshState::set_fans_ahead_from`]): a smaller state (about 58 bytes a
+/// vertex, SPEC §9) mostly stays in the caches, where the extra bookkeeping
+/// costs about as much as the overlapped misses save.
+pub const FANS_AHEAD_FROM_VERTICES: u32 = 1 << 16;
 
 /// Where a round gets its flags and split records from.
 pub trait RecordSource {
@@ -115,7 +114,7 @@ impl MeshState<'_> {
     ) -> Result<Option<Error>, Error> {
         let mut split_error = None;
         let mut batch = [0u32; WARM_BATCH];
-        let warm_up = n >= WARM_FROM_VERTICES;
+        let warm_up = n >= self.fans_ahead_from;
         for w in 0..words {
             // Candidates at round start: vertices below n with deficit 0.
             // Splits of this round only change the bits of blocked vertices
@@ -140,7 +139,7 @@ impl MeshState<'_> {
                 // another. (Where the flags are not known yet, every
                 // candidate's fan is warmed.)
                 if warm_up {
-                    self.warm_batch(&batch[..len], w, source);
+                    self.walk_batch(&batch[..len], w, source, &mut ring.ahead);
                 }
                 for &v in &batch[..len] {
                     if self.bitmaps().2[w] & (1u64 << (v % 64)) != 0 {
@@ -169,6 +168,8 @@ impl MeshState<'_> {
                         Err(e) => split_error = Some(e),
                     }
                 }
+                // The fans walked ahead are the batch's: none outlives it.
+                ring.ahead.owner = [NONE; FANS];
             }
         }
         Ok(split_error)
@@ -189,9 +190,16 @@ impl MeshState<'_> {
         }
     }
 
-    /// Warms the fans of the candidates of `batch` (all in bitmap word `w`)
-    /// that are not blocked and that `source` says are likely flagged.
-    fn warm_batch<S: RecordSource>(&mut self, batch: &[u32], w: usize, source: &mut S) {
+    /// Walks ahead the fans of the candidates of `batch` (all in bitmap
+    /// word `w`) that are not blocked and that `source` says are likely
+    /// flagged (see [`FansAhead`]).
+    fn walk_batch<S: RecordSource>(
+        &mut self,
+        batch: &[u32],
+        w: usize,
+        source: &mut S,
+        ahead: &mut FansAhead,
+    ) {
         let mut upcoming = [0u32; WARM_BATCH];
         let mut upcoming_len = 0;
         for &v in batch {
@@ -201,51 +209,77 @@ impl MeshState<'_> {
             }
         }
         let likely = source.likely_flags(self, &upcoming[..upcoming_len]);
-        let mut warm = [0u32; WARM_BATCH];
-        let mut warm_len = 0;
+        let mut walk = [0u32; WARM_BATCH];
+        let mut walk_len = 0;
         for (i, &v) in upcoming[..upcoming_len].iter().enumerate() {
             if likely >> i & 1 != 0 {
-                warm[warm_len] = v;
-                warm_len += 1;
+                walk[walk_len] = v;
+                walk_len += 1;
             }
         }
-        self.warm_fans(&warm[..warm_len]);
+        self.walk_fans(&walk[..walk_len], ahead);
     }
 
-    /// Walks the fans of `rs` in lockstep, reading the corners, opposites,
-    /// positions and deficits their splits will read, so that the cache misses of
-    /// independent fans overlap instead of queueing one dependent load after
-    /// another. Changes nothing: a pure performance measure.
-    fn warm_fans(&self, rs: &[u32]) {
-        let mut corner = [NONE; WARM_BATCH];
-        for (c, &r) in corner.iter_mut().zip(rs) {
+    /// Walks the fans of `rs` (ascending) in lockstep into `ahead`, then
+    /// touches the positions and deficits of the ring vertices met, so that
+    /// the cache misses of independent fans overlap instead of queueing one
+    /// dependent load after another. Each lockstep step is short (one swing
+    /// and one corner per fan), so that many fans' loads fit in the
+    /// processor's window at once; the positions, which depend on no
+    /// further load, come last, all together.
+    fn walk_fans(&self, rs: &[u32], ahead: &mut FansAhead) {
+        let count = rs.len().min(FANS);
+        let mut corner = [NONE; FANS];
+        for i in 0..FANS {
+            ahead.owner[i] = rs.get(i).copied().unwrap_or(NONE);
+            ahead.len[i] = 0;
+        }
+        ahead.cursor = 0;
+        for (c, &r) in corner.iter_mut().zip(&rs[..count]) {
             *c = self.vertex_corner.get(r);
         }
         let start = corner;
-        let mut sum = 0u32;
-        for _ in 0..WARM_STEPS {
-            let mut active = false;
-            for i in 0..rs.len() {
+        // Fans still being walked, as a bit mask.
+        let mut active: u32 = if count == 32 {
+            u32::MAX
+        } else {
+            (1 << count) - 1
+        };
+        for step in 0..FAN_LEN {
+            let mut left = active;
+            while left != 0 {
+                let i = left.trailing_zeros() as usize;
+                left &= left - 1;
                 let c = corner[i];
-                if c == NONE {
+                let Some(&v) = self.corners.get(next(c) as usize) else {
+                    active &= !(1 << i);
                     continue;
+                };
+                ahead.vertices[i][step] = v;
+                ahead.corners[i][step] = c;
+                let s = self.swing.get(c);
+                if s == start[i] {
+                    // Closed: the whole ring is held.
+                    ahead.len[i] = step as u8 + 1;
+                    active &= !(1 << i);
+                } else if s == NONE {
+                    // A boundary vertex: its ring is walked when it splits.
+                    active &= !(1 << i);
                 }
-                let v = self.corners[next(c) as usize];
+                corner[i] = s;
+            }
+            if active == 0 {
+                break;
+            }
+        }
+        let mut sum = 0u32;
+        for i in 0..count {
+            for &v in &ahead.vertices[i][..ahead.len[i] as usize] {
                 if let (Some(p), Some(&d)) =
                     (self.positions.get(v as usize), self.deficit.get(v as usize))
                 {
                     sum = sum.wrapping_add(p[0]).wrapping_add(d as u32);
                 }
-                let o = self.opposite.get(next(c));
-                corner[i] = if o == NONE || next(o) == start[i] {
-                    NONE
-                } else {
-                    next(o)
-                };
-                active |= corner[i] != NONE;
-            }
-            if !active {
-                break;
             }
         }
         core::hint::black_box(sum);

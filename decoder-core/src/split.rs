@@ -98,57 +98,70 @@ impl MeshState<'_> {
                 self.set_candidate(w, d);
             }
         }
-        // P (index r) owns arc 1 (from a to b), C arc 2.
-        let (x, y) = (r, c);
-        // Arc 2 runs from wedge o + d around to wedge o - 1 (mod k).
+        // P (index r) owns arc 1 (from a to b), C arc 2, which runs from
+        // wedge o + d around to wedge o - 1 (mod k).
         let corners = ring.corners();
         for &corner in corners[o + d..].iter().chain(&corners[..o]) {
             if corner != NONE {
                 self.corners[corner as usize] = c;
             }
         }
-        let wedge = |i: usize| corners[if i >= k { i - k } else { i }];
-        let before_a = wedge(o + k - 1);
-        let after_a = wedge(o);
-        let before_b = wedge(o + d - 1);
-        let after_b = wedge(o + d);
-        let mut next_t = t;
-        let ta = (a != NONE).then(|| {
-            let ta = next_t;
-            next_t += 1;
-            ta
-        });
-        let tb = (b != NONE).then(|| {
-            let tb = next_t;
-            next_t += 1;
-            tb
-        });
-        let facing = |corner: u32, f: fn(u32) -> u32| if corner == NONE { NONE } else { f(corner) };
+        // R's corners in the wedges on either side of each wing: before_a
+        // is C's now (arc 2), after_a P's, before_b P's, after_b C's.
+        let before_a = corners[if o == 0 { k - 1 } else { o - 1 }];
+        let after_a = corners[o];
+        let before_b = corners[o + d - 1];
+        let after_b = corners[o + d];
+        let (ta, tb) = match (a != NONE, b != NONE) {
+            (true, true) => (Some(t), Some(t + 1)),
+            (true, false) => (Some(t), None),
+            _ => (None, Some(t)),
+        };
+        // The new triangles are (P, C, a) and (C, P, b). Their swings, and
+        // the swings into them, follow from the wedges around them
+        // (state.rs: swing[x] is the corner of x's vertex in the next
+        // triangle counter-clockwise, NONE across a boundary edge):
+        //   around P: before_b → (C, P, b) → ... ; (P, C, a) → after_a
+        //   around C: before_a → (P, C, a) → (C, P, b) → after_b
+        //   around a: ... → (P, C, a) → the wedge before_a's triangle
+        //   around b: the wedge before_b's triangle → (C, P, b) → ...
+        let swing_of = |corner: u32, f: fn(u32) -> u32| {
+            if corner == NONE { NONE } else { f(corner) }
+        };
         if let Some(ta) = ta {
-            let base = 3 * ta as usize;
-            self.corners[base..base + 3].copy_from_slice(&[x, y, a]);
-            self.link(3 * ta, facing(before_a, next));
-            self.link(3 * ta + 1, facing(after_a, prev));
+            let (p, cc, w) = (3 * ta, 3 * ta + 1, 3 * ta + 2);
+            self.corners[p as usize..p as usize + 3].copy_from_slice(&[r, c, a]);
+            self.swing.set(p, after_a);
+            self.swing.set(cc, tb.map_or(NONE, |tb| 3 * tb));
+            self.swing.set(w, swing_of(before_a, prev));
+            if before_a != NONE {
+                self.swing.set(before_a, cc);
+            }
+            if after_a != NONE {
+                self.swing.set(next(after_a), w);
+            }
         }
         if let Some(tb) = tb {
-            let base = 3 * tb as usize;
-            self.corners[base..base + 3].copy_from_slice(&[y, x, b]);
-            self.link(3 * tb, facing(before_b, next));
-            self.link(3 * tb + 1, facing(after_b, prev));
+            let (cc, p, w) = (3 * tb, 3 * tb + 1, 3 * tb + 2);
+            self.corners[cc as usize..cc as usize + 3].copy_from_slice(&[c, r, b]);
+            self.swing.set(cc, after_b);
+            self.swing.set(p, ta.map_or(NONE, |ta| 3 * ta));
+            self.swing.set(w, swing_of(before_b, prev));
+            if before_b != NONE {
+                self.swing.set(before_b, p);
+            }
+            if after_b != NONE {
+                self.swing.set(next(after_b), w);
+            }
         }
-        match (ta, tb) {
-            (Some(ta), Some(tb)) => self.link(3 * ta + 2, 3 * tb + 2),
-            (Some(ta), None) => self.opposite.set(3 * ta + 2, NONE),
-            (None, Some(tb)) => self.opposite.set(3 * tb + 2, NONE),
-            (None, None) => {}
-        }
+        let next_t = t + added;
         let (corner_x, corner_y) = match (ta, tb) {
             (Some(ta), _) => (3 * ta, 3 * ta + 1),
             (None, Some(tb)) => (3 * tb + 1, 3 * tb),
             (None, None) => return Err(Error::RingOffsetOutOfRange),
         };
-        self.vertex_corner.set(x, corner_x);
-        self.vertex_corner.set(y, corner_y);
+        self.vertex_corner.set(r, corner_x);
+        self.vertex_corner.set(c, corner_y);
         self.positions[r as usize] = rec.position_p;
         self.positions[c as usize] = rec.position_c;
         self.deficit[r as usize] = rec.deficit_p;

@@ -1,32 +1,54 @@
 //! The decoder state of SPEC §6: positions, triangles, adjacency, deficits.
 //!
 //! Triangles are stored as a corner table: corner `c` is slot `c % 3` of
-//! triangle `c / 3`. `opposite[c]` is the corner facing `c` across the edge
-//! opposite `c` ([`NONE`] on a boundary), `vertex_corner[v]` any corner of `v`,
-//! both packed in 3 or 4 bytes per entry ([`CornerRefs`]). Only the
-//! positions, triangles and deficits are normative; the adjacency is this
-//! decoder's way of walking rings quickly.
+//! triangle `c / 3`. The adjacency is kept as a *swing* table: `swing[c]` is
+//! the corner of the same vertex in the next triangle counter-clockwise
+//! around it, `next(opposite(next(c)))` in terms of the classic opposite
+//! table, or [`NONE`] when the edge `prev(c) → c` is a boundary edge. A
+//! ring walk is then one load per wedge, with no `% 3` on its chain of
+//! dependent loads. `vertex_corner[v]` is any corner of `v`. Both are packed
+//! in 3 or 4 bytes per entry ([`CornerRefs`]). Only the positions,
+//! triangles and deficits are normative; the adjacency is this decoder's way
+//! of walking rings quickly.
 
 use crate::corner_refs::CornerRefs;
-use crate::limits::{LEAF, NONE};
+use crate::limits::LEAF;
 
-/// Next corner of the same triangle (counter-clockwise).
-#[inline]
+/// Whether `x` is a multiple of 3: multiplying by the inverse of 3 modulo
+/// 2^32 maps the multiples of 3 exactly onto `0 ..= (2^32 − 1) / 3`.
+#[inline(always)]
+fn multiple_of_3(x: u32) -> bool {
+    x.wrapping_mul(0xAAAA_AAAB) <= u32::MAX / 3
+}
+
+/// Next corner of the same triangle (counter-clockwise): `3t → 3t+1 →
+/// 3t+2 → 3t`. (Branch-free and without a division: corner walks run on
+/// it.)
+#[inline(always)]
 pub fn next(c: u32) -> u32 {
-    if c % 3 == 2 { c - 2 } else { c + 1 }
+    let after = c.wrapping_add(1);
+    if multiple_of_3(after) {
+        c.wrapping_sub(2)
+    } else {
+        after
+    }
 }
 
 /// Previous corner of the same triangle.
-#[inline]
+#[inline(always)]
 pub fn prev(c: u32) -> u32 {
-    if c.is_multiple_of(3) { c + 2 } else { c - 1 }
+    if multiple_of_3(c) {
+        c.wrapping_add(2)
+    } else {
+        c.wrapping_sub(1)
+    }
 }
 
 /// The mutable mesh a decoder refines, over caller-owned memory.
 pub struct MeshState<'ws> {
     pub(crate) positions: &'ws mut [[u32; 3]],
     pub(crate) corners: &'ws mut [u32],
-    pub(crate) opposite: CornerRefs<'ws>,
+    pub(crate) swing: CornerRefs<'ws>,
     pub(crate) vertex_corner: CornerRefs<'ws>,
     pub(crate) deficit: &'ws mut [u8],
     pub(crate) candidates: &'ws mut [u64],
@@ -34,6 +56,9 @@ pub struct MeshState<'ws> {
     pub(crate) triangle_count: u32,
     /// Triangle count the current level may reach (SPEC §7.6).
     pub(crate) triangle_limit: u32,
+    /// Rounds starting with this many vertices or more walk their fans
+    /// ahead (`round.rs`).
+    pub(crate) fans_ahead_from: u32,
     /// What the memory holds, fixed when the state is made (a split checks
     /// them, so they are not recomputed from the array lengths each time).
     vertex_capacity: u32,
@@ -46,9 +71,11 @@ pub struct StateMemory<'ws> {
     pub positions: &'ws mut [[u32; 3]],
     /// 3 per triangle.
     pub corners: &'ws mut [u32],
-    /// At least 3 per triangle; [`crate::Layout`] sizes it for base-mesh
-    /// scratch too (SPEC §9: `4 × (6 T0 + V0 + 1)` bytes).
-    pub opposite: CornerRefs<'ws>,
+    /// The swing table (see the module documentation): at least 3 entries
+    /// per triangle, in SPEC §9's region 3 ("opposite corners"), which
+    /// [`crate::Layout`] sizes for base-mesh scratch too (`4 × (6 T0 + V0 + 1)`
+    /// bytes).
+    pub swing: CornerRefs<'ws>,
     pub vertex_corner: CornerRefs<'ws>,
     pub deficit: &'ws mut [u8],
     /// Three bitmaps of one bit per vertex, one after the other: the current
@@ -64,7 +91,7 @@ impl<'ws> MeshState<'ws> {
         let StateMemory {
             positions,
             corners,
-            opposite,
+            swing,
             vertex_corner,
             deficit,
             candidates,
@@ -75,19 +102,20 @@ impl<'ws> MeshState<'ws> {
             n.min(by_bits).min(u32::MAX as u64 - 1) as u32
         };
         let triangle_capacity = {
-            let n = (corners.len().min(opposite.len()) / 3) as u64;
+            let n = (corners.len().min(swing.len()) / 3) as u64;
             n.min(crate::limits::MAX_TRIANGLES as u64) as u32
         };
         MeshState {
             positions,
             corners,
-            opposite,
+            swing,
             vertex_corner,
             deficit,
             candidates,
             vertex_count: 0,
             triangle_count: 0,
             triangle_limit: u32::MAX,
+            fans_ahead_from: crate::round::FANS_AHEAD_FROM_VERTICES,
             vertex_capacity,
             triangle_capacity,
             bits,
@@ -119,6 +147,15 @@ impl<'ws> MeshState<'ws> {
     /// (SPEC §7.6), whatever the workspace could hold.
     pub fn set_triangle_limit(&mut self, limit: u32) {
         self.triangle_limit = limit;
+    }
+
+    /// Makes rounds that start with at least `vertices` vertices walk the
+    /// fans of their upcoming splits ahead, many at once, so that their
+    /// cache misses overlap (default [`crate::FANS_AHEAD_FROM_VERTICES`];
+    /// 0: always, `u32::MAX`: never). A speed setting only: the decoded
+    /// state is the same whatever it is.
+    pub fn set_fans_ahead_from(&mut self, vertices: u32) {
+        self.fans_ahead_from = vertices;
     }
 
     /// Quantized positions of the current vertices, in decoded order.
@@ -175,12 +212,19 @@ impl<'ws> MeshState<'ws> {
     pub(crate) fn vertex_at(&self, corner: u32) -> u32 {
         self.corners[corner as usize]
     }
+}
 
-    #[inline]
-    pub(crate) fn link(&mut self, a: u32, b: u32) {
-        self.opposite.set(a, b);
-        if b != NONE {
-            self.opposite.set(b, a);
+#[cfg(test)]
+mod tests {
+    use super::{next, prev};
+
+    #[test]
+    fn next_and_prev_stay_in_their_triangle() {
+        let triangles = [0u32, 1, 2, 1000, 0x1555_5554, 0x5555_5553, 0x5555_5554];
+        for t in triangles {
+            let c = 3 * t;
+            assert_eq!([next(c), next(c + 1), next(c + 2)], [c + 1, c + 2, c]);
+            assert_eq!([prev(c), prev(c + 1), prev(c + 2)], [c + 2, c, c + 1]);
         }
     }
 }

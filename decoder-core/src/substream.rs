@@ -11,10 +11,9 @@
 
 use crate::inflate::Inflater;
 use crate::level_header::LevelHeader;
-use crate::limits::rans::TABLE_WORDS;
 use crate::limits::substream::SLOTS;
 use crate::limits::{codec, substream};
-use crate::rans::{self, LANE_WORDS};
+use crate::rans::ChunkDecoder;
 use crate::{ChecksumScope, Error, bytes::crc32};
 
 struct Reader<'b> {
@@ -24,14 +23,13 @@ struct Reader<'b> {
     payload_at: usize,
     /// Byte codecs: the current chunk's raw bytes.
     buf: &'b mut [u8],
-    /// rANS: the tables (`TABLE_WORDS`), then `LANE_WORDS` per lane.
-    words: &'b mut [u32],
+    /// rANS: the current chunk's tables and lanes, in the slot's memory
+    /// (`None` when the slot is too small for them).
+    chunk: Option<ChunkDecoder<'b>>,
     rans: bool,
     /// Byte codecs: bytes of the chunk and bytes read; rANS: values.
     len: usize,
     pos: usize,
-    /// rANS: lane of the next value.
-    lane: usize,
     bit_byte: u8,
     bit_index: u8,
     /// rANS bit substreams: values decoded ahead of the reader (bit i is
@@ -74,13 +72,11 @@ impl<'l, 'b> Substreams<'l, 'b> {
                     .chunk(k)
                     .is_ok_and(|e| e.substream == id && e.codec == codec::RANS)
             });
-            let words_needed = TABLE_WORDS + LANE_WORDS * lane_count as usize;
-            let (buf, words): (&mut [u8], &mut [u32]) = if rans {
+            let (buf, chunk) = if rans {
                 let words = bytemuck::try_cast_slice_mut::<u8, u32>(buf).unwrap_or(&mut []);
-                let len = words.len().min(words_needed);
-                (&mut [], &mut words[..len])
+                (&mut [][..], ChunkDecoder::new(words, lane_count as usize))
             } else {
-                (buf, &mut [])
+                (buf, None)
             };
             Reader {
                 id,
@@ -88,11 +84,10 @@ impl<'l, 'b> Substreams<'l, 'b> {
                 end_chunk: 0,
                 payload_at: 0,
                 buf,
-                words,
+                chunk,
                 rans,
                 len: 0,
                 pos: 0,
-                lane: 0,
                 bit_byte: 0,
                 bit_index: 8,
                 ahead: 0,
@@ -175,28 +170,20 @@ impl<'l, 'b> Substreams<'l, 'b> {
     }
 
     /// Next value of the rANS-coded substream in `slot`, in `context` (SPEC §5.5).
-    #[inline]
+    #[inline(always)]
     fn rans_value(&mut self, slot: usize, context: u8) -> Result<u32, Error> {
         let r = &mut self.readers[slot];
         if r.pos == r.len {
             self.refill(slot)?;
         }
         let r = &mut self.readers[slot];
-        let (table, lanes) = r.words.split_at_mut(TABLE_WORDS);
-        let at = r.lane * LANE_WORDS;
-        let value = rans::decode_value(
-            self.level,
-            table,
-            context as usize,
-            &mut lanes[at..at + LANE_WORDS],
-        )?;
+        let Some(chunk) = r.chunk.as_mut() else {
+            return Err(Error::CapacityExceeded);
+        };
+        let value = chunk.decode(self.level, context as usize)?;
         r.pos += 1;
-        r.lane += 1;
-        if r.lane * LANE_WORDS == lanes.len() {
-            r.lane = 0;
-        }
         // The chunk's last value: every lane must end exactly here.
-        if r.pos == r.len && !rans::lanes_exhausted(lanes) {
+        if r.pos == r.len && !chunk.exhausted() {
             return Err(Error::InvalidRansChunk("a lane did not end exactly"));
         }
         Ok(value)
@@ -365,16 +352,17 @@ fn open_rans_chunk(
     stored_len: usize,
     values: u32,
 ) -> Result<(), Error> {
-    let (table, lanes) = r.words.split_at_mut(TABLE_WORDS.min(r.words.len()));
-    if lanes.is_empty() {
+    let Some(chunk) = r.chunk.as_mut() else {
         return Err(Error::CapacityExceeded);
-    }
-    let (mut at, end) = (r.payload_at, r.payload_at + stored_len);
+    };
     let contexts = substream::CONTEXTS[r.id as usize] as usize;
-    rans::read_tables(level, &mut at, end, contexts, table)?;
-    rans::open_lanes(level, at, end, values, lanes)?;
-    r.lane = 0;
-    Ok(())
+    chunk.open(
+        level,
+        r.payload_at,
+        r.payload_at + stored_len,
+        contexts,
+        values,
+    )
 }
 
 #[cfg(all(test, feature = "alloc"))]
@@ -383,6 +371,7 @@ mod tests {
     use crate::context::SINGLE;
     use crate::header::PositionMode;
     use crate::limits::rans::TABLE_WORDS;
+    use crate::rans::LANE_WORDS;
     use crate::writer::{ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, frame_level};
     use alloc::vec;
     use alloc::vec::Vec;

@@ -43,6 +43,7 @@ proptest! {
         if let Err(msg) = streams::check_against(&g, &d) {
             return Err(TestCaseError::fail(msg));
         }
+        streams::check_fans_ahead(&g.stream, &d).map_err(TestCaseError::fail)?;
         prop_assert_eq!(d.positions.len() as u32, g.base_vertices + g.splits);
         let chi = check_oriented_manifold(d.positions.len(), &d.triangles)
             .map_err(TestCaseError::fail)?;
@@ -57,6 +58,7 @@ proptest! {
     fn injected_faults_give_the_replays_error(choices in proptest::collection::vec(any::<u8>(), 0..2048)) {
         let g = streams::generate(&mut Choices::new(&choices), true);
         let d = streams::decode_full(&g.stream);
+        streams::check_fans_ahead(&g.stream, &d).map_err(TestCaseError::fail)?;
         if let Err(msg) = streams::check_against(&g, &d) {
             return Err(TestCaseError::fail(msg));
         }

@@ -23,6 +23,9 @@ fuzz_target!(|data: &[u8]| {
     let (params, levels) = streams::mutate_levels(seed, &mut Choices::new(ops));
     let stream = streams::frame(&params, &levels, seed.seeded);
     let decoded = streams::decode_full(&stream);
+    if let Err(msg) = streams::check_fans_ahead(&stream, &decoded) {
+        panic!("{msg}");
+    }
     if ops.is_empty() {
         streams::check_against(seed, &decoded).unwrap();
     }

@@ -2,7 +2,8 @@
 //! split records from the fuzz bytes (valid by construction, with rare
 //! injected faults), writes the chosen records into a stream, decodes it and
 //! compares the decoder with the replay after every round: same state
-//! hashes, same final mesh, or the very same error.
+//! hashes, same final mesh, or the very same error; and the decoder with
+//! fans walked ahead in every round with the default one.
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
@@ -13,5 +14,8 @@ fuzz_target!(|data: &[u8]| {
     let decoded = streams::decode_full(&g.stream);
     if let Err(msg) = streams::check_against(&g, &decoded) {
         panic!("decoder and replay disagree: {msg}");
+    }
+    if let Err(msg) = streams::check_fans_ahead(&g.stream, &decoded) {
+        panic!("{msg}");
     }
 });

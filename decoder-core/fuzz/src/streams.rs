@@ -28,9 +28,9 @@ use splitstream_decoder_core::writer::{
     write_stream_seeded,
 };
 use splitstream_decoder_core::{
-    Decoder, Error, Inflater, Layout, MeshState, Plane, PlanePolicy, PositionMode, RecordSource,
-    Ring, SplitRecord, Target, add_residual, arc_means, constrained_positions, context, predict,
-    residual, workspace_len,
+    Decoder, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane, PlanePolicy,
+    PositionMode, RecordSource, Ring, SplitRecord, Target, add_residual, arc_means,
+    constrained_positions, context, predict, residual, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -603,6 +603,17 @@ pub struct Decoded {
 
 /// Decodes `stream` round by round with the no-alloc API into `workspace`.
 pub fn decode_rounds(stream: &[u8], workspace: &mut [u8], inflater: &mut Inflater) -> Decoded {
+    decode_rounds_with(stream, workspace, inflater, FANS_AHEAD_FROM_VERTICES)
+}
+
+/// [`decode_rounds`] with fans walked ahead from `fans_ahead_from` vertices
+/// on (a speed setting that must not change any result).
+pub fn decode_rounds_with(
+    stream: &[u8],
+    workspace: &mut [u8],
+    inflater: &mut Inflater,
+    fans_ahead_from: u32,
+) -> Decoded {
     let mut out = Decoded {
         hashes: Vec::new(),
         level_hashes: Vec::new(),
@@ -621,6 +632,7 @@ pub fn decode_rounds(stream: &[u8], workspace: &mut [u8], inflater: &mut Inflate
         }
     };
     out.levels_that_fit = decoder.levels_that_fit();
+    decoder.set_fans_ahead_from(fans_ahead_from);
     let result = (|| -> Result<(), Error> {
         while let Some(k) = decoder.next_level() {
             let range = decoder.level_range(k);
@@ -648,10 +660,37 @@ pub fn decode_rounds(stream: &[u8], workspace: &mut [u8], inflater: &mut Inflate
 
 /// Decodes with a workspace of exactly the needed size.
 pub fn decode_full(stream: &[u8]) -> Decoded {
+    decode_full_with(stream, FANS_AHEAD_FROM_VERTICES)
+}
+
+/// [`decode_full`] with fans walked ahead from `fans_ahead_from` vertices on.
+pub fn decode_full_with(stream: &[u8], fans_ahead_from: u32) -> Decoded {
     let len = workspace_len(stream).unwrap_or(0).min(64 << 20);
     let mut ws = vec![0u8; len];
     let mut inflater = Box::new(Inflater::new());
-    decode_rounds(stream, &mut ws, &mut inflater)
+    decode_rounds_with(stream, &mut ws, &mut inflater, fans_ahead_from)
+}
+
+/// Checks that walking fans ahead in every round (`set_fans_ahead_from(0)`)
+/// decodes `stream` exactly as `d`, the default decode, did: the same
+/// hashes after every round, the same error, the same final mesh.
+pub fn check_fans_ahead(stream: &[u8], d: &Decoded) -> Result<(), String> {
+    let ahead = decode_full_with(stream, 0);
+    if ahead.hashes != d.hashes
+        || ahead.error != d.error
+        || ahead.triangles != d.triangles
+        || ahead.positions != d.positions
+        || ahead.deficits != d.deficits
+    {
+        return Err(format!(
+            "walking fans ahead changed the decode: {} hashes and error {:?}, against {} and {:?}",
+            ahead.hashes.len(),
+            ahead.error,
+            d.hashes.len(),
+            d.error
+        ));
+    }
+    Ok(())
 }
 
 /// Checks a decode against the replay that generated the stream.

@@ -84,7 +84,7 @@ impl Memory {
             StateMemory {
                 positions: &mut self.positions,
                 corners: &mut self.corners,
-                opposite: CornerRefs::new(bytemuck::cast_slice_mut(&mut self.opposite), self.width),
+                swing: CornerRefs::new(bytemuck::cast_slice_mut(&mut self.opposite), self.width),
                 vertex_corner: CornerRefs::new(
                     bytemuck::cast_slice_mut(&mut self.vertex_corner),
                     self.width,
