@@ -122,6 +122,7 @@ pub fn floor_div(s: i64, n: i64) -> i64 {
 /// The statistics of SPEC §7.4 for the split of a vertex at `parent` whose
 /// ring is `ring`, with wings at ring positions `offset` and
 /// `offset + distance` (`1 <= distance`, `offset + distance < ring.len()`).
+#[inline]
 pub fn arc_means(
     positions: &[[u32; 3]],
     parent: [u32; 3],
@@ -229,6 +230,7 @@ pub const OPTIMAL_WEIGHTS: [i64; 3] = [1, 4, -1];
 /// The prediction of `target` (relative to R for P and C, SPEC §7.4):
 /// `(w_W m_W + w_own m_own + w_other m_other) >> 4` per axis, where the own
 /// arc is arc 1 for P and arc 2 for C and for the edge.
+#[inline]
 pub fn predict(means: &ArcMeans, mode: PositionMode, target: Target) -> [i64; 3] {
     let weights = match (mode, target) {
         (PositionMode::Constrained, Target::Edge) => CONSTRAINED_EDGE_WEIGHTS,
@@ -247,6 +249,7 @@ pub fn predict(means: &ArcMeans, mode: PositionMode, target: Target) -> [i64; 3]
 
 /// Constrained mode's positions of P and C (SPEC §7.4) from R and the
 /// decoded vector `x` of the placement code's target.
+#[inline]
 pub fn constrained_positions(parent: [u32; 3], code: u8, x: [i64; 3]) -> ([i64; 3], [i64; 3]) {
     let r = parent.map(|v| v as i64);
     match code {
@@ -277,6 +280,7 @@ pub struct Plane {
 
 impl Plane {
     /// The plane of a split with statistics `means` under `policy`.
+    #[inline]
     pub fn new(policy: PlanePolicy, means: &ArcMeans) -> Plane {
         match policy {
             PlanePolicy::Off => Plane::with_normal(policy, [0; 3]),
@@ -287,6 +291,7 @@ impl Plane {
     /// The plane of a split whose shifted normal `n` (SPEC §7.4
     /// `plane_of`) is known, under `policy` (`n` is ignored under `off`).
     /// An encoder trying every policy computes `n` once.
+    #[inline]
     pub fn with_normal(policy: PlanePolicy, n: [i64; 3]) -> Plane {
         let (normal, axis) = match policy {
             PlanePolicy::Off => {
@@ -423,6 +428,7 @@ pub fn round_div(p: i64, q: i64) -> i64 {
 /// and `|m_I2 − m_I1|` (two floor means of positions relative to the same R)
 /// are at most `2^31 − 1`; each product is below `2^62` and each component
 /// below `2^63`.
+#[inline]
 pub fn normal(means: &ArcMeans) -> [i64; 3] {
     let Some(a) = means.wing_edge else {
         return [0; 3];
@@ -446,6 +452,7 @@ fn cross(a: [i64; 3], b: [i64; 3]) -> [i64; 3] {
 /// Constrained mode's context of the placement code (SPEC §5.5.5): where
 /// R lies along the direction `a = m_I2 − m_I1` from arc 1 to arc 2, from
 /// `T = −G·a` against `Q = nG |a|²`, in 128-bit arithmetic.
+#[inline]
 pub fn placement_context(means: &ArcMeans) -> u8 {
     let a: [i64; 3] = core::array::from_fn(|k| means.arc_2[k] - means.arc_1[k]);
     let g = means.sum;

@@ -196,7 +196,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
     }
 
     /// Next byte-sized value of `slot` (SPEC §5.4, §5.5).
-    #[inline]
+    #[inline(always)]
     pub fn byte(&mut self, slot: usize, context: u8) -> Result<u8, Error> {
         if self.is_rans(slot) {
             let v = self.rans_value(slot, context)?;
@@ -300,7 +300,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// Next LEB128 varint of `slot`: at most 5 bytes, at most 32 bits,
     /// minimal (a multi-byte varint does not end in a zero byte) (SPEC §5.4).
     /// Under rANS, one value of the hybrid code (SPEC §5.5).
-    #[inline]
+    #[inline(always)]
     pub fn varint(&mut self, slot: usize, context: u8) -> Result<u32, Error> {
         if self.is_rans(slot) {
             return self.rans_value(slot, context);
@@ -324,7 +324,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
     }
 
     /// Zigzag-decoded signed varint (SPEC §5.4).
-    #[inline]
+    #[inline(always)]
     pub fn signed(&mut self, slot: usize, context: u8) -> Result<i32, Error> {
         let u = self.varint(slot, context)?;
         Ok(((u >> 1) as i32) ^ -((u & 1) as i32))

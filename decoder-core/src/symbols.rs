@@ -39,6 +39,7 @@ impl WingCandidates {
     }
 
     /// The ring position of the `n`-th eligible entry (from 0), if any.
+    #[inline]
     fn select(&self, mut n: usize) -> Option<usize> {
         for (k, &word) in self.mask.iter().enumerate() {
             let ones = word.count_ones() as usize;
@@ -104,6 +105,7 @@ impl MeshState<'_> {
     /// candidate when the round started. Meaningful while a round runs
     /// (inside [`crate::RecordSource::record`]); between rounds every entry
     /// is eligible.
+    #[inline]
     pub fn wing_candidates(&self, ring: &Ring) -> WingCandidates {
         // The round-start copy of the candidate bitmap (SPEC §9, region 6).
         let third = self.candidates.len() / 3;
