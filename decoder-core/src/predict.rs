@@ -132,50 +132,34 @@ pub fn arc_means(
 ) -> ArcMeans {
     let vertices = ring.vertices();
     let b_at = offset + distance;
+    if distance == 0 || b_at >= vertices.len() {
+        return ArcMeans::default();
+    }
     let origin = parent.map(|x| x as i64);
-    // Sums relative to R and counts of the real entries of each set (the
-    // ghost, NONE, has no position). Coordinates are below 2^31 and a ring
-    // has at most 255 entries: every sum stays below 2^39 in magnitude.
-    let add = |entries: &[u32], sum: &mut [i64; 3]| -> i64 {
-        let mut n = 0;
+    // Sums relative to R and counts of the real entries of a run of the
+    // ring (the ghost, NONE, has no position). Coordinates are below 2^31
+    // and a ring has at most 255 entries: every sum stays below 2^39.
+    let sum = |entries: &[u32]| -> ([i64; 3], i64) {
+        let (mut s, mut n) = ([0i64; 3], 0);
         for &v in entries {
             if let Some(p) = positions.get(v as usize) {
-                sum[0] += p[0] as i64 - origin[0];
-                sum[1] += p[1] as i64 - origin[1];
-                sum[2] += p[2] as i64 - origin[2];
+                s[0] += p[0] as i64 - origin[0];
+                s[1] += p[1] as i64 - origin[1];
+                s[2] += p[2] as i64 - origin[2];
                 n += 1;
             }
         }
-        n
+        (s, n)
     };
-    let (mut arc_1, mut arc_2) = ([0i64; 3], [0i64; 3]);
-    let (n_1, n_2) = match (
-        vertices.get(offset + 1..b_at),
-        vertices.get(b_at + 1..),
-        vertices.get(..offset),
-    ) {
-        (Some(inner), Some(after), Some(before)) => (
-            add(inner, &mut arc_1),
-            add(after, &mut arc_2) + add(before, &mut arc_2),
-        ),
-        _ => (0, 0),
-    };
-    let wing = |at: usize| {
-        vertices
-            .get(at)
-            .and_then(|&v| positions.get(v as usize))
-            .map(|p| [p[0] as i64, p[1] as i64, p[2] as i64])
-    };
-    let (a, b) = (wing(offset), wing(b_at));
-    let relative = |p: &[i64; 3]| -> [i64; 3] { core::array::from_fn(|k| p[k] - origin[k]) };
-    let (wings, n_wings) = match (&a, &b) {
-        (Some(a), Some(b)) => {
-            let sum: [i64; 3] = core::array::from_fn(|k| a[k] + b[k] - 2 * origin[k]);
-            (sum, 2)
-        }
-        (Some(w), None) | (None, Some(w)) => (relative(w), 1),
-        (None, None) => ([0; 3], 0),
-    };
+    let (arc_1, n_1) = sum(&vertices[offset + 1..b_at]);
+    let (after, n_after) = sum(&vertices[b_at + 1..]);
+    let (before, n_before) = sum(&vertices[..offset]);
+    let arc_2: [i64; 3] = core::array::from_fn(|k| after[k] + before[k]);
+    let n_2 = n_after + n_before;
+    let (a, n_a) = sum(&vertices[offset..offset + 1]);
+    let (b, n_b) = sum(&vertices[b_at..b_at + 1]);
+    let wings: [i64; 3] = core::array::from_fn(|k| a[k] + b[k]);
+    let n_wings = n_a + n_b;
     let mean = |sum: &[i64; 3], n: i64| -> [i64; 3] {
         match n {
             0 => [0; 3],
@@ -184,17 +168,14 @@ pub fn arc_means(
             _ => sum.map(|s| floor_div(s, n)),
         }
     };
-    let wing_edge = match (a, b) {
-        (Some(a), Some(b)) => Some(core::array::from_fn(|k| b[k] - a[k])),
-        _ => None,
-    };
     ArcMeans {
         wings: mean(&wings, n_wings),
         arc_1: mean(&arc_1, n_1),
         arc_2: mean(&arc_2, n_2),
         sum: core::array::from_fn(|k| wings[k] + arc_1[k] + arc_2[k]),
         count: n_wings + n_1 + n_2,
-        wing_edge,
+        // Both wings real: pos[b] − pos[a] (relative to R on both sides).
+        wing_edge: (n_a == 1 && n_b == 1).then(|| core::array::from_fn(|k| b[k] - a[k])),
     }
 }
 
