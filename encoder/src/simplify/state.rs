@@ -336,25 +336,35 @@ pub fn simplify(
         let state = steps.len() as u32 + 1;
         phases.lap("loop");
         if alive_count * 5 < edge_measured_at * 4 {
+            let old_flat = flat_of(edge);
             edge = meter.measure(&s);
             edge_measured_at = alive_count;
             // The sub-grid and the flat threshold change with the scale:
-            // every request chooses again under the new one. (Requests kept
-            // from the old scale would compare keys and cells of two scales;
-            // on a DEM in degrees and metres, where the flat threshold is
-            // above most errors and the tie-breaks decide, the steps then
-            // found few collapses each.)
+            // every request that they can change chooses again under the
+            // new one. (Requests kept from the old scale would compare keys
+            // and cells of two scales; on a DEM in degrees and metres, where
+            // the flat threshold is above most errors and the tie-breaks
+            // decide, the steps then found few collapses each.)
+            let bound = old_flat.max(flat_of(edge));
+            let mut kept = 0usize;
             for &v in &live {
-                if std::mem::replace(&mut t.listed[v as usize], state) != state {
+                if t.listed[v as usize] == state {
+                    continue;
+                }
+                if rescaled_keeps(&t, v, bound) {
+                    kept += 1;
+                } else {
+                    t.listed[v as usize] = state;
                     choosers.push(v);
                 }
+            }
+            if debug {
+                eprintln!("rescale: {kept} of {} requests kept", live.len());
             }
         }
         let scale = Scale {
             cell: options.subgrid_cells * edge,
-            // A collapse moving the surface by 1e-4 of an edge length or less
-            // (error ~ area x distance^2 ~ L^2 x (1e-4 L)^2) counts as flat.
-            flat: 1e-8 * edge.powi(4),
+            flat: flat_of(edge),
         };
         let t_best = std::time::Instant::now();
         phases.lap("measure");
@@ -524,6 +534,35 @@ pub fn simplify(
         alive: s.alive,
         alive_count,
         step_errors,
+    }
+}
+
+/// The flat threshold of the tie-breaks ([`Scale::flat`]) for a mean edge
+/// length: a collapse moving the surface by 1e-4 of an edge length or less
+/// (error ~ area x distance^2 ~ L^2 x (1e-4 L)^2) counts as flat.
+fn flat_of(edge: f64) -> f64 {
+    1e-8 * edge.powi(4)
+}
+
+/// Whether the request of `v` stays what [`pick_edge`] would choose when the
+/// scale changes and no flat threshold, old or new, reaches `bound`: its
+/// error is above both (so its key is the same under both) and its
+/// runner-up's key is higher (so no tie-break, whose sub-grid changed,
+/// decided it). Every other candidate then keeps a higher key too. (A
+/// vertex without a request chooses again: it may have chosen while its
+/// neighbours were blocked.) The runner-up's key stays right as well; a tie
+/// behind it could be broken the other way, which only picks another
+/// runner-up of the same key.
+fn rescaled_keeps(t: &Tracking, v: u32, bound: f64) -> bool {
+    let v = v as usize;
+    let best = t.best[v];
+    if best.other == NONE || best.error <= bound {
+        return false;
+    }
+    match t.second[v] {
+        Some(second) if second.other == NONE => true,
+        Some(second) if second.error_key > best.error_key => true,
+        _ => false,
     }
 }
 
