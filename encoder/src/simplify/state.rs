@@ -494,6 +494,7 @@ pub fn simplify(
             same_scale,
             &mut choosers,
             &mut offers,
+            &mut phases,
         );
         phases.lap("refresh");
         live.retain(|&v| s.alive[v as usize]);
@@ -607,43 +608,79 @@ fn take_offers(
     scale: Scale,
     state: u32,
 ) -> usize {
-    let mut offered = 0;
     let gone =
-        |t: &Tracking, u: u32| u != NONE && (!s.alive[u as usize] || t.merged[u as usize] == state);
-    for o in offers {
-        let x = o.x as usize;
-        if t.sorted[x] != state {
-            t.sorted[x] = state;
-            if t.listed[x] != state {
-                let second = t.second[x];
-                let second_gone = second.is_none_or(|b| gone(t, b.other));
-                if t.refusals[x] != 0 || (gone(t, t.best[x].other) && second_gone) {
-                    t.listed[x] = state;
-                    choosers.push(o.x);
-                } else {
-                    offered += 1;
-                    if gone(t, t.best[x].other) {
-                        // The runner-up is the best of what is left; what
-                        // comes after it is not known.
-                        let b = second.unwrap_or(Best::NONE);
-                        t.best[x] = b;
-                        t.second[x] = (b.other == NONE).then_some(Best::NONE);
-                    } else if second_gone {
-                        t.second[x] = None;
+        |merged: &[u32], u: u32| u != NONE && (!s.alive[u as usize] || merged[u as usize] == state);
+    // Each part of the vertex range takes the offers to its own vertices,
+    // in the order of `offers` (the parts scan the whole list: a compare
+    // per offer), so the requests come out as one pass in order gives them.
+    let n = t.best.len();
+    let size = part_size(n);
+    let Tracking {
+        best,
+        second,
+        listed,
+        sorted,
+        merged,
+        refusals,
+        ..
+    } = t;
+    let (merged, refusals): (&[u32], &[u32]) = (merged, refusals);
+    let parts: Vec<(Vec<u32>, usize)> = best
+        .par_chunks_mut(size)
+        .zip(second.par_chunks_mut(size))
+        .zip(listed.par_chunks_mut(size))
+        .zip(sorted.par_chunks_mut(size))
+        .enumerate()
+        .map(|(k, (((best, second), listed), sorted))| {
+            let lo = k * size;
+            let mut choose = Vec::new();
+            let mut offered = 0;
+            for o in offers {
+                let x = (o.x as usize).wrapping_sub(lo);
+                if x >= best.len() {
+                    continue;
+                }
+                if sorted[x] != state {
+                    sorted[x] = state;
+                    if listed[x] != state {
+                        let runner_up = second[x];
+                        let second_gone = runner_up.is_none_or(|b| gone(merged, b.other));
+                        let best_gone = gone(merged, best[x].other);
+                        if refusals[o.x as usize] != 0 || (best_gone && second_gone) {
+                            listed[x] = state;
+                            choose.push(o.x);
+                        } else {
+                            offered += 1;
+                            if best_gone {
+                                // The runner-up is the best of what is left;
+                                // what comes after it is not known.
+                                let b = runner_up.unwrap_or(Best::NONE);
+                                best[x] = b;
+                                second[x] = (b.other == NONE).then_some(Best::NONE);
+                            } else if second_gone {
+                                second[x] = None;
+                            }
+                        }
                     }
                 }
+                if listed[x] == state {
+                    continue;
+                }
+                let mut choices = Choices {
+                    best: best[x],
+                    second: second[x],
+                };
+                offer(s, o.x, &mut choices, o.r, o.facing, scale);
+                best[x] = choices.best;
+                second[x] = choices.second;
             }
-        }
-        if t.listed[x] == state {
-            continue;
-        }
-        let mut choices = Choices {
-            best: t.best[x],
-            second: t.second[x],
-        };
-        offer(s, o.x, &mut choices, o.r, o.facing, scale);
-        t.best[x] = choices.best;
-        t.second[x] = choices.second;
+            (choose, offered)
+        })
+        .collect();
+    let mut offered = 0;
+    for (choose, count) in parts {
+        choosers.extend(choose);
+        offered += count;
     }
     // Every chooser's refused edges are stale now (its 1-ring changed, or
     // it was refused and chooses without the refused edge).
@@ -653,6 +690,65 @@ fn take_offers(
         }
     }
     offered
+}
+
+/// Asks the cache for element `i` of `items` (all of its cache lines), where
+/// the target has a prefetch instruction; a hint, never a fault.
+#[inline(always)]
+pub(super) fn prefetch<T>(items: &[T], i: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(x) = items.get(i) {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let first = (x as *const T).cast::<i8>();
+        let last = first.wrapping_add(std::mem::size_of::<T>() - 1);
+        // SAFETY: SSE is part of the x86-64 baseline, and a prefetch reads
+        // nothing the program sees and never faults.
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(first);
+            if std::mem::size_of::<T>() > 64 {
+                _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(64));
+            }
+            _mm_prefetch::<_MM_HINT_T0>(last);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (items, i);
+}
+
+/// Prefetches, while the vertex at `i` of `list` is processed, what the
+/// fan walks of the next ones start from: the corner of the vertex 16
+/// ahead, and the first triangle (corners, opposites, edge slots) of the
+/// vertex 8 ahead. A fan walk is a chain of dependent loads; without this,
+/// each link waits for memory in turn.
+#[inline(always)]
+fn prefetch_ahead(s: &State, list: &[u32], i: usize) {
+    if let Some(&w) = list.get(i + 16) {
+        prefetch(&s.table.corner_of, w as usize);
+    }
+    if let Some(&w) = list.get(i + 8) {
+        prefetch_fan(s, w);
+    }
+}
+
+/// Prefetches the first triangle of the fan of `v` (whose corner should be
+/// in cache already), its position and quadric.
+#[inline(always)]
+fn prefetch_fan(s: &State, v: u32) {
+    let c = s.table.corner_of[v as usize];
+    if c != NONE {
+        let base = (c - c % 3) as usize;
+        prefetch(&s.table.vertex, base);
+        prefetch(&s.table.opposite, base);
+        prefetch(&s.edges, base);
+        prefetch(&s.edges, base + 2);
+    }
+}
+
+/// Size of the parts a per-vertex array is cut into when every part scans
+/// one list for the entries it owns (see `take_offers`): a few parts per
+/// thread, so the scans stay cheap and the work still balances.
+fn part_size(n: usize) -> usize {
+    n.div_ceil(4 * rayon::current_num_threads()).max(4096)
 }
 
 /// §2 step a for `vertices`, in parallel: their requests are replaced.
@@ -769,7 +865,11 @@ fn pick_all(
         let mut reopened = Vec::new();
         let picks: Vec<(u32, Choices)> = chunk
             .iter()
-            .map(|&v| (v, pick_edge(s, v, scale, known, &mut reopened)))
+            .enumerate()
+            .map(|(i, &v)| {
+                prefetch_ahead(s, chunk, i);
+                (v, pick_edge(s, v, scale, known, &mut reopened))
+            })
             .collect();
         (picks, reopened)
     })
@@ -1188,6 +1288,7 @@ fn refresh_edges(
     scale: Option<Scale>,
     choosers: &mut Vec<u32>,
     offers: &mut Vec<Offer>,
+    phases: &mut Phases,
 ) {
     let s_now: &State = s;
     let chunks = par_chunks_map(merged, |chunk| {
@@ -1195,30 +1296,38 @@ fn refresh_edges(
         let mut updates = Vec::with_capacity(7 * chunk.len());
         let mut offers = Vec::with_capacity(7 * chunk.len());
         let mut choices = Vec::with_capacity(if scale.is_some() { chunk.len() } else { 0 });
+        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(16);
         for &r in chunk {
+            // Edge (r, prev c) faces next c; a boundary edge (r, next c)
+            // faces prev c.
+            edges.clear();
+            s_now.table.for_each_corner(r, |c| {
+                edges.push((s_now.table.v(prev(c)), next(c)));
+                if s_now.table.o(prev(c)) == NONE {
+                    edges.push((s_now.table.v(next(c)), prev(c)));
+                }
+            });
+            // The neighbours' quadrics are the evaluations' cache misses:
+            // ask for them all at once.
+            for &(x, _) in &edges {
+                prefetch(&s_now.quadrics, x as usize);
+            }
             let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
-            let mut refresh = |x: u32, facing: u32| {
+            for &(x, facing) in &edges {
                 let slot = edge_slot(s_now, facing);
                 updates.push((s_now.slot_index(facing) as u32, slot));
                 offers.push(Offer { x, r, facing });
                 if let Some(ranking) = &mut ranking {
                     ranking.consider(x, facing, &slot);
                 }
-            };
-            // Edge (r, prev c) faces next c; a boundary edge (r, next c)
-            // faces prev c.
-            s_now.table.for_each_corner(r, |c| {
-                refresh(s_now.table.v(prev(c)), next(c));
-                if s_now.table.o(prev(c)) == NONE {
-                    refresh(s_now.table.v(next(c)), prev(c));
-                }
-            });
+            }
             if let Some(ranking) = ranking {
                 choices.push(ranking.choices());
             }
         }
         (updates, offers, choices)
     });
+    phases.lap("refresh (evaluate)");
     offers.clear();
     let mut chosen = Vec::with_capacity(merged.len());
     for (updates, chunk_offers, choices) in chunks {
