@@ -110,6 +110,10 @@ pub(super) struct State {
     pub metric: [f64; 3],
     pub constrained: bool,
     pub lock_boundary: bool,
+    /// Input id of each vertex: the CPU loop renumbers the live vertices
+    /// and triangles densely as they thin out ([`compact`]); records and
+    /// results are in input ids.
+    pub orig: Vec<u32>,
 }
 
 impl State {
@@ -144,6 +148,7 @@ impl State {
             metric,
             constrained: options.constrained,
             lock_boundary: options.lock_boundary,
+            orig: (0..n as u32).collect(),
         }
     }
 
@@ -224,6 +229,9 @@ struct Tracking {
     /// a vertex whose partner a collapse took falls back on it instead of
     /// walking its fan.
     second: Vec<Option<Best>>,
+    /// [`Choices::bound`] of each request; 0 where the request may not be
+    /// what a pick gives (chosen while neighbours were blocked).
+    bound: Vec<u32>,
     /// Requests chosen again within a step (blocked partners, refused
     /// edges), valid where `repick_at == state`; they never outlive it.
     repick: Vec<Best>,
@@ -251,6 +259,7 @@ impl Tracking {
         Tracking {
             best: vec![Best::NONE; n],
             second: vec![None; n],
+            bound: vec![u32::MAX; n],
             repick: vec![Best::NONE; n],
             repick_at: vec![0; n],
             changed: vec![0; n],
@@ -332,6 +341,12 @@ pub fn simplify(
     // vertices are gone since the last measure (a full pass over the corners).
     let mut meter = EdgeMeter::new(&s);
     let (mut edge, mut edge_measured_at) = (meter.measure(&s), alive_count);
+    // Positions and split valences by input id, of the vertices renumbered
+    // away (see `compact`).
+    let mut input = InputArrays {
+        positions: mesh.positions.clone(),
+        split_valence: vec![LEAF; n],
+    };
     while alive_count > options.target_vertices {
         let state = steps.len() as u32 + 1;
         phases.lap("loop");
@@ -351,7 +366,7 @@ pub fn simplify(
                 if t.listed[v as usize] == state {
                     continue;
                 }
-                if rescaled_keeps(&t, v, bound) {
+                if rescaled_keeps(&mut t, v, bound) {
                     kept += 1;
                 } else {
                     t.listed[v as usize] = state;
@@ -456,7 +471,19 @@ pub fn simplify(
         phases.lap("select");
         let mut collapses = Vec::with_capacity(winners.len());
         let mut step_error = 0.0f64;
-        for w in &winners {
+        for (i, w) in winners.iter().enumerate() {
+            // The next winners' vertices and fans (see `prefetch_ahead`).
+            if let Some(w) = winners.get(i + 4) {
+                for x in [w.p, w.best.other] {
+                    prefetch(&s.quadrics, x as usize);
+                    prefetch(&s.positions, x as usize);
+                }
+                let start = w.fans.0 as usize;
+                for &c in &buffers.fans[start..start + (w.fans.1 + w.fans.2) as usize] {
+                    prefetch(&s.table.vertex, c as usize);
+                    prefetch(&s.table.opposite, c as usize);
+                }
+            }
             debug_assert_eq!(
                 check_collapse(
                     &s,
@@ -494,11 +521,28 @@ pub fn simplify(
             same_scale,
             &mut choosers,
             &mut offers,
-            &mut phases,
         );
         phases.lap("refresh");
         live.retain(|&v| s.alive[v as usize]);
         phases.lap("retain");
+        // Renumber densely once half the vertices are gone: the passes then
+        // read whole cache lines of live data instead of scattered ones.
+        if live.len() * 2 < s.positions.len() {
+            let pairs: Vec<(u32, u32)> = winners.iter().map(|w| (w.p, w.best.other)).collect();
+            compact(
+                &mut s,
+                &mut t,
+                Renumbered {
+                    live: &mut live,
+                    pairs: &pairs,
+                    choosers: &mut choosers,
+                    offers: &mut offers,
+                    meter: &mut meter,
+                    input: &mut input,
+                },
+            );
+            phases.lap("compact");
+        }
         if debug {
             let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
             let now = std::time::Instant::now();
@@ -527,15 +571,188 @@ pub fn simplify(
     if debug {
         eprintln!("{}", phases.report());
     }
+    // Back to input ids.
+    input.save(&s);
+    let mut alive = vec![false; n];
+    let mut corner_of = vec![NONE; n];
+    for (i, &v) in s.orig.iter().enumerate() {
+        alive[v as usize] = s.alive[i];
+        corner_of[v as usize] = s.table.corner_of[i];
+    }
+    let orig = &s.orig;
+    let vertex = s
+        .table
+        .vertex
+        .par_iter()
+        .map(|&v| if v == NONE { NONE } else { orig[v as usize] })
+        .collect();
     Simplification {
         steps,
-        table: s.table,
-        positions: s.positions,
-        split_valence: s.split_valence,
-        alive: s.alive,
+        table: CornerTable {
+            vertex,
+            opposite: s.table.opposite,
+            corner_of,
+        },
+        positions: input.positions,
+        split_valence: input.split_valence,
+        alive,
         alive_count,
         step_errors,
     }
+}
+
+/// Per input id, the positions and split valences of the vertices as they
+/// were last renumbered (a vertex's never change once it is gone).
+struct InputArrays {
+    positions: Vec<[u32; 3]>,
+    split_valence: Vec<u8>,
+}
+
+impl InputArrays {
+    /// Saves every vertex of the current numbering, live or not.
+    fn save(&mut self, s: &State) {
+        for (i, &v) in s.orig.iter().enumerate() {
+            self.positions[v as usize] = s.positions[i];
+            self.split_valence[v as usize] = s.split_valence[i];
+        }
+    }
+}
+
+/// What the loop keeps in current ids besides the state and tracking, for
+/// [`compact`].
+struct Renumbered<'a> {
+    /// The live vertices, ascending (become 0..n).
+    live: &'a mut Vec<u32>,
+    /// (P, C) of the step just applied: requests still naming C (its
+    /// neighbours take their offers at the next step) name P instead, who
+    /// was merged at that step and so counts as taken just the same.
+    pairs: &'a [(u32, u32)],
+    choosers: &'a mut Vec<u32>,
+    offers: &'a mut Vec<Offer>,
+    meter: &'a mut EdgeMeter,
+    input: &'a mut InputArrays,
+}
+
+/// Renumbers the live vertices (in `live` order, ascending) and the live
+/// triangles (in order) densely, between two steps. Every comparison of ids
+/// (index priority, tie-breaks, the lower corner of an edge) keeps its
+/// outcome, so the collapses are the same, only cheaper to find: once most
+/// vertices are gone, each pass otherwise reads one live vertex per cache
+/// line and per page. The state numbers in the tracking stamps carry over.
+fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
+    let Renumbered {
+        live,
+        pairs,
+        choosers,
+        offers,
+        meter,
+        input,
+    } = r;
+    input.save(s);
+    let n = s.positions.len();
+    let mut vmap = vec![NONE; n];
+    for (i, &v) in live.iter().enumerate() {
+        vmap[v as usize] = i as u32;
+    }
+    for &(p, c) in pairs {
+        vmap[c as usize] = vmap[p as usize];
+    }
+    let table = &s.table;
+    let mut tmap = vec![NONE; table.vertex.len() / 3];
+    let mut triangles = Vec::with_capacity(2 * live.len());
+    for (k, slot) in tmap.iter_mut().enumerate() {
+        if table.vertex[3 * k] != NONE {
+            *slot = triangles.len() as u32;
+            triangles.push(k as u32);
+        }
+    }
+    let cmap = |c: u32| {
+        if c == NONE || tmap[(c / 3) as usize] == NONE {
+            NONE
+        } else {
+            3 * tmap[(c / 3) as usize] + c % 3
+        }
+    };
+    let vmap_of = |v: u32| if v == NONE { NONE } else { vmap[v as usize] };
+    // Corner arrays, by new corner: its old corner is 3 k + j.
+    let old = |c: usize| 3 * triangles[c / 3] as usize + c % 3;
+    let corners = 3 * triangles.len();
+    let vertex: Vec<u32> = (0..corners)
+        .into_par_iter()
+        .map(|c| vmap_of(table.vertex[old(c)]))
+        .collect();
+    let opposite: Vec<u32> = (0..corners)
+        .into_par_iter()
+        .map(|c| cmap(table.opposite[old(c)]))
+        .collect();
+    let edges: Vec<EdgeSlot> = (0..corners)
+        .into_par_iter()
+        .map(|c| s.edges[old(c)])
+        .collect();
+    let corner_of: Vec<u32> = live
+        .par_iter()
+        .map(|&v| cmap(table.corner_of[v as usize]))
+        .collect();
+    let live_now: &[u32] = live;
+    fn gather<T: Copy + Send + Sync>(items: &[T], live: &[u32]) -> Vec<T> {
+        live.par_iter().map(|&v| items[v as usize]).collect()
+    }
+    s.positions = gather(&s.positions, live_now);
+    s.quadrics = gather(&s.quadrics, live_now);
+    s.boundary = gather(&s.boundary, live_now);
+    s.valence = gather(&s.valence, live_now);
+    s.alive = vec![true; live_now.len()];
+    s.split_valence = gather(&s.split_valence, live_now);
+    s.orig = gather(&s.orig, live_now);
+    s.edges = edges;
+    s.table = CornerTable {
+        vertex,
+        opposite,
+        corner_of,
+    };
+    let remap = |b: Best| {
+        debug_assert!(b.other == NONE || vmap[b.other as usize] != NONE);
+        Best {
+            other: vmap_of(b.other),
+            corner: cmap(b.corner),
+            ..b
+        }
+    };
+    t.best = live_now
+        .par_iter()
+        .map(|&v| remap(t.best[v as usize]))
+        .collect();
+    t.second = live_now
+        .par_iter()
+        .map(|&v| t.second[v as usize].map(remap))
+        .collect();
+    t.bound = gather(&t.bound, live_now);
+    let m = live_now.len();
+    t.repick = vec![Best::NONE; m];
+    t.repick_at = vec![0; m];
+    t.changed = gather(&t.changed, live_now);
+    t.merged = gather(&t.merged, live_now);
+    t.refusals = gather(&t.refusals, live_now);
+    t.blocked = gather(&t.blocked, live_now);
+    t.listed = gather(&t.listed, live_now);
+    t.sorted = gather(&t.sorted, live_now);
+    t.keys = vec![u64::MAX; m];
+    for v in choosers.iter_mut() {
+        *v = vmap[*v as usize];
+    }
+    for o in offers.iter_mut() {
+        *o = Offer {
+            x: vmap[o.x as usize],
+            r: vmap[o.r as usize],
+            facing: cmap(o.facing),
+        };
+    }
+    meter.triangles = meter
+        .triangles
+        .iter()
+        .filter_map(|&k| Some(tmap[k as usize]).filter(|&k| k != NONE))
+        .collect();
+    *live = (0..m as u32).collect();
 }
 
 /// The flat threshold of the tie-breaks ([`Scale::flat`]) for a mean edge
@@ -546,24 +763,29 @@ fn flat_of(edge: f64) -> f64 {
 }
 
 /// Whether the request of `v` stays what [`pick_edge`] would choose when the
-/// scale changes and no flat threshold, old or new, reaches `bound`: its
-/// error is above both (so its key is the same under both) and its
-/// runner-up's key is higher (so no tie-break, whose sub-grid changed,
-/// decided it). Every other candidate then keeps a higher key too. (A
-/// vertex without a request chooses again: it may have chosen while its
-/// neighbours were blocked.) The runner-up's key stays right as well; a tie
-/// behind it could be broken the other way, which only picks another
-/// runner-up of the same key.
-fn rescaled_keeps(t: &Tracking, v: u32, bound: f64) -> bool {
+/// scale changes and no flat threshold, old or new, reaches `flat`: its
+/// error is above both (so its key is the same under both) and every other
+/// candidate's key is higher (so no tie-break, whose sub-grid changed,
+/// decided it); they then keep higher keys under the new scale too. A
+/// runner-up with a possible tie behind it becomes unknown (the new
+/// sub-grid could break the tie the other way). A vertex without a request,
+/// or whose request may not be a pick's, chooses again.
+fn rescaled_keeps(t: &mut Tracking, v: u32, flat: f64) -> bool {
     let v = v as usize;
-    let best = t.best[v];
-    if best.other == NONE || best.error <= bound {
+    let (best, bound) = (t.best[v], t.bound[v]);
+    if best.other == NONE || best.error <= flat || bound == 0 {
         return false;
     }
     match t.second[v] {
         Some(second) if second.other == NONE => true,
-        Some(second) if second.error_key > best.error_key => true,
-        _ => false,
+        Some(second) if second.error_key > best.error_key => {
+            if bound <= second.error_key {
+                t.second[v] = None;
+            }
+            true
+        }
+        Some(_) => false,
+        None => bound > best.error_key,
     }
 }
 
@@ -618,6 +840,7 @@ fn take_offers(
     let Tracking {
         best,
         second,
+        bound,
         listed,
         sorted,
         merged,
@@ -628,17 +851,29 @@ fn take_offers(
     let parts: Vec<(Vec<u32>, usize)> = best
         .par_chunks_mut(size)
         .zip(second.par_chunks_mut(size))
+        .zip(bound.par_chunks_mut(size))
         .zip(listed.par_chunks_mut(size))
         .zip(sorted.par_chunks_mut(size))
         .enumerate()
-        .map(|(k, (((best, second), listed), sorted))| {
+        .map(|(k, ((((best, second), bound), listed), sorted))| {
             let lo = k * size;
             let mut choose = Vec::new();
             let mut offered = 0;
-            for o in offers {
+            for (i, o) in offers.iter().enumerate() {
                 let x = (o.x as usize).wrapping_sub(lo);
                 if x >= best.len() {
                     continue;
+                }
+                // What the offers ahead read at random: the request, and
+                // the slot (through its corner's opposite).
+                if let Some(ahead) = offers.get(i + 8) {
+                    let y = (ahead.x as usize).wrapping_sub(lo);
+                    if y < best.len() {
+                        prefetch(best, y);
+                        prefetch(second, y);
+                        prefetch(&s.table.opposite, ahead.facing as usize);
+                        prefetch(&s.edges, ahead.facing as usize);
+                    }
                 }
                 if sorted[x] != state {
                     sorted[x] = state;
@@ -651,6 +886,8 @@ fn take_offers(
                             choose.push(o.x);
                         } else {
                             offered += 1;
+                            // Either way the bound of what comes after the
+                            // runner-up now bounds what comes after the best.
                             if best_gone {
                                 // The runner-up is the best of what is left;
                                 // what comes after it is not known.
@@ -669,10 +906,12 @@ fn take_offers(
                 let mut choices = Choices {
                     best: best[x],
                     second: second[x],
+                    bound: bound[x],
                 };
                 offer(s, o.x, &mut choices, o.r, o.facing, scale);
                 best[x] = choices.best;
                 second[x] = choices.second;
+                bound[x] = choices.bound;
             }
             (choose, offered)
         })
@@ -759,6 +998,7 @@ fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u3
         for (v, choices) in picks {
             t.best[v as usize] = choices.best;
             t.second[v as usize] = choices.second;
+            t.bound[v as usize] = choices.bound;
         }
         reopened.extend(chunk_reopened);
     }
@@ -829,6 +1069,9 @@ fn validate(
             }
             for x in [v, b.other] {
                 t.refusals[x as usize] = state;
+                // The other end may keep the refused edge as its request
+                // until its 1-ring changes: a rescale must not keep it.
+                t.bound[x as usize] = 0;
                 if in_step && t.listed[x as usize] != state + 1 {
                     t.listed[x as usize] = state + 1;
                     refused_ends.push(x);
@@ -839,6 +1082,11 @@ fn validate(
             return;
         }
         choose(s, t, &again, scale, state);
+        // Chosen without the step's blocked neighbours: a rescale must not
+        // keep these requests (`rescaled_keeps`).
+        for &v in &again {
+            t.bound[v as usize] = 0;
+        }
         let picks = pick_all(s, t, &overlay, scale, state);
         for (v, c) in picks.into_iter().flat_map(|(picks, _)| picks) {
             t.repick[v as usize] = c.best;
@@ -1091,7 +1339,25 @@ fn step_winners(
         let checked: Vec<Checked> = par_chunks_map(admitted_keys, |chunk| {
             let mut scratch = CheckScratch::default();
             let mut out = Checked::default();
-            for &(v, key) in chunk {
+            for (i, &(v, key)) in chunk.iter().enumerate() {
+                // Both fans and quadrics of the pairs ahead (see
+                // `prefetch_ahead`).
+                if let Some(&(w, _)) = chunk.get(i + 12) {
+                    let u = tr.request(w, state).other;
+                    if w < u {
+                        prefetch(&s_now.table.corner_of, w as usize);
+                        prefetch(&s_now.table.corner_of, u as usize);
+                    }
+                }
+                if let Some(&(w, _)) = chunk.get(i + 6) {
+                    let u = tr.request(w, state).other;
+                    if w < u {
+                        prefetch_fan(s_now, w);
+                        prefetch_fan(s_now, u);
+                        prefetch(&s_now.quadrics, w as usize);
+                        prefetch(&s_now.quadrics, u as usize);
+                    }
+                }
                 let b = tr.request(v, state);
                 let c = b.other;
                 if v > c {
@@ -1238,11 +1504,12 @@ fn prepare(s: &State, p: u32, b: Best, target: [u32; 3], plan: Plan) -> (Collaps
     } else {
         0.0
     };
+    let input = |v: u32| if v == NONE { NONE } else { s.orig[v as usize] };
     let record = Collapse {
-        p,
-        c,
-        wing_a: plan.wing_a,
-        wing_b: plan.wing_b,
+        p: input(p),
+        c: input(c),
+        wing_a: input(plan.wing_a),
+        wing_b: input(plan.wing_b),
         position_p: s.positions[p as usize],
         position_c: s.positions[c as usize],
         position_r: target,
@@ -1288,7 +1555,6 @@ fn refresh_edges(
     scale: Option<Scale>,
     choosers: &mut Vec<u32>,
     offers: &mut Vec<Offer>,
-    phases: &mut Phases,
 ) {
     let s_now: &State = s;
     let chunks = par_chunks_map(merged, |chunk| {
@@ -1297,7 +1563,8 @@ fn refresh_edges(
         let mut offers = Vec::with_capacity(7 * chunk.len());
         let mut choices = Vec::with_capacity(if scale.is_some() { chunk.len() } else { 0 });
         let mut edges: Vec<(u32, u32)> = Vec::with_capacity(16);
-        for &r in chunk {
+        for (i, &r) in chunk.iter().enumerate() {
+            prefetch_ahead(s_now, chunk, i);
             // Edge (r, prev c) faces next c; a boundary edge (r, next c)
             // faces prev c.
             edges.clear();
@@ -1311,6 +1578,7 @@ fn refresh_edges(
             // ask for them all at once.
             for &(x, _) in &edges {
                 prefetch(&s_now.quadrics, x as usize);
+                prefetch(&s_now.positions, x as usize);
             }
             let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
             for &(x, facing) in &edges {
@@ -1327,7 +1595,6 @@ fn refresh_edges(
         }
         (updates, offers, choices)
     });
-    phases.lap("refresh (evaluate)");
     offers.clear();
     let mut chosen = Vec::with_capacity(merged.len());
     for (updates, chunk_offers, choices) in chunks {
@@ -1347,6 +1614,7 @@ fn refresh_edges(
             Some(choices) => {
                 t.best[v] = choices.best;
                 t.second[v] = choices.second;
+                t.bound[v] = choices.bound;
                 // Its edges are all fresh: nothing refused to forget.
                 t.refusals[v] = 0;
             }
