@@ -77,6 +77,12 @@ impl CornerTable {
     /// not pair up as exactly two opposite half-edges are left unmatched
     /// (treated as boundary) rather than trusted.
     pub fn new(vertex_count: usize, triangles: &[[u32; 3]]) -> CornerTable {
+        Self::build(vertex_count, triangles).0
+    }
+
+    /// [`Self::new`], and whether every edge paired up or is used by one
+    /// triangle only: then exactly the edges used once are left unmatched.
+    pub fn build(vertex_count: usize, triangles: &[[u32; 3]]) -> (CornerTable, bool) {
         let vertex: Vec<u32> = triangles.iter().flatten().copied().collect();
         let mut opposite = vec![NONE; vertex.len()];
         // Group the corners by the undirected edge they face; the corner's
@@ -84,23 +90,27 @@ impl CornerTable {
         let from = |c: u32| vertex[next(c) as usize];
         let ends = |c: u32| (from(c), vertex[prev(c) as usize]);
         let keys = by_undirected_edge(vertex_count, vertex.len(), |c| Some(ends(c)));
+        let mut clean = true;
         for run in keys.chunk_by(|x, y| x.0 == y.0) {
             if let [(_, c0), (_, c1)] = *run
                 && from(c0) != from(c1)
             {
                 opposite[c0 as usize] = c1;
                 opposite[c1 as usize] = c0;
+            } else if run.len() != 1 {
+                clean = false;
             }
         }
         let mut corner_of = vec![NONE; vertex_count];
         for (c, &v) in vertex.iter().enumerate() {
             corner_of[v as usize] = c as u32;
         }
-        CornerTable {
+        let table = CornerTable {
             vertex,
             opposite,
             corner_of,
-        }
+        };
+        (table, clean)
     }
 
     pub fn v(&self, c: u32) -> u32 {

@@ -110,6 +110,9 @@ pub(super) struct State {
     pub metric: [f64; 3],
     pub constrained: bool,
     pub lock_boundary: bool,
+    /// Whether each vertex's fan holds all its corners and only the edges
+    /// used once are unmatched (see [`State::new`]).
+    pub manifold: bool,
     /// Input id of each vertex: the CPU loop renumbers the live vertices
     /// and triangles densely as they thin out ([`compact`]); records and
     /// results are in input ids.
@@ -122,19 +125,43 @@ impl State {
     pub fn new(mesh: &QuantizedMesh, options: &SimplifyOptions) -> State {
         let n = mesh.positions.len();
         let metric = mesh.metric;
-        let table = CornerTable::new(n, &mesh.triangles);
-        let mut boundary = vec![false; n];
-        for (c, &o) in table.opposite.iter().enumerate() {
-            if o == NONE {
-                boundary[table.v(next(c as u32)) as usize] = true;
-                boundary[table.v(prev(c as u32)) as usize] = true;
+        let (table, clean) = CornerTable::build(n, &mesh.triangles);
+        // Boundary flags and valences from each vertex's fan, in parallel;
+        // that holds where every vertex has one fan holding all its corners
+        // and the only unmatched edges are those used once (a checked mesh),
+        // which the fans' corner count tells.
+        let fans: Vec<(bool, u32)> = (0..n as u32)
+            .into_par_iter()
+            .map(|v| {
+                let (mut open, mut count) = (false, 0);
+                table.for_each_corner(v, |c| {
+                    count += 1;
+                    open |= table.o(prev(c)) == NONE;
+                });
+                (open, count)
+            })
+            .collect();
+        let manifold =
+            clean && fans.iter().map(|&(_, k)| k as usize).sum::<usize>() == table.vertex.len();
+        let (boundary, valence) = if manifold {
+            fans.into_iter()
+                .map(|(open, count)| (open, count + if open { 2 } else { 0 }))
+                .unzip()
+        } else {
+            let mut boundary = vec![false; n];
+            for (c, &o) in table.opposite.iter().enumerate() {
+                if o == NONE {
+                    boundary[table.v(next(c as u32)) as usize] = true;
+                    boundary[table.v(prev(c as u32)) as usize] = true;
+                }
             }
-        }
-        let alive: Vec<bool> = table.corner_of.iter().map(|&c| c != NONE).collect();
-        let mut valence: Vec<u32> = boundary.iter().map(|&b| if b { 2 } else { 0 }).collect();
-        for &v in &table.vertex {
-            valence[v as usize] += 1;
-        }
+            let mut valence: Vec<u32> = boundary.iter().map(|&b| if b { 2 } else { 0 }).collect();
+            for &v in &table.vertex {
+                valence[v as usize] += 1;
+            }
+            (boundary, valence)
+        };
+        let alive: Vec<bool> = table.corner_of.par_iter().map(|&c| c != NONE).collect();
         State {
             quadrics: Vec::new(),
             positions: mesh.positions.clone(),
@@ -149,7 +176,64 @@ impl State {
             constrained: options.constrained,
             lock_boundary: options.lock_boundary,
             orig: (0..n as u32).collect(),
+            manifold,
         }
+    }
+
+    /// [`vertex_quadrics`] of the input, summed per vertex over its fan in
+    /// parallel, in the same order (its triangles ascending, then its
+    /// boundary edges by key), so the same bits; `None` where the fans do not
+    /// cover the mesh ([`State::manifold`]).
+    pub fn fan_quadrics(&self, boundary_weight: f64) -> Option<Vec<Quadric>> {
+        if !self.manifold {
+            return None;
+        }
+        let t = &self.table;
+        let face: Vec<Quadric> = (0..(t.vertex.len() / 3) as u32)
+            .into_par_iter()
+            .map(|k| {
+                let [a, b, c] = [0, 1, 2].map(|j| self.geometry(t.v(3 * k + j)));
+                Quadric::from_triangle(a, b, c)
+            })
+            .collect();
+        let n = self.positions.len() as u32;
+        let quadrics = (0..n)
+            .into_par_iter()
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(triangles, edges): &mut (Vec<u32>, Vec<(u64, [u32; 3])>), v| {
+                    triangles.clear();
+                    t.for_each_corner(v, |c| triangles.push(c / 3));
+                    triangles.sort_unstable();
+                    let mut q = Quadric::ZERO;
+                    for &k in triangles.iter() {
+                        q += face[k as usize];
+                    }
+                    if boundary_weight == 0.0 || !self.boundary[v as usize] {
+                        return q;
+                    }
+                    // The boundary edge facing corner f runs from next f to
+                    // prev f, with f's vertex third.
+                    edges.clear();
+                    t.for_each_corner(v, |c| {
+                        for f in [prev(c), next(c)] {
+                            if t.o(f) == NONE {
+                                let (a, b) = (t.v(next(f)), t.v(prev(f)));
+                                let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+                                edges.push((key, [a, b, t.v(f)]));
+                            }
+                        }
+                    });
+                    edges.sort_unstable_by_key(|e| e.0);
+                    for &(_, ends) in edges.iter() {
+                        let [a, b, c] = ends.map(|x| self.geometry(x));
+                        q += crate::quadric::boundary_quadric(a, b, c, boundary_weight);
+                    }
+                    q
+                },
+            )
+            .collect();
+        Some(quadrics)
     }
 
     /// Metric coordinates of vertex `v`, computed from its grid position
@@ -314,9 +398,10 @@ pub fn simplify(
     phases.lap("");
     let mut s = State::new(mesh, options);
     phases.lap("table");
-    let geometry: Vec<[f64; 3]> = (0..n as u32).map(|v| s.geometry(v)).collect();
-    s.quadrics = vertex_quadrics(&geometry, &mesh.triangles, options.boundary_weight);
-    drop(geometry);
+    s.quadrics = s.fan_quadrics(options.boundary_weight).unwrap_or_else(|| {
+        let geometry: Vec<[f64; 3]> = (0..n as u32).map(|v| s.geometry(v)).collect();
+        vertex_quadrics(&geometry, &mesh.triangles, options.boundary_weight)
+    });
     phases.lap("quadrics");
     s.edges = initial_slots(&s);
     phases.lap("slots");
@@ -657,11 +742,10 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
     for &(p, c) in pairs {
         vmap[c as usize] = vmap[p as usize];
     }
-    let table = &s.table;
-    let mut tmap = vec![NONE; table.vertex.len() / 3];
+    let mut tmap = vec![NONE; s.table.vertex.len() / 3];
     let mut triangles = Vec::with_capacity(2 * live.len());
     for (k, slot) in tmap.iter_mut().enumerate() {
-        if table.vertex[3 * k] != NONE {
+        if s.table.vertex[3 * k] != NONE {
             *slot = triangles.len() as u32;
             triangles.push(k as u32);
         }
@@ -674,42 +758,26 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
         }
     };
     let vmap_of = |v: u32| if v == NONE { NONE } else { vmap[v as usize] };
-    // Corner arrays, by new corner: its old corner is 3 k + j.
-    let old = |c: usize| 3 * triangles[c / 3] as usize + c % 3;
-    let corners = 3 * triangles.len();
-    let vertex: Vec<u32> = (0..corners)
-        .into_par_iter()
-        .map(|c| vmap_of(table.vertex[old(c)]))
+    // In place, in ascending order: every element moves down or stays, and
+    // is read before anything lands on it; no fresh pages to fault in.
+    let corners: Vec<u32> = triangles
+        .iter()
+        .flat_map(|&k| [3 * k, 3 * k + 1, 3 * k + 2])
         .collect();
-    let opposite: Vec<u32> = (0..corners)
-        .into_par_iter()
-        .map(|c| cmap(table.opposite[old(c)]))
-        .collect();
-    let edges: Vec<EdgeSlot> = (0..corners)
-        .into_par_iter()
-        .map(|c| s.edges[old(c)])
-        .collect();
-    let corner_of: Vec<u32> = live
-        .par_iter()
-        .map(|&v| cmap(table.corner_of[v as usize]))
-        .collect();
-    let live_now: &[u32] = live;
-    fn gather<T: Copy + Send + Sync>(items: &[T], live: &[u32]) -> Vec<T> {
-        live.par_iter().map(|&v| items[v as usize]).collect()
-    }
-    s.positions = gather(&s.positions, live_now);
-    s.quadrics = gather(&s.quadrics, live_now);
-    s.boundary = gather(&s.boundary, live_now);
-    s.valence = gather(&s.valence, live_now);
-    s.alive = vec![true; live_now.len()];
-    s.split_valence = gather(&s.split_valence, live_now);
-    s.orig = gather(&s.orig, live_now);
-    s.edges = edges;
-    s.table = CornerTable {
-        vertex,
-        opposite,
-        corner_of,
-    };
+    let table = &mut s.table;
+    gather_map(&mut table.vertex, &corners, vmap_of);
+    gather_map(&mut table.opposite, &corners, cmap);
+    gather_map(&mut s.edges, &corners, |e| e);
+    gather_map(&mut table.corner_of, live, cmap);
+    let m = live.len();
+    gather_map(&mut s.positions, live, |x| x);
+    gather_map(&mut s.quadrics, live, |x| x);
+    gather_map(&mut s.boundary, live, |x| x);
+    gather_map(&mut s.valence, live, |x| x);
+    gather_map(&mut s.split_valence, live, |x| x);
+    gather_map(&mut s.orig, live, |x| x);
+    s.alive.truncate(m);
+    s.alive.fill(true);
     let remap = |b: Best| {
         debug_assert!(b.other == NONE || vmap[b.other as usize] != NONE);
         Best {
@@ -718,25 +786,20 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
             ..b
         }
     };
-    t.best = live_now
-        .par_iter()
-        .map(|&v| remap(t.best[v as usize]))
-        .collect();
-    t.second = live_now
-        .par_iter()
-        .map(|&v| t.second[v as usize].map(remap))
-        .collect();
-    t.bound = gather(&t.bound, live_now);
-    let m = live_now.len();
-    t.repick = vec![Best::NONE; m];
-    t.repick_at = vec![0; m];
-    t.changed = gather(&t.changed, live_now);
-    t.merged = gather(&t.merged, live_now);
-    t.refusals = gather(&t.refusals, live_now);
-    t.blocked = gather(&t.blocked, live_now);
-    t.listed = gather(&t.listed, live_now);
-    t.sorted = gather(&t.sorted, live_now);
-    t.keys = vec![u64::MAX; m];
+    gather_map(&mut t.best, live, remap);
+    gather_map(&mut t.second, live, |b| b.map(remap));
+    gather_map(&mut t.bound, live, |x| x);
+    gather_map(&mut t.changed, live, |x| x);
+    gather_map(&mut t.merged, live, |x| x);
+    gather_map(&mut t.refusals, live, |x| x);
+    gather_map(&mut t.blocked, live, |x| x);
+    gather_map(&mut t.listed, live, |x| x);
+    gather_map(&mut t.sorted, live, |x| x);
+    t.repick.truncate(m);
+    t.repick_at.truncate(m);
+    t.repick_at.fill(0);
+    t.keys.truncate(m);
+    t.keys.fill(u64::MAX);
     for v in choosers.iter_mut() {
         *v = vmap[*v as usize];
     }
@@ -753,6 +816,17 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
         .filter_map(|&k| Some(tmap[k as usize]).filter(|&k| k != NONE))
         .collect();
     *live = (0..m as u32).collect();
+}
+
+/// `items[i] = f(items[from[i]])` for each `i` in order, then `items` cut to
+/// `from.len()`: with `from` ascending and `from[i] >= i`, every element is
+/// read before it is overwritten.
+fn gather_map<T: Copy>(items: &mut Vec<T>, from: &[u32], f: impl Fn(T) -> T) {
+    for (i, &k) in from.iter().enumerate() {
+        debug_assert!(k as usize >= i);
+        items[i] = f(items[k as usize]);
+    }
+    items.truncate(from.len());
 }
 
 /// The flat threshold of the tie-breaks ([`Scale::flat`]) for a mean edge
@@ -1144,6 +1218,7 @@ fn par_filter_into<T: Sync, U: Send>(
 struct Buffers {
     errors: Vec<f64>,
     players: Vec<u32>,
+    spare: Vec<u32>,
     again: Vec<u32>,
     admitted: Vec<(u32, u64)>,
     /// The fans of the step's winners (see [`Winner::fans`]).
@@ -1244,6 +1319,7 @@ fn step_winners(
     let tr: &Tracking = t;
     let Buffers {
         players,
+        spare,
         again,
         admitted: admitted_keys,
         fans,
@@ -1255,16 +1331,15 @@ fn step_winners(
         let b = &tr.best[v as usize];
         (b.other != NONE && (b.error <= threshold || b.error_key <= threshold_key)).then_some(v)
     });
-    let live = &players[..];
     // The players' requests are checked before they pair up (see `validate`).
     if validating {
-        validate(s, t, live, scale, state, refused_ends, tally);
+        validate(s, t, players, scale, state, refused_ends, tally);
     }
     phases.lap("validate");
     loop {
         if !first {
             let tr: &Tracking = t;
-            par_filter_into(live, again, |&v| {
+            par_filter_into(players, again, |&v| {
                 let b = tr.request(v, state);
                 (tr.blocked[v as usize] != state
                     && b.other != NONE
@@ -1318,7 +1393,7 @@ fn step_winners(
         // One key per pair, taken from its lower endpoint, so that both
         // endpoints compare alike (their cached errors may come from
         // different steps).
-        par_filter_into(live, admitted_keys, |&v| {
+        par_filter_into(players, admitted_keys, |&v| {
             admitted(v).then(|| {
                 let low = v.min(tr.request(v, state).other);
                 (v, pair_key(tr.request(low, state), low))
@@ -1458,6 +1533,14 @@ fn step_winners(
         if counted == PASSES || passes == MAX_PASSES {
             break;
         }
+        // Blocked players take no further part in the step: the next
+        // passes sweep the others only.
+        let tr: &Tracking = t;
+        par_filter_into(players, spare, |&v| {
+            (tr.blocked[v as usize] != state).then_some(v)
+        });
+        std::mem::swap(players, spare);
+        phases.lap("retain players");
     }
     winners.sort_unstable_by_key(|w| w.p);
     winners
@@ -1744,5 +1827,64 @@ impl Simplification {
     /// Largest quadric error of any collapse.
     pub fn max_error(&self) -> f64 {
         self.step_errors.iter().copied().fold(0.0, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::input::{fractal_terrain, icosphere};
+    use crate::quantize::{Units, quantize};
+
+    /// A terrain with a square hole cut out (inner boundary edges too).
+    fn holed_terrain() -> crate::Mesh {
+        let mut mesh = fractal_terrain(24, 5);
+        let side = 24u32;
+        let inside = |v: u32| (8..14).contains(&(v % side)) && (8..14).contains(&(v / side));
+        mesh.triangles.retain(|t| !t.iter().all(|&v| inside(v)));
+        mesh
+    }
+
+    #[test]
+    fn fan_quadrics_are_the_vertex_quadrics_bit_for_bit() {
+        for mesh in [fractal_terrain(40, 3), icosphere(3), holed_terrain()] {
+            let q = quantize(&mesh, 14, Units::Linear);
+            let s = State::new(&q, &SimplifyOptions::default());
+            assert!(s.manifold);
+            let geometry: Vec<[f64; 3]> = (0..q.positions.len() as u32)
+                .map(|v| s.geometry(v))
+                .collect();
+            for weight in [0.0, crate::quadric::DEFAULT_BOUNDARY_WEIGHT] {
+                let want = vertex_quadrics(&geometry, &q.triangles, weight);
+                let got = s.fan_quadrics(weight).expect("manifold");
+                assert_eq!(got, want);
+            }
+        }
+    }
+
+    #[test]
+    fn renumbering_keeps_the_collapses() {
+        // Compaction happens at every halving; a mesh small enough that the
+        // loop also runs many steps after the last one.
+        let q = quantize(&fractal_terrain(48, 9), 14, Units::Linear);
+        for constrained in [false, true] {
+            let options = SimplifyOptions {
+                target_vertices: 8,
+                constrained,
+                ..SimplifyOptions::default()
+            };
+            let s = simplify(&q, &options, |_| {});
+            let mut alive = vec![true; q.positions.len()];
+            for c in s.steps.iter().flatten() {
+                assert!(c.p < c.c, "P is the lower input id");
+                assert!(alive[c.p as usize] && alive[c.c as usize]);
+                alive[c.c as usize] = false;
+            }
+            assert_eq!(alive, s.alive);
+            assert_eq!(s.alive.iter().filter(|&&a| a).count(), s.alive_count);
+            for t in s.table.vertex.chunks_exact(3).filter(|t| t[0] != NONE) {
+                assert!(t.iter().all(|&v| s.alive[v as usize]));
+            }
+        }
     }
 }
