@@ -448,7 +448,10 @@ pub fn simplify(
             let bound = old_flat.max(flat_of(edge));
             let mut kept = 0usize;
             for &v in &live {
-                if t.listed[v as usize] == state {
+                // Listed vertices choose anyway, but for those the last
+                // step merged: they chose then, under the old scale.
+                let listed = t.listed[v as usize] == state;
+                if listed && t.merged[v as usize] != state {
                     continue;
                 }
                 if rescaled_keeps(&mut t, v, bound) {
@@ -595,15 +598,15 @@ pub fn simplify(
         let t_refresh = std::time::Instant::now();
         phases.lap("apply");
         let merged: Vec<u32> = winners.iter().map(|w| w.p).collect();
-        // The next step keeps this scale unless it measures edges again.
-        let left = alive_count - collapses.len();
-        let same_scale = (left * 5 >= edge_measured_at * 4).then_some(scale);
+        // The merged vertices choose under this step's scale; should the
+        // next step measure edges again, its rescale sorts them like the
+        // other requests.
         refresh_edges(
             &mut s,
             &mut t,
             &merged,
             state + 1,
-            same_scale,
+            Some(scale),
             &mut choosers,
             &mut offers,
         );
