@@ -415,7 +415,7 @@ pub fn simplify(
     // `refresh_edges` and `step_winners`; `offers` are the edges refreshed
     // by the last step's collapses, for their other ends.
     let mut choosers = live.clone();
-    let mut offers: Vec<Offer> = Vec::new();
+    let mut offers: Vec<RefreshChunk> = Vec::new();
     let mut buffers = Buffers::default();
     // Recent refused checks and checks (see `VALIDATE_ABOVE`).
     let mut refusals = (0.0f64, 0.0f64);
@@ -716,7 +716,7 @@ struct Renumbered<'a> {
     /// was merged at that step and so counts as taken just the same.
     pairs: &'a [(u32, u32)],
     choosers: &'a mut Vec<u32>,
-    offers: &'a mut Vec<Offer>,
+    offers: &'a mut [RefreshChunk],
     meter: &'a mut EdgeMeter,
     input: &'a mut InputArrays,
 }
@@ -806,7 +806,7 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
     for v in choosers.iter_mut() {
         *v = vmap[*v as usize];
     }
-    for o in offers.iter_mut() {
+    for o in offers.iter_mut().flat_map(|chunk| chunk.offers.iter_mut()) {
         *o = Offer {
             x: vmap[o.x as usize],
             r: vmap[o.r as usize],
@@ -902,7 +902,7 @@ struct Offer {
 fn take_offers(
     s: &State,
     t: &mut Tracking,
-    offers: &[Offer],
+    offers: &[RefreshChunk],
     choosers: &mut Vec<u32>,
     scale: Scale,
     state: u32,
@@ -936,59 +936,61 @@ fn take_offers(
             let lo = k * size;
             let mut choose = Vec::new();
             let mut offered = 0;
-            for (i, o) in offers.iter().enumerate() {
-                let x = (o.x as usize).wrapping_sub(lo);
-                if x >= best.len() {
-                    continue;
-                }
-                // What the offers ahead read at random: the request, and
-                // the slot (through its corner's opposite).
-                if let Some(ahead) = offers.get(i + 8) {
-                    let y = (ahead.x as usize).wrapping_sub(lo);
-                    if y < best.len() {
-                        prefetch(best, y);
-                        prefetch(second, y);
-                        prefetch(&s.table.opposite, ahead.facing as usize);
-                        prefetch(&s.edges, ahead.facing as usize);
+            for offers in offers.iter().map(|chunk| &chunk.offers) {
+                for (i, o) in offers.iter().enumerate() {
+                    let x = (o.x as usize).wrapping_sub(lo);
+                    if x >= best.len() {
+                        continue;
                     }
-                }
-                if sorted[x] != state {
-                    sorted[x] = state;
-                    if listed[x] != state {
-                        let runner_up = second[x];
-                        let second_gone = runner_up.is_none_or(|b| gone(merged, b.other));
-                        let best_gone = gone(merged, best[x].other);
-                        if refusals[o.x as usize] != 0 || (best_gone && second_gone) {
-                            listed[x] = state;
-                            choose.push(o.x);
-                        } else {
-                            offered += 1;
-                            // Either way the bound of what comes after the
-                            // runner-up now bounds what comes after the best.
-                            if best_gone {
-                                // The runner-up is the best of what is left;
-                                // what comes after it is not known.
-                                let b = runner_up.unwrap_or(Best::NONE);
-                                best[x] = b;
-                                second[x] = (b.other == NONE).then_some(Best::NONE);
-                            } else if second_gone {
-                                second[x] = None;
+                    // What the offers ahead read at random: the request, and
+                    // the slot (through its corner's opposite).
+                    if let Some(ahead) = offers.get(i + 8) {
+                        let y = (ahead.x as usize).wrapping_sub(lo);
+                        if y < best.len() {
+                            prefetch(best, y);
+                            prefetch(second, y);
+                            prefetch(&s.table.opposite, ahead.facing as usize);
+                            prefetch(&s.edges, ahead.facing as usize);
+                        }
+                    }
+                    if sorted[x] != state {
+                        sorted[x] = state;
+                        if listed[x] != state {
+                            let runner_up = second[x];
+                            let second_gone = runner_up.is_none_or(|b| gone(merged, b.other));
+                            let best_gone = gone(merged, best[x].other);
+                            if refusals[o.x as usize] != 0 || (best_gone && second_gone) {
+                                listed[x] = state;
+                                choose.push(o.x);
+                            } else {
+                                offered += 1;
+                                // Either way the bound of what comes after the
+                                // runner-up now bounds what comes after the best.
+                                if best_gone {
+                                    // The runner-up is the best of what is left;
+                                    // what comes after it is not known.
+                                    let b = runner_up.unwrap_or(Best::NONE);
+                                    best[x] = b;
+                                    second[x] = (b.other == NONE).then_some(Best::NONE);
+                                } else if second_gone {
+                                    second[x] = None;
+                                }
                             }
                         }
                     }
+                    if listed[x] == state {
+                        continue;
+                    }
+                    let mut choices = Choices {
+                        best: best[x],
+                        second: second[x],
+                        bound: bound[x],
+                    };
+                    offer(s, o.x, &mut choices, o.r, o.facing, scale);
+                    best[x] = choices.best;
+                    second[x] = choices.second;
+                    bound[x] = choices.bound;
                 }
-                if listed[x] == state {
-                    continue;
-                }
-                let mut choices = Choices {
-                    best: best[x],
-                    second: second[x],
-                    bound: bound[x],
-                };
-                offer(s, o.x, &mut choices, o.r, o.facing, scale);
-                best[x] = choices.best;
-                second[x] = choices.second;
-                bound[x] = choices.bound;
             }
             (choose, offered)
         })
@@ -1256,8 +1258,12 @@ struct Checked {
 /// order. Each chunk fills its own buffers: no allocation per item and no
 /// merging copies (rayon's fold/reduce re-copies at every level).
 fn par_chunks_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&[T]) -> R + Sync + Send) -> Vec<R> {
-    let size = (items.len() / (8 * rayon::current_num_threads())).clamp(512, 16384);
-    items.par_chunks(size).map(f).collect()
+    items.par_chunks(chunk_size(items.len())).map(f).collect()
+}
+
+/// The chunk length of the data-parallel passes over `len` items.
+fn chunk_size(len: usize) -> usize {
+    (len / (8 * rayon::current_num_threads())).clamp(512, 16384)
 }
 
 /// What one step selects with: its state number, the threshold S, the
@@ -1640,63 +1646,68 @@ fn refresh_edges(
     next_state: u32,
     scale: Option<Scale>,
     choosers: &mut Vec<u32>,
-    offers: &mut Vec<Offer>,
+    chunks: &mut Vec<RefreshChunk>,
 ) {
     let s_now: &State = s;
-    let chunks = par_chunks_map(merged, |chunk| {
-        // About six edges a vertex.
-        let mut updates = Vec::with_capacity(7 * chunk.len());
-        let mut offers = Vec::with_capacity(7 * chunk.len());
-        let mut choices = Vec::with_capacity(if scale.is_some() { chunk.len() } else { 0 });
-        let mut edges: Vec<(u32, u32)> = Vec::with_capacity(16);
-        for (i, &r) in chunk.iter().enumerate() {
-            prefetch_ahead(s_now, chunk, i);
-            // Edge (r, prev c) faces next c; a boundary edge (r, next c)
-            // faces prev c.
-            edges.clear();
-            s_now.table.for_each_corner(r, |c| {
-                edges.push((s_now.table.v(prev(c)), next(c)));
-                if s_now.table.o(prev(c)) == NONE {
-                    edges.push((s_now.table.v(next(c)), prev(c)));
+    let size = chunk_size(merged.len());
+    let count = merged.len().div_ceil(size);
+    if chunks.len() < count {
+        chunks.resize_with(count, RefreshChunk::default);
+    }
+    // Chunks past this step's keep their capacity and nothing else.
+    for chunk in &mut chunks[count..] {
+        chunk.clear();
+    }
+    merged
+        .par_chunks(size)
+        .zip(chunks[..count].par_iter_mut())
+        .for_each(|(chunk, out)| {
+            out.clear();
+            let mut edges: Vec<(u32, u32)> = Vec::with_capacity(16);
+            for (i, &r) in chunk.iter().enumerate() {
+                prefetch_ahead(s_now, chunk, i);
+                // Edge (r, prev c) faces next c; a boundary edge (r, next c)
+                // faces prev c.
+                edges.clear();
+                s_now.table.for_each_corner(r, |c| {
+                    edges.push((s_now.table.v(prev(c)), next(c)));
+                    if s_now.table.o(prev(c)) == NONE {
+                        edges.push((s_now.table.v(next(c)), prev(c)));
+                    }
+                });
+                // The neighbours' quadrics are the evaluations' cache misses:
+                // ask for them all at once.
+                for &(x, _) in &edges {
+                    prefetch(&s_now.quadrics, x as usize);
+                    prefetch(&s_now.positions, x as usize);
                 }
-            });
-            // The neighbours' quadrics are the evaluations' cache misses:
-            // ask for them all at once.
-            for &(x, _) in &edges {
-                prefetch(&s_now.quadrics, x as usize);
-                prefetch(&s_now.positions, x as usize);
-            }
-            let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
-            for &(x, facing) in &edges {
-                let slot = edge_slot(s_now, facing);
-                updates.push((s_now.slot_index(facing) as u32, slot));
-                offers.push(Offer { x, r, facing });
-                if let Some(ranking) = &mut ranking {
-                    ranking.consider(x, facing, &slot);
+                let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
+                for &(x, facing) in &edges {
+                    let slot = edge_slot(s_now, facing);
+                    out.updates.push((s_now.slot_index(facing) as u32, slot));
+                    out.offers.push(Offer { x, r, facing });
+                    if let Some(ranking) = &mut ranking {
+                        ranking.consider(x, facing, &slot);
+                    }
+                }
+                if let Some(ranking) = ranking {
+                    out.choices.push(ranking.choices());
                 }
             }
-            if let Some(ranking) = ranking {
-                choices.push(ranking.choices());
-            }
-        }
-        (updates, offers, choices)
-    });
-    offers.clear();
-    let mut chosen = Vec::with_capacity(merged.len());
-    for (updates, chunk_offers, choices) in chunks {
-        for (c, slot) in updates {
+        });
+    let mut chosen = chunks.iter().flat_map(|chunk| chunk.choices.iter());
+    for chunk in chunks.iter() {
+        for &(c, slot) in &chunk.updates {
             s.edges[c as usize] = slot;
         }
-        offers.extend(chunk_offers);
-        chosen.extend(choices);
     }
-    for (i, &r) in merged.iter().enumerate() {
+    for &r in merged {
         let v = r as usize;
         t.changed[v] = next_state;
         t.merged[v] = next_state;
         // Never listed already: merged vertices are not refused ends.
         t.listed[v] = next_state;
-        match chosen.get(i) {
+        match chosen.next() {
             Some(choices) => {
                 t.best[v] = choices.best;
                 t.second[v] = choices.second;
@@ -1707,8 +1718,26 @@ fn refresh_edges(
             None => choosers.push(r),
         }
     }
-    for o in offers.iter() {
+    for o in chunks.iter().flat_map(|chunk| chunk.offers.iter()) {
         t.changed[o.x as usize] = next_state;
+    }
+}
+
+/// One chunk's part of a refresh, kept from step to step for its capacity:
+/// the refreshed slots (index, slot), the offers to the other ends, and the
+/// merged vertices' choices. The offers stay until the next step takes them.
+#[derive(Default)]
+struct RefreshChunk {
+    updates: Vec<(u32, EdgeSlot)>,
+    offers: Vec<Offer>,
+    choices: Vec<Choices>,
+}
+
+impl RefreshChunk {
+    fn clear(&mut self) {
+        self.updates.clear();
+        self.offers.clear();
+        self.choices.clear();
     }
 }
 
