@@ -87,18 +87,46 @@ impl CornerTable {
         let mut opposite = vec![NONE; vertex.len()];
         // Group the corners by the undirected edge they face; the corner's
         // own direction (from `next` to `prev`) tells the two sides apart.
+        // A counting sort on the edge's lower vertex, then each short run
+        // sorted by (upper vertex, corner): the order `by_undirected_edge`
+        // gives, in 8 bytes an entry instead of 16.
         let from = |c: u32| vertex[next(c) as usize];
-        let ends = |c: u32| (from(c), vertex[prev(c) as usize]);
-        let keys = by_undirected_edge(vertex_count, vertex.len(), |c| Some(ends(c)));
+        let ends = |c: u32| {
+            let (a, b) = (from(c), vertex[prev(c) as usize]);
+            (a.min(b), a.max(b))
+        };
+        let mut start = vec![0u32; vertex_count + 1];
+        for c in 0..vertex.len() as u32 {
+            start[ends(c).0 as usize + 1] += 1;
+        }
+        for k in 1..start.len() {
+            start[k] += start[k - 1];
+        }
+        let mut fill = start.clone();
+        let mut order = vec![0u64; vertex.len()];
+        for c in 0..vertex.len() as u32 {
+            let (lo, hi) = ends(c);
+            let slot = &mut fill[lo as usize];
+            order[*slot as usize] = (u64::from(hi) << 32) | u64::from(c);
+            *slot += 1;
+        }
+        drop(fill);
         let mut clean = true;
-        for run in keys.chunk_by(|x, y| x.0 == y.0) {
-            if let [(_, c0), (_, c1)] = *run
-                && from(c0) != from(c1)
-            {
-                opposite[c0 as usize] = c1;
-                opposite[c1 as usize] = c0;
-            } else if run.len() != 1 {
-                clean = false;
+        for w in start.windows(2) {
+            let bucket = &mut order[w[0] as usize..w[1] as usize];
+            bucket.sort_unstable();
+            for run in bucket.chunk_by(|x, y| x >> 32 == y >> 32) {
+                if let [e0, e1] = *run {
+                    let (c0, c1) = (e0 as u32, e1 as u32);
+                    if from(c0) != from(c1) {
+                        opposite[c0 as usize] = c1;
+                        opposite[c1 as usize] = c0;
+                        continue;
+                    }
+                }
+                if run.len() != 1 {
+                    clean = false;
+                }
             }
         }
         let mut corner_of = vec![NONE; vertex_count];

@@ -189,13 +189,13 @@ impl State {
             return None;
         }
         let t = &self.table;
-        let face: Vec<Quadric> = (0..(t.vertex.len() / 3) as u32)
-            .into_par_iter()
-            .map(|k| {
-                let [a, b, c] = [0, 1, 2].map(|j| self.geometry(t.v(3 * k + j)));
-                Quadric::from_triangle(a, b, c)
-            })
-            .collect();
+        // Each triangle's quadric is computed by each of its vertices: three
+        // times the arithmetic, but no 80-byte-a-triangle array to fill and
+        // read back.
+        let face = |k: u32| {
+            let [a, b, c] = [0, 1, 2].map(|j| self.geometry(t.v(3 * k + j)));
+            Quadric::from_triangle(a, b, c)
+        };
         let n = self.positions.len() as u32;
         let quadrics = (0..n)
             .into_par_iter()
@@ -207,7 +207,7 @@ impl State {
                     triangles.sort_unstable();
                     let mut q = Quadric::ZERO;
                     for &k in triangles.iter() {
-                        q += face[k as usize];
+                        q += face(k);
                     }
                     if boundary_weight == 0.0 || !self.boundary[v as usize] {
                         return q;
