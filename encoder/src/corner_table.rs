@@ -234,22 +234,7 @@ impl CornerTable {
     /// corners are marked dead. `keep` is the corner of `t` whose facing edge
     /// is the collapsing one; the other two face the folded edges.
     pub fn remove_triangle(&mut self, keep: u32) {
-        let (c1, c2) = (next(keep), prev(keep));
-        let (o1, o2) = (self.o(c1), self.o(c2));
-        if o1 != NONE {
-            self.opposite[o1 as usize] = o2;
-        }
-        if o2 != NONE {
-            self.opposite[o2 as usize] = o1;
-        }
-        let across = self.o(keep);
-        if across != NONE {
-            self.opposite[across as usize] = NONE;
-        }
-        for c in [keep, c1, c2] {
-            self.vertex[c as usize] = NONE;
-            self.opposite[c as usize] = NONE;
-        }
+        remove_triangle_in(self, keep);
     }
 
     /// Collapses the edge from `keep` to `gone`: `gone`'s triangles move to
@@ -275,40 +260,12 @@ impl CornerTable {
         fan_keep: &[u32],
         fan_gone: &[u32],
     ) {
-        let doomed = |c: u32| c != NONE && (c / 3 == left / 3 || c / 3 == right / 3);
-        // Re-anchor the wing vertices on triangles that survive: the
-        // neighbours across their two folded edges.
-        for (c, is_left) in [(left, true), (right, false)] {
-            if c == NONE {
-                continue;
-            }
-            let x = self.v(if is_left { prev(c) } else { next(c) });
-            let anchor = [c, next(c), prev(c)]
-                .into_iter()
-                .map(|k| self.o(k))
-                .find(|&o| o != NONE && !doomed(o))
-                .map(|o| self.corner_at(o, x))
-                .unwrap_or(NONE);
-            self.corner_of[x as usize] = anchor;
-        }
-        for &c in fan_gone {
-            if !doomed(c) {
-                self.vertex[c as usize] = keep;
+        let anchors = collapse_in(self, keep, gone, left, right, fan_keep, fan_gone);
+        for (x, anchor) in anchors {
+            if x != NONE {
+                self.corner_of[x as usize] = anchor;
             }
         }
-        if left != NONE {
-            self.remove_triangle(prev(left));
-        }
-        if right != NONE {
-            self.remove_triangle(next(right));
-        }
-        self.corner_of[keep as usize] = fan_keep
-            .iter()
-            .chain(fan_gone)
-            .copied()
-            .find(|&c| !doomed(c))
-            .unwrap_or(NONE);
-        self.corner_of[gone as usize] = NONE;
     }
 
     /// A live corner at vertex `x` in the triangle of corner `c` (which must
@@ -317,6 +274,111 @@ impl CornerTable {
         let base = c - c % 3;
         (base..base + 3).find(|&k| self.v(k) == x).unwrap_or(NONE)
     }
+}
+
+/// The corner arrays a collapse reads and writes, so that the one
+/// implementation ([`collapse_in`]) serves the table itself and the
+/// parallel simplifier's disjoint views of it.
+pub trait CornerAccess {
+    fn v(&self, c: u32) -> u32;
+    fn o(&self, c: u32) -> u32;
+    fn set_v(&mut self, c: u32, v: u32);
+    fn set_o(&mut self, c: u32, o: u32);
+    fn set_corner_of(&mut self, v: u32, c: u32);
+}
+
+impl CornerAccess for CornerTable {
+    fn v(&self, c: u32) -> u32 {
+        self.vertex[c as usize]
+    }
+    fn o(&self, c: u32) -> u32 {
+        self.opposite[c as usize]
+    }
+    fn set_v(&mut self, c: u32, v: u32) {
+        self.vertex[c as usize] = v;
+    }
+    fn set_o(&mut self, c: u32, o: u32) {
+        self.opposite[c as usize] = o;
+    }
+    fn set_corner_of(&mut self, v: u32, c: u32) {
+        self.corner_of[v as usize] = c;
+    }
+}
+
+/// [`CornerTable::remove_triangle`] on any [`CornerAccess`].
+pub fn remove_triangle_in<A: CornerAccess + ?Sized>(t: &mut A, keep: u32) {
+    let (c1, c2) = (next(keep), prev(keep));
+    let (o1, o2) = (t.o(c1), t.o(c2));
+    if o1 != NONE {
+        t.set_o(o1, o2);
+    }
+    if o2 != NONE {
+        t.set_o(o2, o1);
+    }
+    let across = t.o(keep);
+    if across != NONE {
+        t.set_o(across, NONE);
+    }
+    for c in [keep, c1, c2] {
+        t.set_v(c, NONE);
+        t.set_o(c, NONE);
+    }
+}
+
+/// [`CornerTable::collapse_fans`] on any [`CornerAccess`], except that the
+/// wing vertices' new corners are returned as (wing, corner) pairs instead
+/// of written ([`NONE`] wings where a side is open): a wing can be shared by
+/// two collapses of one parallel step. Reads and writes only the triangles
+/// around `keep` and `gone` (and their corners).
+pub fn collapse_in<A: CornerAccess + ?Sized>(
+    t: &mut A,
+    keep: u32,
+    gone: u32,
+    left: u32,
+    right: u32,
+    fan_keep: &[u32],
+    fan_gone: &[u32],
+) -> [(u32, u32); 2] {
+    let doomed = |c: u32| c != NONE && (c / 3 == left / 3 || c / 3 == right / 3);
+    // Re-anchor the wing vertices on triangles that survive: the
+    // neighbours across their two folded edges.
+    let mut anchors = [(NONE, NONE); 2];
+    for (slot, (c, is_left)) in anchors.iter_mut().zip([(left, true), (right, false)]) {
+        if c == NONE {
+            continue;
+        }
+        let x = t.v(if is_left { prev(c) } else { next(c) });
+        let anchor = [c, next(c), prev(c)]
+            .into_iter()
+            .map(|k| t.o(k))
+            .find(|&o| o != NONE && !doomed(o))
+            .map(|o| {
+                let base = o - o % 3;
+                (base..base + 3).find(|&k| t.v(k) == x).unwrap_or(NONE)
+            })
+            .unwrap_or(NONE);
+        *slot = (x, anchor);
+    }
+    for &c in fan_gone {
+        if !doomed(c) {
+            t.set_v(c, keep);
+        }
+    }
+    if left != NONE {
+        remove_triangle_in(t, prev(left));
+    }
+    if right != NONE {
+        remove_triangle_in(t, next(right));
+    }
+    let start = fan_keep
+        .iter()
+        .chain(fan_gone)
+        .copied()
+        .find(|&c| !doomed(c))
+        .unwrap_or(NONE);
+    t.set_corner_of(keep, start);
+    t.set_corner_of(gone, NONE);
+    anchors
 }
 
 #[cfg(test)]

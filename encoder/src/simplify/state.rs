@@ -7,7 +7,7 @@ use super::select::{
     Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, error_key, evaluate, offer,
     pair_key, pick_edge,
 };
-use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
+use crate::corner_table::{CornerAccess, CornerTable, Fan, NONE, collapse_in, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
 
@@ -446,23 +446,32 @@ pub fn simplify(
             // the flat threshold is above most errors and the tie-breaks
             // decide, the steps then found few collapses each.)
             let bound = old_flat.max(flat_of(edge));
-            let mut kept = 0usize;
-            for &v in &live {
+            let tr: &Tracking = &t;
+            let mut changes = Vec::new();
+            par_filter_into(&live, &mut changes, |&v| {
                 // Listed vertices choose anyway, but for those the last
                 // step merged: they chose then, under the old scale.
-                let listed = t.listed[v as usize] == state;
-                if listed && t.merged[v as usize] != state {
-                    continue;
+                let listed = tr.listed[v as usize] == state;
+                if listed && tr.merged[v as usize] != state {
+                    return None;
                 }
-                if rescaled_keeps(&mut t, v, bound) {
-                    kept += 1;
-                } else {
+                match rescaled(tr, v, bound) {
+                    Rescaled::Kept => None,
+                    change => Some((v, change)),
+                }
+            });
+            let mut chose = 0usize;
+            for &(v, change) in &changes {
+                if change == Rescaled::Chooses {
                     t.listed[v as usize] = state;
                     choosers.push(v);
+                    chose += 1;
+                } else {
+                    t.second[v as usize] = None;
                 }
             }
             if debug {
-                eprintln!("rescale: {kept} of {} requests kept", live.len());
+                eprintln!("rescale: {chose} of {} requests choose again", live.len());
             }
         }
         let scale = Scale {
@@ -557,44 +566,19 @@ pub fn simplify(
         }
         let t_apply = std::time::Instant::now();
         phases.lap("select");
-        let mut collapses = Vec::with_capacity(winners.len());
-        let mut step_error = 0.0f64;
-        for (i, w) in winners.iter().enumerate() {
-            // The next winners' vertices and fans (see `prefetch_ahead`).
-            if let Some(w) = winners.get(i + 4) {
-                for x in [w.p, w.best.other] {
-                    prefetch(&s.quadrics, x as usize);
-                    prefetch(&s.positions, x as usize);
-                }
-                let start = w.fans.0 as usize;
-                for &c in &buffers.fans[start..start + (w.fans.1 + w.fans.2) as usize] {
-                    prefetch(&s.table.vertex, c as usize);
-                    prefetch(&s.table.opposite, c as usize);
-                }
+        if cfg!(debug_assertions) {
+            for w in &winners {
+                let target = s.to_metric(w.target);
+                let check = check_collapse(&s, w.p, w.best.other, target, &mut Default::default());
+                assert_eq!(
+                    check,
+                    Ok(w.plan),
+                    "a winner's check holds at the end of its step"
+                );
             }
-            debug_assert_eq!(
-                check_collapse(
-                    &s,
-                    w.p,
-                    w.best.other,
-                    s.to_metric(w.target),
-                    &mut CheckScratch::default()
-                ),
-                Ok(w.plan),
-                "a winner's check holds after the other collapses of its step"
-            );
-            let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
-            let fan_p = &buffers.fans[start..start + np];
-            let fan_c = &buffers.fans[start + np..start + np + nc];
-            // Built from P and C before the collapse, as its check saw them
-            // (no other collapse of the step touches them).
-            let (record, quadric) = prepare(&s, w.p, w.best, w.target, w.plan);
-            s.table
-                .collapse_fans(w.p, w.best.other, w.plan.left, w.plan.right, fan_p, fan_c);
-            commit(&mut s, w.p, w.best.other, w.target, w.plan, quadric);
-            collapses.push(record);
-            step_error = step_error.max(w.best.error);
         }
+        let step_error = winners.iter().fold(0.0f64, |e, w| e.max(w.best.error));
+        let collapses = apply_collapses(&mut s, &winners, &buffers.fans);
         let t_refresh = std::time::Instant::now();
         phases.lap("apply");
         let merged: Vec<u32> = winners.iter().map(|w| w.p).collect();
@@ -767,20 +751,7 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
         .iter()
         .flat_map(|&k| [3 * k, 3 * k + 1, 3 * k + 2])
         .collect();
-    let table = &mut s.table;
-    gather_map(&mut table.vertex, &corners, vmap_of);
-    gather_map(&mut table.opposite, &corners, cmap);
-    gather_map(&mut s.edges, &corners, |e| e);
-    gather_map(&mut table.corner_of, live, cmap);
     let m = live.len();
-    gather_map(&mut s.positions, live, |x| x);
-    gather_map(&mut s.quadrics, live, |x| x);
-    gather_map(&mut s.boundary, live, |x| x);
-    gather_map(&mut s.valence, live, |x| x);
-    gather_map(&mut s.split_valence, live, |x| x);
-    gather_map(&mut s.orig, live, |x| x);
-    s.alive.truncate(m);
-    s.alive.fill(true);
     let remap = |b: Best| {
         debug_assert!(b.other == NONE || vmap[b.other as usize] != NONE);
         Best {
@@ -789,20 +760,46 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
             ..b
         }
     };
-    gather_map(&mut t.best, live, remap);
-    gather_map(&mut t.second, live, |b| b.map(remap));
-    gather_map(&mut t.bound, live, |x| x);
-    gather_map(&mut t.changed, live, |x| x);
-    gather_map(&mut t.merged, live, |x| x);
-    gather_map(&mut t.refusals, live, |x| x);
-    gather_map(&mut t.blocked, live, |x| x);
-    gather_map(&mut t.listed, live, |x| x);
-    gather_map(&mut t.sorted, live, |x| x);
-    t.repick.truncate(m);
-    t.repick_at.truncate(m);
-    t.repick_at.fill(0);
-    t.keys.truncate(m);
-    t.keys.fill(u64::MAX);
+    let live_now: &[u32] = live;
+    let corners = &corners[..];
+    let CornerTable {
+        vertex,
+        opposite,
+        corner_of,
+    } = &mut s.table;
+    // Each array on its own: they are independent.
+    rayon::scope(|scope| {
+        scope.spawn(|_| gather_map(vertex, corners, vmap_of));
+        scope.spawn(|_| gather_map(opposite, corners, cmap));
+        scope.spawn(|_| gather_map(&mut s.edges, corners, |e| e));
+        scope.spawn(|_| gather_map(&mut s.quadrics, live_now, |x| x));
+        scope.spawn(|_| {
+            gather_map(corner_of, live_now, cmap);
+            gather_map(&mut s.positions, live_now, |x| x);
+            gather_map(&mut s.boundary, live_now, |x| x);
+            gather_map(&mut s.valence, live_now, |x| x);
+            gather_map(&mut s.split_valence, live_now, |x| x);
+            gather_map(&mut s.orig, live_now, |x| x);
+            s.alive.truncate(m);
+            s.alive.fill(true);
+        });
+        scope.spawn(|_| gather_map(&mut t.best, live_now, remap));
+        scope.spawn(|_| gather_map(&mut t.second, live_now, |b| b.map(remap)));
+        scope.spawn(|_| {
+            gather_map(&mut t.bound, live_now, |x| x);
+            gather_map(&mut t.changed, live_now, |x| x);
+            gather_map(&mut t.merged, live_now, |x| x);
+            gather_map(&mut t.refusals, live_now, |x| x);
+            gather_map(&mut t.blocked, live_now, |x| x);
+            gather_map(&mut t.listed, live_now, |x| x);
+            gather_map(&mut t.sorted, live_now, |x| x);
+            t.repick.truncate(m);
+            t.repick_at.truncate(m);
+            t.repick_at.fill(0);
+            t.keys.truncate(m);
+            t.keys.fill(u64::MAX);
+        });
+    });
     for v in choosers.iter_mut() {
         *v = vmap[*v as usize];
     }
@@ -847,23 +844,35 @@ fn flat_of(edge: f64) -> f64 {
 /// runner-up with a possible tie behind it becomes unknown (the new
 /// sub-grid could break the tie the other way). A vertex without a request,
 /// or whose request may not be a pick's, chooses again.
-fn rescaled_keeps(t: &mut Tracking, v: u32, flat: f64) -> bool {
+fn rescaled(t: &Tracking, v: u32, flat: f64) -> Rescaled {
     let v = v as usize;
     let (best, bound) = (t.best[v], t.bound[v]);
     if best.other == NONE || best.error <= flat || bound == 0 {
-        return false;
+        return Rescaled::Chooses;
     }
     match t.second[v] {
-        Some(second) if second.other == NONE => true,
+        Some(second) if second.other == NONE => Rescaled::Kept,
         Some(second) if second.error_key > best.error_key => {
             if bound <= second.error_key {
-                t.second[v] = None;
+                Rescaled::KeptWithoutSecond
+            } else {
+                Rescaled::Kept
             }
-            true
         }
-        Some(_) => false,
-        None => bound > best.error_key,
+        Some(_) => Rescaled::Chooses,
+        None if bound > best.error_key => Rescaled::Kept,
+        None => Rescaled::Chooses,
     }
+}
+
+/// What a rescale does to a request ([`rescaled`]).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Rescaled {
+    Kept,
+    /// Kept, the runner-up made unknown.
+    KeptWithoutSecond,
+    /// The vertex chooses again.
+    Chooses,
 }
 
 /// Every edge's slot, at the lower of its corners ([`State::slot_index`]);
@@ -1590,27 +1599,42 @@ pub(super) fn try_apply_collapse(
 fn prepare(s: &State, p: u32, b: Best, target: [u32; 3], plan: Plan) -> (Collapse, Quadric) {
     let c = b.other;
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
+    let ends = [p, c].map(|v| (s.positions[v as usize], s.split_valence[v as usize]));
+    let record = record(b, p, target, plan, &q, ends, &s.orig);
+    (record, q)
+}
+
+/// The record of the collapse of `p` and `b.other` to `target`, given the
+/// merged quadric and the positions and split valences of P and C.
+fn record(
+    b: Best,
+    p: u32,
+    target: [u32; 3],
+    plan: Plan,
+    q: &Quadric,
+    ends: [([u32; 3], u8); 2],
+    orig: &[u32],
+) -> Collapse {
     let weight = q.c[0] + q.c[4] + q.c[7];
     let distance = if weight > 0.0 {
         (b.error / weight).sqrt()
     } else {
         0.0
     };
-    let input = |v: u32| if v == NONE { NONE } else { s.orig[v as usize] };
-    let record = Collapse {
+    let input = |v: u32| if v == NONE { NONE } else { orig[v as usize] };
+    Collapse {
         p: input(p),
-        c: input(c),
+        c: input(b.other),
         wing_a: input(plan.wing_a),
         wing_b: input(plan.wing_b),
-        position_p: s.positions[p as usize],
-        position_c: s.positions[c as usize],
+        position_p: ends[0].0,
+        position_c: ends[1].0,
         position_r: target,
-        split_valence_p: s.split_valence[p as usize],
-        split_valence_c: s.split_valence[c as usize],
+        split_valence_p: ends[0].1,
+        split_valence_c: ends[1].1,
         error: b.error,
         distance,
-    };
-    (record, q)
+    }
 }
 
 /// The merged vertex's new attributes once the corner table is collapsed.
@@ -1626,6 +1650,191 @@ fn commit(s: &mut State, p: u32, c: u32, target: [u32; 3], plan: Plan, q: Quadri
         if w != NONE {
             s.valence[w as usize] -= 1;
         }
+    }
+}
+
+/// Applies a step's winners, in parallel, returning their records in order.
+///
+/// The collapses of a step touch disjoint parts of the mesh: the triangles
+/// around P and C, and P's and C's own entries, belong to one collapse each
+/// (the endpoints of two winners are never neighbours: each winner blocks
+/// its endpoints' 1-rings). Only a wing can be shared, so the wings' new
+/// corners and valences are set afterwards, in winner order, as one
+/// collapse after the other would leave them.
+fn apply_collapses(s: &mut State, winners: &[Winner], fans: &[u32]) -> Vec<Collapse> {
+    let table = TableView {
+        vertex: Raw::new(&mut s.table.vertex),
+        opposite: Raw::new(&mut s.table.opposite),
+        corner_of: Raw::new(&mut s.table.corner_of),
+    };
+    let positions = Raw::new(&mut s.positions);
+    let quadrics = Raw::new(&mut s.quadrics);
+    let boundary = Raw::new(&mut s.boundary);
+    let alive = Raw::new(&mut s.alive);
+    let split_valence = Raw::new(&mut s.split_valence);
+    let valence = Raw::new(&mut s.valence);
+    let orig: &[u32] = &s.orig;
+    let applied: Vec<(Collapse, [(u32, u32); 2])> = winners
+        .par_chunks(chunk_size(winners.len()))
+        .flat_map_iter(|chunk| {
+            chunk.iter().enumerate().map(move |(i, w)| {
+                // The next winners' vertices and fans (see `prefetch_ahead`).
+                if let Some(w) = chunk.get(i + 4) {
+                    for x in [w.p, w.best.other] {
+                        quadrics.prefetch(x as usize);
+                        positions.prefetch(x as usize);
+                    }
+                    let start = w.fans.0 as usize;
+                    for &c in &fans[start..start + (w.fans.1 + w.fans.2) as usize] {
+                        table.vertex.prefetch(c as usize);
+                        table.opposite.prefetch(c as usize);
+                    }
+                }
+                let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
+                let fan_p = &fans[start..start + np];
+                let fan_c = &fans[start + np..start + np + nc];
+                let (p, c) = (w.p as usize, w.best.other as usize);
+                // SAFETY: P's and C's entries belong to this collapse alone
+                // (see above), and nothing else reads these arrays meanwhile.
+                let (q, ends) = unsafe {
+                    (
+                        quadrics.get(p) + quadrics.get(c),
+                        [p, c].map(|v| (positions.get(v), split_valence.get(v))),
+                    )
+                };
+                // Built from P and C before the collapse, as its check saw them.
+                let record = record(w.best, w.p, w.target, w.plan, &q, ends, orig);
+                let mut view = table;
+                let anchors = collapse_in(
+                    &mut view,
+                    w.p,
+                    w.best.other,
+                    w.plan.left,
+                    w.plan.right,
+                    fan_p,
+                    fan_c,
+                );
+                // SAFETY: as above.
+                unsafe {
+                    positions.set(p, w.target);
+                    quadrics.set(p, q);
+                    boundary.set(p, boundary.get(p) | boundary.get(c));
+                    alive.set(c, false);
+                    split_valence.set(p, w.plan.valence_r as u8);
+                    valence.set(p, w.plan.valence_r as u32);
+                }
+                (record, anchors)
+            })
+        })
+        .collect();
+    let mut records = Vec::with_capacity(applied.len());
+    for (w, (record, anchors)) in winners.iter().zip(applied) {
+        for (x, corner) in anchors {
+            if x != NONE {
+                s.table.corner_of[x as usize] = corner;
+            }
+        }
+        for wing in [w.plan.wing_a, w.plan.wing_b] {
+            if wing != NONE {
+                s.valence[wing as usize] -= 1;
+            }
+        }
+        records.push(record);
+    }
+    records
+}
+
+/// A slice's elements for writes from parallel tasks, each to elements no
+/// other task touches (see [`apply_collapses`]).
+struct Raw<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+impl<T> Clone for Raw<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for Raw<T> {}
+
+// SAFETY: a `Raw` is only used for disjoint accesses (see `apply_collapses`).
+unsafe impl<T: Send> Send for Raw<T> {}
+unsafe impl<T: Send> Sync for Raw<T> {}
+
+impl<T: Copy> Raw<T> {
+    fn new(items: &mut [T]) -> Raw<T> {
+        Raw {
+            ptr: items.as_mut_ptr(),
+            len: items.len(),
+        }
+    }
+
+    /// [`prefetch`] of element `i` (reads nothing the program sees).
+    fn prefetch(self, i: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if i < self.len {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let first = self.ptr.wrapping_add(i).cast::<i8>().cast_const();
+            let last = first.wrapping_add(std::mem::size_of::<T>() - 1);
+            // SAFETY: SSE is part of the x86-64 baseline, and a prefetch
+            // never faults.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(first);
+                if std::mem::size_of::<T>() > 64 {
+                    _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(64));
+                }
+                _mm_prefetch::<_MM_HINT_T0>(last);
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = i;
+    }
+
+    /// # Safety
+    /// No other task writes element `i` meanwhile.
+    unsafe fn get(self, i: usize) -> T {
+        assert!(i < self.len);
+        // SAFETY: in bounds; no concurrent write (the caller's promise).
+        unsafe { *self.ptr.add(i) }
+    }
+
+    /// # Safety
+    /// No other task reads or writes element `i` meanwhile.
+    unsafe fn set(self, i: usize, value: T) {
+        assert!(i < self.len);
+        // SAFETY: in bounds; no concurrent access (the caller's promise).
+        unsafe { *self.ptr.add(i) = value }
+    }
+}
+
+/// The corner table as [`Raw`] views, for one collapse of a parallel step:
+/// it reads and writes only its own triangles (see [`collapse_in`]).
+#[derive(Clone, Copy)]
+struct TableView {
+    vertex: Raw<u32>,
+    opposite: Raw<u32>,
+    corner_of: Raw<u32>,
+}
+
+// SAFETY (all methods): a `TableView` exists only inside `apply_collapses`,
+// whose collapses touch disjoint corners and vertices.
+impl CornerAccess for TableView {
+    fn v(&self, c: u32) -> u32 {
+        unsafe { self.vertex.get(c as usize) }
+    }
+    fn o(&self, c: u32) -> u32 {
+        unsafe { self.opposite.get(c as usize) }
+    }
+    fn set_v(&mut self, c: u32, v: u32) {
+        unsafe { self.vertex.set(c as usize, v) }
+    }
+    fn set_o(&mut self, c: u32, o: u32) {
+        unsafe { self.opposite.set(c as usize, o) }
+    }
+    fn set_corner_of(&mut self, v: u32, c: u32) {
+        unsafe { self.corner_of.set(v as usize, c) }
     }
 }
 
