@@ -1072,10 +1072,10 @@ fn prefetch_fan(s: &State, v: u32) {
 }
 
 /// Size of the parts a per-vertex array is cut into when every part scans
-/// one list for the entries it owns (see `take_offers`): a few parts per
+/// one list for the entries it owns (see `take_offers`): two parts per
 /// thread, so the scans stay cheap and the work still balances.
 fn part_size(n: usize) -> usize {
-    n.div_ceil(4 * rayon::current_num_threads()).max(4096)
+    n.div_ceil(2 * rayon::current_num_threads()).max(4096)
 }
 
 /// §2 step a for `vertices`, in parallel: their requests are replaced.
@@ -1457,9 +1457,16 @@ fn step_winners(
                     continue;
                 }
                 // C's fan only if P's neighbours do not already beat the pair.
-                if !is_local_minimum(s_now, v, c, key, &tr.keys, scratch.walk_p(s_now, v))
-                    || !is_local_minimum(s_now, v, c, key, &tr.keys, scratch.walk_c(s_now, c))
-                {
+                // The check reads every neighbour's position: ask for them
+                // as soon as the fans are known.
+                let fan = scratch.walk_p(s_now, v);
+                prefetch_neighbours(s_now, fan);
+                if !is_local_minimum(s_now, v, c, key, &tr.keys, fan) {
+                    continue;
+                }
+                let fan = scratch.walk_c(s_now, c);
+                prefetch_neighbours(s_now, fan);
+                if !is_local_minimum(s_now, v, c, key, &tr.keys, fan) {
                     continue;
                 }
                 // The merged position, as the slot's evaluation found it.
@@ -1562,6 +1569,14 @@ fn step_winners(
     }
     winners.sort_unstable_by_key(|w| w.p);
     winners
+}
+
+/// Prefetches the positions of the vertices of `fan`'s triangles.
+fn prefetch_neighbours(s: &State, fan: &Fan) {
+    for &corner in &fan.corners {
+        prefetch(&s.positions, s.table.v(next(corner)) as usize);
+        prefetch(&s.positions, s.table.v(prev(corner)) as usize);
+    }
 }
 
 /// Whether no neighbour in `fan` (of P or C) other than P and C has an
