@@ -8,6 +8,9 @@
 //! Checking a few chosen pairs instead of every dirty vertex's candidates is
 //! most of the simplifier's speed.
 
+use std::sync::atomic::AtomicU32;
+use std::sync::atomic::Ordering::Relaxed;
+
 use super::state::State;
 use crate::corner_table::{NONE, next, prev};
 use crate::quadric::collapse_target;
@@ -165,7 +168,7 @@ pub struct Known<'a> {
     /// Per vertex, the state since which its 1-ring is what it is now.
     pub changed: &'a [u32],
     /// Per vertex, `== state` when a winner of this step blocks it.
-    pub blocked: &'a [u32],
+    pub blocked: &'a [AtomicU32],
 }
 
 impl Known<'_> {
@@ -330,7 +333,7 @@ pub fn pick_edge(
     }
     let changed_v = known.changed[v as usize];
     let mut consider = |u: u32, facing: u32| {
-        if known.blocked[u as usize] == known.state {
+        if known.blocked[u as usize].load(Relaxed) == known.state {
             return;
         }
         let slot = s.slot(facing);

@@ -1,5 +1,8 @@
 //! Working state and the step loop of the parallel simplifier.
 
+use std::sync::atomic::AtomicU32;
+use std::sync::atomic::Ordering::Relaxed;
+
 use rayon::prelude::*;
 
 use super::check::{CheckScratch, Plan, check_collapse, check_walked};
@@ -327,8 +330,9 @@ struct Tracking {
     /// Latest state in which one of the vertex's edges was refused (0: none
     /// since its 1-ring last changed).
     refusals: Vec<u32>,
-    /// `== state`: a winner of this step blocks the vertex.
-    blocked: Vec<u32>,
+    /// `== state`: a winner of this step blocks the vertex (set by the
+    /// checks as they find winners, in parallel).
+    blocked: Vec<AtomicU32>,
     /// `== state`: the vertex chooses from scratch at this step.
     listed: Vec<u32>,
     /// `== state`: the vertex was sorted into choosing or taking offers.
@@ -349,7 +353,7 @@ impl Tracking {
             changed: vec![0; n],
             merged: vec![0; n],
             refusals: vec![0; n],
-            blocked: vec![0; n],
+            blocked: (0..n).map(|_| AtomicU32::new(0)).collect(),
             // Every vertex is on the first step's list.
             listed: vec![1; n],
             sorted: vec![0; n],
@@ -790,7 +794,11 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
             gather_map(&mut t.changed, live_now, |x| x);
             gather_map(&mut t.merged, live_now, |x| x);
             gather_map(&mut t.refusals, live_now, |x| x);
-            gather_map(&mut t.blocked, live_now, |x| x);
+            for (i, &v) in live_now.iter().enumerate() {
+                let blocked = t.blocked[v as usize].load(Relaxed);
+                t.blocked[i].store(blocked, Relaxed);
+            }
+            t.blocked.truncate(m);
             gather_map(&mut t.listed, live_now, |x| x);
             gather_map(&mut t.sorted, live_now, |x| x);
             t.repick.truncate(m);
@@ -1252,13 +1260,11 @@ struct Tally {
 /// lengths of P's and C's).
 type Prepared = ([u32; 3], (u32, u32, u32));
 
-/// One chunk's checks: results in order, and for the valid ones the
-/// vertices they block, their targets, and
-/// their fans (offsets into `corners`).
+/// One chunk's checks: results in order, and for the valid ones their
+/// targets and their fans (offsets into `corners`).
 #[derive(Default)]
 struct Checked {
     results: Vec<(u32, Result<Plan, ()>)>,
-    blocks: Vec<u32>,
     prepared: Vec<Prepared>,
     corners: Vec<u32>,
 }
@@ -1359,10 +1365,10 @@ fn step_winners(
             let tr: &Tracking = t;
             par_filter_into(players, again, |&v| {
                 let b = tr.request(v, state);
-                (tr.blocked[v as usize] != state
+                (tr.blocked[v as usize].load(Relaxed) != state
                     && b.other != NONE
                     && (b.error <= threshold || b.error_key <= threshold_key)
-                    && tr.blocked[b.other as usize] == state)
+                    && tr.blocked[b.other as usize].load(Relaxed) == state)
                     .then_some(v)
             });
             // The ends of a refused pair are never blocked: a winner of the
@@ -1378,7 +1384,7 @@ fn step_winners(
             for &v in again.iter() {
                 let free = |b: &Best| {
                     b.other == NONE
-                        || (t.blocked[b.other as usize] != state
+                        || (t.blocked[b.other as usize].load(Relaxed) != state
                             && !known.refused(s.slot(b.corner), v, b.other))
                 };
                 match t.second[v as usize] {
@@ -1402,10 +1408,10 @@ fn step_winners(
         let tr: &Tracking = t;
         let admitted = |v: u32| {
             let b = tr.request(v, state);
-            tr.blocked[v as usize] != state
+            tr.blocked[v as usize].load(Relaxed) != state
                 && b.other != NONE
                 && b.error <= threshold
-                && tr.blocked[b.other as usize] != state
+                && tr.blocked[b.other as usize].load(Relaxed) != state
                 && tr.request(b.other, state).other == v
         };
         // One key per pair, taken from its lower endpoint, so that both
@@ -1427,8 +1433,8 @@ fn step_winners(
         phases.lap("admit");
         let tr: &Tracking = t;
         let s_now: &State = s;
-        // Local minima, checked; a valid one lists the vertices it blocks
-        // (from the fans its check walked).
+        // Local minima, checked; a valid one blocks its endpoints and their
+        // neighbours (from the fans its check walked).
         let checked: Vec<Checked> = par_chunks_map(admitted_keys, |chunk| {
             let mut scratch = CheckScratch::default();
             let mut out = Checked::default();
@@ -1475,7 +1481,11 @@ fn step_winners(
                 debug_assert_eq!(error, b.error, "slot of ({v}, {c}) up to date");
                 let result = check_walked(s_now, v, c, s_now.to_metric(target), &mut scratch);
                 if result.is_ok() {
-                    out.blocks.extend(scratch.neighbourhood());
+                    // The winner's endpoints and neighbours leave the
+                    // game; no check of this pass reads the flags.
+                    for x in scratch.neighbourhood() {
+                        tr.blocked[x as usize].store(state, Relaxed);
+                    }
                     let (fan_p, fan_c) = scratch.fans();
                     let start = out.corners.len() as u32;
                     out.corners.extend_from_slice(&fan_p.corners);
@@ -1547,12 +1557,6 @@ fn step_winners(
             }
             continue;
         }
-        // The winners' endpoints and neighbours leave the game.
-        for out in &checked {
-            for &x in &out.blocks {
-                t.blocked[x as usize] = state;
-            }
-        }
         phases.lap("block");
         counted += 1;
         if counted == PASSES || passes == MAX_PASSES {
@@ -1562,7 +1566,7 @@ fn step_winners(
         // passes sweep the others only.
         let tr: &Tracking = t;
         par_filter_into(players, spare, |&v| {
-            (tr.blocked[v as usize] != state).then_some(v)
+            (tr.blocked[v as usize].load(Relaxed) != state).then_some(v)
         });
         std::mem::swap(players, spare);
         phases.lap("retain players");
