@@ -1,7 +1,7 @@
 //! Working state and the step loop of the parallel simplifier.
 
-use std::sync::atomic::AtomicU32;
 use std::sync::atomic::Ordering::Relaxed;
+use std::sync::atomic::{AtomicU32, AtomicU64};
 
 use rayon::prelude::*;
 
@@ -339,7 +339,7 @@ struct Tracking {
     sorted: Vec<u32>,
     /// Pair key of each vertex's admitted request in the current pass,
     /// `u64::MAX` otherwise (reset after each pass, so never swept whole).
-    keys: Vec<u64>,
+    keys: Vec<AtomicU64>,
 }
 
 impl Tracking {
@@ -357,7 +357,7 @@ impl Tracking {
             // Every vertex is on the first step's list.
             listed: vec![1; n],
             sorted: vec![0; n],
-            keys: vec![u64::MAX; n],
+            keys: (0..n).map(|_| AtomicU64::new(u64::MAX)).collect(),
         }
     }
 
@@ -805,7 +805,9 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
             t.repick_at.truncate(m);
             t.repick_at.fill(0);
             t.keys.truncate(m);
-            t.keys.fill(u64::MAX);
+            for key in &t.keys {
+                key.store(u64::MAX, Relaxed);
+            }
         });
     });
     for v in choosers.iter_mut() {
@@ -1419,17 +1421,18 @@ fn step_winners(
         // different steps).
         par_filter_into(players, admitted_keys, |&v| {
             admitted(v).then(|| {
-                let low = v.min(tr.request(v, state).other);
-                (v, pair_key(tr.request(low, state), low))
+                let other = tr.request(v, state).other;
+                let low = v.min(other);
+                let key = pair_key(tr.request(low, state), low);
+                // Both ends (the partner may not be a player: its
+                // request's key can date from another scale); both write
+                // the same key, and nothing reads keys until the pass's
+                // minima.
+                tr.keys[v as usize].store(key, Relaxed);
+                tr.keys[other as usize].store(key, Relaxed);
+                (v, key)
             })
         });
-        for &(v, key) in admitted_keys.iter() {
-            // Both ends: the partner may not be a player (its request's key
-            // can date from another scale).
-            let other = t.request(v, state).other;
-            t.keys[v as usize] = key;
-            t.keys[other as usize] = key;
-        }
         phases.lap("admit");
         let tr: &Tracking = t;
         let s_now: &State = s;
@@ -1503,11 +1506,12 @@ fn step_winners(
             }
             out
         });
-        for &(v, _) in admitted_keys.iter() {
-            let other = t.request(v, state).other;
-            t.keys[v as usize] = u64::MAX;
-            t.keys[other as usize] = u64::MAX;
-        }
+        let tr: &Tracking = t;
+        admitted_keys.par_iter().for_each(|&(v, _)| {
+            let other = tr.request(v, state).other;
+            tr.keys[v as usize].store(u64::MAX, Relaxed);
+            tr.keys[other as usize].store(u64::MAX, Relaxed);
+        });
         phases.lap("minima+check");
         if checked.iter().all(|out| out.results.is_empty()) {
             break;
@@ -1585,8 +1589,8 @@ fn prefetch_neighbours(s: &State, fan: &Fan) {
 
 /// Whether no neighbour in `fan` (of P or C) other than P and C has an
 /// admitted request with a key below `key`.
-fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64], fan: &Fan) -> bool {
-    let beaten = |x: u32| x != p && x != c && keys[x as usize] < key;
+fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[AtomicU64], fan: &Fan) -> bool {
+    let beaten = |x: u32| x != p && x != c && keys[x as usize].load(Relaxed) < key;
     // Each neighbour once: the next vertex of every corner, and the previous
     // one where the fan is open after it.
     fan.corners.iter().all(|&corner| {
