@@ -254,7 +254,7 @@ pub struct Choices {
     /// A lower bound of the keys of the other candidates, those after
     /// `second` (after `best` where `second` is not known); `u32::MAX`
     /// when there are none. What a change of scale cannot reorder is
-    /// told by it (`state::rescaled_keeps`).
+    /// told by it (`state::rescaled`).
     pub bound: u32,
 }
 

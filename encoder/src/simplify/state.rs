@@ -813,12 +813,15 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
     for v in choosers.iter_mut() {
         *v = vmap[*v as usize];
     }
-    for o in offers.iter_mut().flat_map(|chunk| chunk.offers.iter_mut()) {
-        *o = Offer {
-            x: vmap[o.x as usize],
-            r: vmap[o.r as usize],
-            facing: cmap(o.facing),
-        };
+    for chunk in offers.iter_mut() {
+        for o in chunk.offers.iter_mut() {
+            *o = Offer {
+                x: vmap[o.x as usize],
+                r: vmap[o.r as usize],
+                facing: cmap(o.facing),
+            };
+        }
+        chunk.measure_span();
     }
     meter.triangles = meter
         .triangles
@@ -955,7 +958,11 @@ fn take_offers(
             let lo = k * size;
             let mut choose = Vec::new();
             let mut offered = 0;
-            for offers in offers.iter().map(|chunk| &chunk.offers) {
+            let hi = lo + best.len();
+            let chunks = offers
+                .iter()
+                .filter(|chunk| (chunk.span.0 as usize) < hi && chunk.span.1 as usize >= lo);
+            for offers in chunks.map(|chunk| &chunk.offers) {
                 for (i, o) in offers.iter().enumerate() {
                     let x = (o.x as usize).wrapping_sub(lo);
                     if x >= best.len() {
@@ -1181,7 +1188,7 @@ fn validate(
         }
         choose(s, t, &again, scale, state);
         // Chosen without the step's blocked neighbours: a rescale must not
-        // keep these requests (`rescaled_keeps`).
+        // keep these requests (`rescaled`).
         for &v in &again {
             t.bound[v as usize] = 0;
         }
@@ -1926,6 +1933,7 @@ fn refresh_edges(
                     out.choices.push(ranking.choices());
                 }
             }
+            out.measure_span();
         });
     let mut chosen = chunks.iter().flat_map(|chunk| chunk.choices.iter());
     for chunk in chunks.iter() {
@@ -1963,6 +1971,9 @@ struct RefreshChunk {
     updates: Vec<(u32, EdgeSlot)>,
     offers: Vec<Offer>,
     choices: Vec<Choices>,
+    /// The smallest and largest vertex the offers go to (`take_offers`
+    /// skips the chunk in the parts of the vertex range it misses).
+    span: (u32, u32),
 }
 
 impl RefreshChunk {
@@ -1970,6 +1981,15 @@ impl RefreshChunk {
         self.updates.clear();
         self.offers.clear();
         self.choices.clear();
+        self.span = (u32::MAX, 0);
+    }
+
+    /// Sets `span` from the offers.
+    fn measure_span(&mut self) {
+        self.span = self
+            .offers
+            .iter()
+            .fold((u32::MAX, 0), |(lo, hi), o| (lo.min(o.x), hi.max(o.x)));
     }
 }
 
