@@ -211,7 +211,7 @@ pub fn vertex_quadrics(
 
 /// Penalty quadric of boundary edge `(p, q)` of triangle `(p, q, r)`: the
 /// plane containing the edge and the triangle's normal.
-fn boundary_quadric(p: [f64; 3], q: [f64; 3], r: [f64; 3], weight: f64) -> Quadric {
+pub(crate) fn boundary_quadric(p: [f64; 3], q: [f64; 3], r: [f64; 3], weight: f64) -> Quadric {
     let e = sub(q, p);
     let n = cross(e, sub(r, p));
     let m = cross(e, n);

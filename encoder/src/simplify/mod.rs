@@ -11,7 +11,10 @@
 //! `corner_table`; per corner again (Edge) the cached error and merged
 //! position of the edge facing it (`select::EdgeSlot`). The Index array's
 //! job (who was merged into whom, in which order) is the list of
-//! [`Collapse`] records per step.
+//! [`Collapse`] records per step. As the mesh thins out, the CPU loop
+//! renumbers the live vertices and triangles densely (a monotone compaction
+//! of every array, so that every comparison of ids keeps its outcome) and
+//! maps records and results back to input ids.
 //!
 //! Each step is three data-parallel passes over the vertex array (rayon here,
 //! compute kernels later): best edge per vertex (§2 step a, with the sub-grid

@@ -8,6 +8,9 @@
 //! Checking a few chosen pairs instead of every dirty vertex's candidates is
 //! most of the simplifier's speed.
 
+use std::sync::atomic::AtomicU32;
+use std::sync::atomic::Ordering::Relaxed;
+
 use super::state::State;
 use crate::corner_table::{NONE, next, prev};
 use crate::quadric::collapse_target;
@@ -165,7 +168,7 @@ pub struct Known<'a> {
     /// Per vertex, the state since which its 1-ring is what it is now.
     pub changed: &'a [u32],
     /// Per vertex, `== state` when a winner of this step blocks it.
-    pub blocked: &'a [u32],
+    pub blocked: &'a [AtomicU32],
 }
 
 impl Known<'_> {
@@ -248,6 +251,11 @@ pub fn error_key(error: f64, scale: Scale) -> u32 {
 pub struct Choices {
     pub best: Best,
     pub second: Option<Best>,
+    /// A lower bound of the keys of the other candidates, those after
+    /// `second` (after `best` where `second` is not known); `u32::MAX`
+    /// when there are none. What a change of scale cannot reorder is
+    /// told by it (`state::rescaled`).
+    pub bound: u32,
 }
 
 /// The two cheapest candidates of one vertex seen so far, in [`Order`].
@@ -255,6 +263,8 @@ pub struct Ranking<'a> {
     order: Order<'a>,
     best: Best,
     second: Best,
+    /// The smallest key after the two.
+    third: u32,
 }
 
 impl<'a> Ranking<'a> {
@@ -263,6 +273,7 @@ impl<'a> Ranking<'a> {
             order: Order::new(s, v, scale),
             best: Best::NONE,
             second: Best::NONE,
+            third: u32::MAX,
         }
     }
 
@@ -275,6 +286,7 @@ impl<'a> Ranking<'a> {
         }
         let key = error_key(slot.error, self.order.scale);
         if key > self.second.error_key || !self.order.before(key, u, &self.second) {
+            self.third = self.third.min(key);
             return;
         }
         let choice = Best {
@@ -283,6 +295,7 @@ impl<'a> Ranking<'a> {
             error_key: key,
             corner: facing,
         };
+        self.third = self.third.min(self.second.error_key);
         if self.order.before(key, u, &self.best) {
             self.second = self.best;
             self.best = choice;
@@ -295,6 +308,7 @@ impl<'a> Ranking<'a> {
         Choices {
             best: self.best,
             second: Some(self.second),
+            bound: self.third,
         }
     }
 }
@@ -319,7 +333,7 @@ pub fn pick_edge(
     }
     let changed_v = known.changed[v as usize];
     let mut consider = |u: u32, facing: u32| {
-        if known.blocked[u as usize] == known.state {
+        if known.blocked[u as usize].load(Relaxed) == known.state {
             return;
         }
         let slot = s.slot(facing);
@@ -356,10 +370,11 @@ pub fn offer(s: &State, v: u32, choices: &mut Choices, u: u32, facing: u32, scal
         return;
     }
     let key = error_key(slot.error, scale);
-    let bound = choices
+    let last = choices
         .second
         .map_or(choices.best.error_key, |b| b.error_key);
-    if key > bound {
+    if key > last {
+        choices.bound = choices.bound.min(key);
         return;
     }
     let order = Order::new(s, v, scale);
@@ -370,12 +385,20 @@ pub fn offer(s: &State, v: u32, choices: &mut Choices, u: u32, facing: u32, scal
         corner: facing,
     };
     if order.before(key, u, &choices.best) {
+        // A known runner-up falls behind; without one, everything behind
+        // the old best stays behind the new runner-up.
+        if let Some(second) = choices.second {
+            choices.bound = choices.bound.min(second.error_key);
+        }
         choices.second = Some(choices.best);
         choices.best = choice;
     } else if let Some(second) = choices.second
         && order.before(key, u, &second)
     {
+        choices.bound = choices.bound.min(second.error_key);
         choices.second = Some(choice);
+    } else {
+        choices.bound = choices.bound.min(key);
     }
 }
 

@@ -1,5 +1,8 @@
 //! Working state and the step loop of the parallel simplifier.
 
+use std::sync::atomic::Ordering::Relaxed;
+use std::sync::atomic::{AtomicU32, AtomicU64};
+
 use rayon::prelude::*;
 
 use super::check::{CheckScratch, Plan, check_collapse, check_walked};
@@ -7,7 +10,7 @@ use super::select::{
     Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, error_key, evaluate, offer,
     pair_key, pick_edge,
 };
-use crate::corner_table::{CornerTable, Fan, NONE, next, prev};
+use crate::corner_table::{CornerAccess, CornerTable, Fan, NONE, collapse_in, next, prev};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
 
@@ -110,6 +113,13 @@ pub(super) struct State {
     pub metric: [f64; 3],
     pub constrained: bool,
     pub lock_boundary: bool,
+    /// Whether each vertex's fan holds all its corners and only the edges
+    /// used once are unmatched (see [`State::new`]).
+    pub manifold: bool,
+    /// Input id of each vertex: the CPU loop renumbers the live vertices
+    /// and triangles densely as they thin out ([`compact`]); records and
+    /// results are in input ids.
+    pub orig: Vec<u32>,
 }
 
 impl State {
@@ -118,19 +128,43 @@ impl State {
     pub fn new(mesh: &QuantizedMesh, options: &SimplifyOptions) -> State {
         let n = mesh.positions.len();
         let metric = mesh.metric;
-        let table = CornerTable::new(n, &mesh.triangles);
-        let mut boundary = vec![false; n];
-        for (c, &o) in table.opposite.iter().enumerate() {
-            if o == NONE {
-                boundary[table.v(next(c as u32)) as usize] = true;
-                boundary[table.v(prev(c as u32)) as usize] = true;
+        let (table, clean) = CornerTable::build(n, &mesh.triangles);
+        // Boundary flags and valences from each vertex's fan, in parallel;
+        // that holds where every vertex has one fan holding all its corners
+        // and the only unmatched edges are those used once (a checked mesh),
+        // which the fans' corner count tells.
+        let fans: Vec<(bool, u32)> = (0..n as u32)
+            .into_par_iter()
+            .map(|v| {
+                let (mut open, mut count) = (false, 0);
+                table.for_each_corner(v, |c| {
+                    count += 1;
+                    open |= table.o(prev(c)) == NONE;
+                });
+                (open, count)
+            })
+            .collect();
+        let manifold =
+            clean && fans.iter().map(|&(_, k)| k as usize).sum::<usize>() == table.vertex.len();
+        let (boundary, valence) = if manifold {
+            fans.into_iter()
+                .map(|(open, count)| (open, count + if open { 2 } else { 0 }))
+                .unzip()
+        } else {
+            let mut boundary = vec![false; n];
+            for (c, &o) in table.opposite.iter().enumerate() {
+                if o == NONE {
+                    boundary[table.v(next(c as u32)) as usize] = true;
+                    boundary[table.v(prev(c as u32)) as usize] = true;
+                }
             }
-        }
-        let alive: Vec<bool> = table.corner_of.iter().map(|&c| c != NONE).collect();
-        let mut valence: Vec<u32> = boundary.iter().map(|&b| if b { 2 } else { 0 }).collect();
-        for &v in &table.vertex {
-            valence[v as usize] += 1;
-        }
+            let mut valence: Vec<u32> = boundary.iter().map(|&b| if b { 2 } else { 0 }).collect();
+            for &v in &table.vertex {
+                valence[v as usize] += 1;
+            }
+            (boundary, valence)
+        };
+        let alive: Vec<bool> = table.corner_of.par_iter().map(|&c| c != NONE).collect();
         State {
             quadrics: Vec::new(),
             positions: mesh.positions.clone(),
@@ -144,7 +178,65 @@ impl State {
             metric,
             constrained: options.constrained,
             lock_boundary: options.lock_boundary,
+            orig: (0..n as u32).collect(),
+            manifold,
         }
+    }
+
+    /// [`vertex_quadrics`] of the input, summed per vertex over its fan in
+    /// parallel, in the same order (its triangles ascending, then its
+    /// boundary edges by key), so the same bits; `None` where the fans do not
+    /// cover the mesh ([`State::manifold`]).
+    pub fn fan_quadrics(&self, boundary_weight: f64) -> Option<Vec<Quadric>> {
+        if !self.manifold {
+            return None;
+        }
+        let t = &self.table;
+        // Each triangle's quadric is computed by each of its vertices: three
+        // times the arithmetic, but no 80-byte-a-triangle array to fill and
+        // read back.
+        let face = |k: u32| {
+            let [a, b, c] = [0, 1, 2].map(|j| self.geometry(t.v(3 * k + j)));
+            Quadric::from_triangle(a, b, c)
+        };
+        let n = self.positions.len() as u32;
+        let quadrics = (0..n)
+            .into_par_iter()
+            .map_init(
+                || (Vec::new(), Vec::new()),
+                |(triangles, edges): &mut (Vec<u32>, Vec<(u64, [u32; 3])>), v| {
+                    triangles.clear();
+                    t.for_each_corner(v, |c| triangles.push(c / 3));
+                    triangles.sort_unstable();
+                    let mut q = Quadric::ZERO;
+                    for &k in triangles.iter() {
+                        q += face(k);
+                    }
+                    if boundary_weight == 0.0 || !self.boundary[v as usize] {
+                        return q;
+                    }
+                    // The boundary edge facing corner f runs from next f to
+                    // prev f, with f's vertex third.
+                    edges.clear();
+                    t.for_each_corner(v, |c| {
+                        for f in [prev(c), next(c)] {
+                            if t.o(f) == NONE {
+                                let (a, b) = (t.v(next(f)), t.v(prev(f)));
+                                let key = (u64::from(a.min(b)) << 32) | u64::from(a.max(b));
+                                edges.push((key, [a, b, t.v(f)]));
+                            }
+                        }
+                    });
+                    edges.sort_unstable_by_key(|e| e.0);
+                    for &(_, ends) in edges.iter() {
+                        let [a, b, c] = ends.map(|x| self.geometry(x));
+                        q += crate::quadric::boundary_quadric(a, b, c, boundary_weight);
+                    }
+                    q
+                },
+            )
+            .collect();
+        Some(quadrics)
     }
 
     /// Metric coordinates of vertex `v`, computed from its grid position
@@ -224,6 +316,9 @@ struct Tracking {
     /// a vertex whose partner a collapse took falls back on it instead of
     /// walking its fan.
     second: Vec<Option<Best>>,
+    /// [`Choices::bound`] of each request; 0 where the request may not be
+    /// what a pick gives (chosen while neighbours were blocked).
+    bound: Vec<u32>,
     /// Requests chosen again within a step (blocked partners, refused
     /// edges), valid where `repick_at == state`; they never outlive it.
     repick: Vec<Best>,
@@ -235,15 +330,16 @@ struct Tracking {
     /// Latest state in which one of the vertex's edges was refused (0: none
     /// since its 1-ring last changed).
     refusals: Vec<u32>,
-    /// `== state`: a winner of this step blocks the vertex.
-    blocked: Vec<u32>,
+    /// `== state`: a winner of this step blocks the vertex (set by the
+    /// checks as they find winners, in parallel).
+    blocked: Vec<AtomicU32>,
     /// `== state`: the vertex chooses from scratch at this step.
     listed: Vec<u32>,
     /// `== state`: the vertex was sorted into choosing or taking offers.
     sorted: Vec<u32>,
     /// Pair key of each vertex's admitted request in the current pass,
     /// `u64::MAX` otherwise (reset after each pass, so never swept whole).
-    keys: Vec<u64>,
+    keys: Vec<AtomicU64>,
 }
 
 impl Tracking {
@@ -251,16 +347,17 @@ impl Tracking {
         Tracking {
             best: vec![Best::NONE; n],
             second: vec![None; n],
+            bound: vec![u32::MAX; n],
             repick: vec![Best::NONE; n],
             repick_at: vec![0; n],
             changed: vec![0; n],
             merged: vec![0; n],
             refusals: vec![0; n],
-            blocked: vec![0; n],
+            blocked: (0..n).map(|_| AtomicU32::new(0)).collect(),
             // Every vertex is on the first step's list.
             listed: vec![1; n],
             sorted: vec![0; n],
-            keys: vec![u64::MAX; n],
+            keys: (0..n).map(|_| AtomicU64::new(u64::MAX)).collect(),
         }
     }
 
@@ -305,9 +402,10 @@ pub fn simplify(
     phases.lap("");
     let mut s = State::new(mesh, options);
     phases.lap("table");
-    let geometry: Vec<[f64; 3]> = (0..n as u32).map(|v| s.geometry(v)).collect();
-    s.quadrics = vertex_quadrics(&geometry, &mesh.triangles, options.boundary_weight);
-    drop(geometry);
+    s.quadrics = s.fan_quadrics(options.boundary_weight).unwrap_or_else(|| {
+        let geometry: Vec<[f64; 3]> = (0..n as u32).map(|v| s.geometry(v)).collect();
+        vertex_quadrics(&geometry, &mesh.triangles, options.boundary_weight)
+    });
     phases.lap("quadrics");
     s.edges = initial_slots(&s);
     phases.lap("slots");
@@ -321,7 +419,7 @@ pub fn simplify(
     // `refresh_edges` and `step_winners`; `offers` are the edges refreshed
     // by the last step's collapses, for their other ends.
     let mut choosers = live.clone();
-    let mut offers: Vec<Offer> = Vec::new();
+    let mut offers: Vec<RefreshChunk> = Vec::new();
     let mut buffers = Buffers::default();
     // Recent refused checks and checks (see `VALIDATE_ABOVE`).
     let mut refusals = (0.0f64, 0.0f64);
@@ -332,29 +430,57 @@ pub fn simplify(
     // vertices are gone since the last measure (a full pass over the corners).
     let mut meter = EdgeMeter::new(&s);
     let (mut edge, mut edge_measured_at) = (meter.measure(&s), alive_count);
+    // Positions and split valences by input id, of the vertices renumbered
+    // away (see `compact`).
+    let mut input = InputArrays {
+        positions: mesh.positions.clone(),
+        split_valence: vec![LEAF; n],
+    };
     while alive_count > options.target_vertices {
         let state = steps.len() as u32 + 1;
         phases.lap("loop");
         if alive_count * 5 < edge_measured_at * 4 {
+            let old_flat = flat_of(edge);
             edge = meter.measure(&s);
             edge_measured_at = alive_count;
             // The sub-grid and the flat threshold change with the scale:
-            // every request chooses again under the new one. (Requests kept
-            // from the old scale would compare keys and cells of two scales;
-            // on a DEM in degrees and metres, where the flat threshold is
-            // above most errors and the tie-breaks decide, the steps then
-            // found few collapses each.)
-            for &v in &live {
-                if std::mem::replace(&mut t.listed[v as usize], state) != state {
-                    choosers.push(v);
+            // every request that they can change chooses again under the
+            // new one. (Requests kept from the old scale would compare keys
+            // and cells of two scales; on a DEM in degrees and metres, where
+            // the flat threshold is above most errors and the tie-breaks
+            // decide, the steps then found few collapses each.)
+            let bound = old_flat.max(flat_of(edge));
+            let tr: &Tracking = &t;
+            let mut changes = Vec::new();
+            par_filter_into(&live, &mut changes, |&v| {
+                // Listed vertices choose anyway, but for those the last
+                // step merged: they chose then, under the old scale.
+                let listed = tr.listed[v as usize] == state;
+                if listed && tr.merged[v as usize] != state {
+                    return None;
                 }
+                match rescaled(tr, v, bound) {
+                    Rescaled::Kept => None,
+                    change => Some((v, change)),
+                }
+            });
+            let mut chose = 0usize;
+            for &(v, change) in &changes {
+                if change == Rescaled::Chooses {
+                    t.listed[v as usize] = state;
+                    choosers.push(v);
+                    chose += 1;
+                } else {
+                    t.second[v as usize] = None;
+                }
+            }
+            if debug {
+                eprintln!("rescale: {chose} of {} requests choose again", live.len());
             }
         }
         let scale = Scale {
             cell: options.subgrid_cells * edge,
-            // A collapse moving the surface by 1e-4 of an edge length or less
-            // (error ~ area x distance^2 ~ L^2 x (1e-4 L)^2) counts as flat.
-            flat: 1e-8 * edge.powi(4),
+            flat: flat_of(edge),
         };
         let t_best = std::time::Instant::now();
         phases.lap("measure");
@@ -444,50 +570,55 @@ pub fn simplify(
         }
         let t_apply = std::time::Instant::now();
         phases.lap("select");
-        let mut collapses = Vec::with_capacity(winners.len());
-        let mut step_error = 0.0f64;
-        for w in &winners {
-            debug_assert_eq!(
-                check_collapse(
-                    &s,
-                    w.p,
-                    w.best.other,
-                    s.to_metric(w.target),
-                    &mut CheckScratch::default()
-                ),
-                Ok(w.plan),
-                "a winner's check holds after the other collapses of its step"
-            );
-            let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
-            let fan_p = &buffers.fans[start..start + np];
-            let fan_c = &buffers.fans[start + np..start + np + nc];
-            // Built from P and C before the collapse, as its check saw them
-            // (no other collapse of the step touches them).
-            let (record, quadric) = prepare(&s, w.p, w.best, w.target, w.plan);
-            s.table
-                .collapse_fans(w.p, w.best.other, w.plan.left, w.plan.right, fan_p, fan_c);
-            commit(&mut s, w.p, w.best.other, w.target, w.plan, quadric);
-            collapses.push(record);
-            step_error = step_error.max(w.best.error);
+        if cfg!(debug_assertions) {
+            for w in &winners {
+                let target = s.to_metric(w.target);
+                let check = check_collapse(&s, w.p, w.best.other, target, &mut Default::default());
+                assert_eq!(
+                    check,
+                    Ok(w.plan),
+                    "a winner's check holds at the end of its step"
+                );
+            }
         }
+        let step_error = winners.iter().fold(0.0f64, |e, w| e.max(w.best.error));
+        let collapses = apply_collapses(&mut s, &winners, &buffers.fans);
         let t_refresh = std::time::Instant::now();
         phases.lap("apply");
         let merged: Vec<u32> = winners.iter().map(|w| w.p).collect();
-        // The next step keeps this scale unless it measures edges again.
-        let left = alive_count - collapses.len();
-        let same_scale = (left * 5 >= edge_measured_at * 4).then_some(scale);
+        // The merged vertices choose under this step's scale; should the
+        // next step measure edges again, its rescale sorts them like the
+        // other requests.
         refresh_edges(
             &mut s,
             &mut t,
             &merged,
             state + 1,
-            same_scale,
+            Some(scale),
             &mut choosers,
             &mut offers,
         );
         phases.lap("refresh");
         live.retain(|&v| s.alive[v as usize]);
         phases.lap("retain");
+        // Renumber densely once half the vertices are gone: the passes then
+        // read whole cache lines of live data instead of scattered ones.
+        if live.len() * 2 < s.positions.len() {
+            let pairs: Vec<(u32, u32)> = winners.iter().map(|w| (w.p, w.best.other)).collect();
+            compact(
+                &mut s,
+                &mut t,
+                Renumbered {
+                    live: &mut live,
+                    pairs: &pairs,
+                    choosers: &mut choosers,
+                    offers: &mut offers,
+                    meter: &mut meter,
+                    input: &mut input,
+                },
+            );
+            phases.lap("compact");
+        }
         if debug {
             let ms = |a: std::time::Instant, b: std::time::Instant| (b - a).as_secs_f64() * 1e3;
             let now = std::time::Instant::now();
@@ -516,15 +647,245 @@ pub fn simplify(
     if debug {
         eprintln!("{}", phases.report());
     }
+    // Back to input ids.
+    input.save(&s);
+    let mut alive = vec![false; n];
+    let mut corner_of = vec![NONE; n];
+    for (i, &v) in s.orig.iter().enumerate() {
+        alive[v as usize] = s.alive[i];
+        corner_of[v as usize] = s.table.corner_of[i];
+    }
+    let orig = &s.orig;
+    let vertex = s
+        .table
+        .vertex
+        .par_iter()
+        .map(|&v| if v == NONE { NONE } else { orig[v as usize] })
+        .collect();
     Simplification {
         steps,
-        table: s.table,
-        positions: s.positions,
-        split_valence: s.split_valence,
-        alive: s.alive,
+        table: CornerTable {
+            vertex,
+            opposite: s.table.opposite,
+            corner_of,
+        },
+        positions: input.positions,
+        split_valence: input.split_valence,
+        alive,
         alive_count,
         step_errors,
     }
+}
+
+/// Per input id, the positions and split valences of the vertices as they
+/// were last renumbered (a vertex's never change once it is gone).
+struct InputArrays {
+    positions: Vec<[u32; 3]>,
+    split_valence: Vec<u8>,
+}
+
+impl InputArrays {
+    /// Saves every vertex of the current numbering, live or not.
+    fn save(&mut self, s: &State) {
+        for (i, &v) in s.orig.iter().enumerate() {
+            self.positions[v as usize] = s.positions[i];
+            self.split_valence[v as usize] = s.split_valence[i];
+        }
+    }
+}
+
+/// What the loop keeps in current ids besides the state and tracking, for
+/// [`compact`].
+struct Renumbered<'a> {
+    /// The live vertices, ascending (become 0..n).
+    live: &'a mut Vec<u32>,
+    /// (P, C) of the step just applied: requests still naming C (its
+    /// neighbours take their offers at the next step) name P instead, who
+    /// was merged at that step and so counts as taken just the same.
+    pairs: &'a [(u32, u32)],
+    choosers: &'a mut Vec<u32>,
+    offers: &'a mut [RefreshChunk],
+    meter: &'a mut EdgeMeter,
+    input: &'a mut InputArrays,
+}
+
+/// Renumbers the live vertices (in `live` order, ascending) and the live
+/// triangles (in order) densely, between two steps. Every comparison of ids
+/// (index priority, tie-breaks, the lower corner of an edge) keeps its
+/// outcome, so the collapses are the same, only cheaper to find: once most
+/// vertices are gone, each pass otherwise reads one live vertex per cache
+/// line and per page. The state numbers in the tracking stamps carry over.
+fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
+    let Renumbered {
+        live,
+        pairs,
+        choosers,
+        offers,
+        meter,
+        input,
+    } = r;
+    input.save(s);
+    let n = s.positions.len();
+    let mut vmap = vec![NONE; n];
+    for (i, &v) in live.iter().enumerate() {
+        vmap[v as usize] = i as u32;
+    }
+    for &(p, c) in pairs {
+        vmap[c as usize] = vmap[p as usize];
+    }
+    let mut tmap = vec![NONE; s.table.vertex.len() / 3];
+    let mut triangles = Vec::with_capacity(2 * live.len());
+    for (k, slot) in tmap.iter_mut().enumerate() {
+        if s.table.vertex[3 * k] != NONE {
+            *slot = triangles.len() as u32;
+            triangles.push(k as u32);
+        }
+    }
+    let cmap = |c: u32| {
+        if c == NONE || tmap[(c / 3) as usize] == NONE {
+            NONE
+        } else {
+            3 * tmap[(c / 3) as usize] + c % 3
+        }
+    };
+    let vmap_of = |v: u32| if v == NONE { NONE } else { vmap[v as usize] };
+    // In place, in ascending order: every element moves down or stays, and
+    // is read before anything lands on it; no fresh pages to fault in.
+    let corners: Vec<u32> = triangles
+        .iter()
+        .flat_map(|&k| [3 * k, 3 * k + 1, 3 * k + 2])
+        .collect();
+    let m = live.len();
+    let remap = |b: Best| {
+        debug_assert!(b.other == NONE || vmap[b.other as usize] != NONE);
+        Best {
+            other: vmap_of(b.other),
+            corner: cmap(b.corner),
+            ..b
+        }
+    };
+    let live_now: &[u32] = live;
+    let corners = &corners[..];
+    let CornerTable {
+        vertex,
+        opposite,
+        corner_of,
+    } = &mut s.table;
+    // Each array on its own: they are independent.
+    rayon::scope(|scope| {
+        scope.spawn(|_| gather_map(vertex, corners, vmap_of));
+        scope.spawn(|_| gather_map(opposite, corners, cmap));
+        scope.spawn(|_| gather_map(&mut s.edges, corners, |e| e));
+        scope.spawn(|_| gather_map(&mut s.quadrics, live_now, |x| x));
+        scope.spawn(|_| {
+            gather_map(corner_of, live_now, cmap);
+            gather_map(&mut s.positions, live_now, |x| x);
+            gather_map(&mut s.boundary, live_now, |x| x);
+            gather_map(&mut s.valence, live_now, |x| x);
+            gather_map(&mut s.split_valence, live_now, |x| x);
+            gather_map(&mut s.orig, live_now, |x| x);
+            s.alive.truncate(m);
+            s.alive.fill(true);
+        });
+        scope.spawn(|_| gather_map(&mut t.best, live_now, remap));
+        scope.spawn(|_| gather_map(&mut t.second, live_now, |b| b.map(remap)));
+        scope.spawn(|_| {
+            gather_map(&mut t.bound, live_now, |x| x);
+            gather_map(&mut t.changed, live_now, |x| x);
+            gather_map(&mut t.merged, live_now, |x| x);
+            gather_map(&mut t.refusals, live_now, |x| x);
+            for (i, &v) in live_now.iter().enumerate() {
+                let blocked = t.blocked[v as usize].load(Relaxed);
+                t.blocked[i].store(blocked, Relaxed);
+            }
+            t.blocked.truncate(m);
+            gather_map(&mut t.listed, live_now, |x| x);
+            gather_map(&mut t.sorted, live_now, |x| x);
+            t.repick.truncate(m);
+            t.repick_at.truncate(m);
+            t.repick_at.fill(0);
+            t.keys.truncate(m);
+            for key in &t.keys {
+                key.store(u64::MAX, Relaxed);
+            }
+        });
+    });
+    for v in choosers.iter_mut() {
+        *v = vmap[*v as usize];
+    }
+    for chunk in offers.iter_mut() {
+        for o in chunk.offers.iter_mut() {
+            *o = Offer {
+                x: vmap[o.x as usize],
+                r: vmap[o.r as usize],
+                facing: cmap(o.facing),
+            };
+        }
+        chunk.measure_span();
+    }
+    meter.triangles = meter
+        .triangles
+        .iter()
+        .filter_map(|&k| Some(tmap[k as usize]).filter(|&k| k != NONE))
+        .collect();
+    *live = (0..m as u32).collect();
+}
+
+/// `items[i] = f(items[from[i]])` for each `i` in order, then `items` cut to
+/// `from.len()`: with `from` ascending and `from[i] >= i`, every element is
+/// read before it is overwritten.
+fn gather_map<T: Copy>(items: &mut Vec<T>, from: &[u32], f: impl Fn(T) -> T) {
+    for (i, &k) in from.iter().enumerate() {
+        debug_assert!(k as usize >= i);
+        items[i] = f(items[k as usize]);
+    }
+    items.truncate(from.len());
+}
+
+/// The flat threshold of the tie-breaks ([`Scale::flat`]) for a mean edge
+/// length: a collapse moving the surface by 1e-4 of an edge length or less
+/// (error ~ area x distance^2 ~ L^2 x (1e-4 L)^2) counts as flat.
+fn flat_of(edge: f64) -> f64 {
+    1e-8 * edge.powi(4)
+}
+
+/// Whether the request of `v` stays what [`pick_edge`] would choose when the
+/// scale changes and no flat threshold, old or new, reaches `flat`: its
+/// error is above both (so its key is the same under both) and every other
+/// candidate's key is higher (so no tie-break, whose sub-grid changed,
+/// decided it); they then keep higher keys under the new scale too. A
+/// runner-up with a possible tie behind it becomes unknown (the new
+/// sub-grid could break the tie the other way). A vertex without a request,
+/// or whose request may not be a pick's, chooses again.
+fn rescaled(t: &Tracking, v: u32, flat: f64) -> Rescaled {
+    let v = v as usize;
+    let (best, bound) = (t.best[v], t.bound[v]);
+    if best.other == NONE || best.error <= flat || bound == 0 {
+        return Rescaled::Chooses;
+    }
+    match t.second[v] {
+        Some(second) if second.other == NONE => Rescaled::Kept,
+        Some(second) if second.error_key > best.error_key => {
+            if bound <= second.error_key {
+                Rescaled::KeptWithoutSecond
+            } else {
+                Rescaled::Kept
+            }
+        }
+        Some(_) => Rescaled::Chooses,
+        None if bound > best.error_key => Rescaled::Kept,
+        None => Rescaled::Chooses,
+    }
+}
+
+/// What a rescale does to a request ([`rescaled`]).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Rescaled {
+    Kept,
+    /// Kept, the runner-up made unknown.
+    KeptWithoutSecond,
+    /// The vertex chooses again.
+    Chooses,
 }
 
 /// Every edge's slot, at the lower of its corners ([`State::slot_index`]);
@@ -563,48 +924,107 @@ struct Offer {
 fn take_offers(
     s: &State,
     t: &mut Tracking,
-    offers: &[Offer],
+    offers: &[RefreshChunk],
     choosers: &mut Vec<u32>,
     scale: Scale,
     state: u32,
 ) -> usize {
-    let mut offered = 0;
     let gone =
-        |t: &Tracking, u: u32| u != NONE && (!s.alive[u as usize] || t.merged[u as usize] == state);
-    for o in offers {
-        let x = o.x as usize;
-        if t.sorted[x] != state {
-            t.sorted[x] = state;
-            if t.listed[x] != state {
-                let second = t.second[x];
-                let second_gone = second.is_none_or(|b| gone(t, b.other));
-                if t.refusals[x] != 0 || (gone(t, t.best[x].other) && second_gone) {
-                    t.listed[x] = state;
-                    choosers.push(o.x);
-                } else {
-                    offered += 1;
-                    if gone(t, t.best[x].other) {
-                        // The runner-up is the best of what is left; what
-                        // comes after it is not known.
-                        let b = second.unwrap_or(Best::NONE);
-                        t.best[x] = b;
-                        t.second[x] = (b.other == NONE).then_some(Best::NONE);
-                    } else if second_gone {
-                        t.second[x] = None;
+        |merged: &[u32], u: u32| u != NONE && (!s.alive[u as usize] || merged[u as usize] == state);
+    // Each part of the vertex range takes the offers to its own vertices,
+    // in the order of `offers` (the parts scan the whole list: a compare
+    // per offer), so the requests come out as one pass in order gives them.
+    let n = t.best.len();
+    let size = part_size(n);
+    let Tracking {
+        best,
+        second,
+        bound,
+        listed,
+        sorted,
+        merged,
+        refusals,
+        ..
+    } = t;
+    let (merged, refusals): (&[u32], &[u32]) = (merged, refusals);
+    let parts: Vec<(Vec<u32>, usize)> = best
+        .par_chunks_mut(size)
+        .zip(second.par_chunks_mut(size))
+        .zip(bound.par_chunks_mut(size))
+        .zip(listed.par_chunks_mut(size))
+        .zip(sorted.par_chunks_mut(size))
+        .enumerate()
+        .map(|(k, ((((best, second), bound), listed), sorted))| {
+            let lo = k * size;
+            let mut choose = Vec::new();
+            let mut offered = 0;
+            let hi = lo + best.len();
+            let chunks = offers
+                .iter()
+                .filter(|chunk| (chunk.span.0 as usize) < hi && chunk.span.1 as usize >= lo);
+            for offers in chunks.map(|chunk| &chunk.offers) {
+                for (i, o) in offers.iter().enumerate() {
+                    let x = (o.x as usize).wrapping_sub(lo);
+                    if x >= best.len() {
+                        continue;
                     }
+                    // What the offers ahead read at random: the request, and
+                    // the slot (through its corner's opposite).
+                    if let Some(ahead) = offers.get(i + 8) {
+                        let y = (ahead.x as usize).wrapping_sub(lo);
+                        if y < best.len() {
+                            prefetch(best, y);
+                            prefetch(second, y);
+                            prefetch(&s.table.opposite, ahead.facing as usize);
+                            prefetch(&s.edges, ahead.facing as usize);
+                        }
+                    }
+                    if sorted[x] != state {
+                        sorted[x] = state;
+                        if listed[x] != state {
+                            let runner_up = second[x];
+                            let second_gone = runner_up.is_none_or(|b| gone(merged, b.other));
+                            let best_gone = gone(merged, best[x].other);
+                            if refusals[o.x as usize] != 0 || (best_gone && second_gone) {
+                                listed[x] = state;
+                                choose.push(o.x);
+                            } else {
+                                offered += 1;
+                                // Either way the bound of what comes after the
+                                // runner-up now bounds what comes after the best.
+                                if best_gone {
+                                    // The runner-up is the best of what is left;
+                                    // what comes after it is not known.
+                                    let b = runner_up.unwrap_or(Best::NONE);
+                                    best[x] = b;
+                                    second[x] = (b.other == NONE).then_some(Best::NONE);
+                                } else if second_gone {
+                                    second[x] = None;
+                                }
+                            }
+                        }
+                    }
+                    if listed[x] == state {
+                        continue;
+                    }
+                    let mut choices = Choices {
+                        best: best[x],
+                        second: second[x],
+                        bound: bound[x],
+                    };
+                    offer(s, o.x, &mut choices, o.r, o.facing, scale);
+                    best[x] = choices.best;
+                    second[x] = choices.second;
+                    bound[x] = choices.bound;
                 }
             }
-        }
-        if t.listed[x] == state {
-            continue;
-        }
-        let mut choices = Choices {
-            best: t.best[x],
-            second: t.second[x],
-        };
-        offer(s, o.x, &mut choices, o.r, o.facing, scale);
-        t.best[x] = choices.best;
-        t.second[x] = choices.second;
+            (choose, offered)
+        })
+        .collect();
+    let mut offered = 0;
+    for (choose, count) in parts {
+        choosers.extend(choose);
+        offered += count;
     }
     // Every chooser's refused edges are stale now (its 1-ring changed, or
     // it was refused and chooses without the refused edge).
@@ -616,6 +1036,65 @@ fn take_offers(
     offered
 }
 
+/// Asks the cache for element `i` of `items` (all of its cache lines), where
+/// the target has a prefetch instruction; a hint, never a fault.
+#[inline(always)]
+pub(super) fn prefetch<T>(items: &[T], i: usize) {
+    #[cfg(target_arch = "x86_64")]
+    if let Some(x) = items.get(i) {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        let first = (x as *const T).cast::<i8>();
+        let last = first.wrapping_add(std::mem::size_of::<T>() - 1);
+        // SAFETY: SSE is part of the x86-64 baseline, and a prefetch reads
+        // nothing the program sees and never faults.
+        unsafe {
+            _mm_prefetch::<_MM_HINT_T0>(first);
+            if std::mem::size_of::<T>() > 64 {
+                _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(64));
+            }
+            _mm_prefetch::<_MM_HINT_T0>(last);
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (items, i);
+}
+
+/// Prefetches, while the vertex at `i` of `list` is processed, what the
+/// fan walks of the next ones start from: the corner of the vertex 16
+/// ahead, and the first triangle (corners, opposites, edge slots) of the
+/// vertex 8 ahead. A fan walk is a chain of dependent loads; without this,
+/// each link waits for memory in turn.
+#[inline(always)]
+fn prefetch_ahead(s: &State, list: &[u32], i: usize) {
+    if let Some(&w) = list.get(i + 16) {
+        prefetch(&s.table.corner_of, w as usize);
+    }
+    if let Some(&w) = list.get(i + 8) {
+        prefetch_fan(s, w);
+    }
+}
+
+/// Prefetches the first triangle of the fan of `v` (whose corner should be
+/// in cache already), its position and quadric.
+#[inline(always)]
+fn prefetch_fan(s: &State, v: u32) {
+    let c = s.table.corner_of[v as usize];
+    if c != NONE {
+        let base = (c - c % 3) as usize;
+        prefetch(&s.table.vertex, base);
+        prefetch(&s.table.opposite, base);
+        prefetch(&s.edges, base);
+        prefetch(&s.edges, base + 2);
+    }
+}
+
+/// Size of the parts a per-vertex array is cut into when every part scans
+/// one list for the entries it owns (see `take_offers`): two parts per
+/// thread, so the scans stay cheap and the work still balances.
+fn part_size(n: usize) -> usize {
+    n.div_ceil(2 * rayon::current_num_threads()).max(4096)
+}
+
 /// §2 step a for `vertices`, in parallel: their requests are replaced.
 /// Returns the neighbours whose refused edges the choosers found reopened.
 fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u32) -> Vec<u32> {
@@ -624,6 +1103,7 @@ fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u3
         for (v, choices) in picks {
             t.best[v as usize] = choices.best;
             t.second[v as usize] = choices.second;
+            t.bound[v as usize] = choices.bound;
         }
         reopened.extend(chunk_reopened);
     }
@@ -694,6 +1174,9 @@ fn validate(
             }
             for x in [v, b.other] {
                 t.refusals[x as usize] = state;
+                // The other end may keep the refused edge as its request
+                // until its 1-ring changes: a rescale must not keep it.
+                t.bound[x as usize] = 0;
                 if in_step && t.listed[x as usize] != state + 1 {
                     t.listed[x as usize] = state + 1;
                     refused_ends.push(x);
@@ -704,6 +1187,11 @@ fn validate(
             return;
         }
         choose(s, t, &again, scale, state);
+        // Chosen without the step's blocked neighbours: a rescale must not
+        // keep these requests (`rescaled`).
+        for &v in &again {
+            t.bound[v as usize] = 0;
+        }
         let picks = pick_all(s, t, &overlay, scale, state);
         for (v, c) in picks.into_iter().flat_map(|(picks, _)| picks) {
             t.repick[v as usize] = c.best;
@@ -730,7 +1218,11 @@ fn pick_all(
         let mut reopened = Vec::new();
         let picks: Vec<(u32, Choices)> = chunk
             .iter()
-            .map(|&v| (v, pick_edge(s, v, scale, known, &mut reopened)))
+            .enumerate()
+            .map(|(i, &v)| {
+                prefetch_ahead(s, chunk, i);
+                (v, pick_edge(s, v, scale, known, &mut reopened))
+            })
             .collect();
         (picks, reopened)
     })
@@ -757,6 +1249,7 @@ fn par_filter_into<T: Sync, U: Send>(
 struct Buffers {
     errors: Vec<f64>,
     players: Vec<u32>,
+    spare: Vec<u32>,
     again: Vec<u32>,
     admitted: Vec<(u32, u64)>,
     /// The fans of the step's winners (see [`Winner::fans`]).
@@ -776,13 +1269,11 @@ struct Tally {
 /// lengths of P's and C's).
 type Prepared = ([u32; 3], (u32, u32, u32));
 
-/// One chunk's checks: results in order, and for the valid ones the
-/// vertices they block, their targets, and
-/// their fans (offsets into `corners`).
+/// One chunk's checks: results in order, and for the valid ones their
+/// targets and their fans (offsets into `corners`).
 #[derive(Default)]
 struct Checked {
     results: Vec<(u32, Result<Plan, ()>)>,
-    blocks: Vec<u32>,
     prepared: Vec<Prepared>,
     corners: Vec<u32>,
 }
@@ -791,8 +1282,12 @@ struct Checked {
 /// order. Each chunk fills its own buffers: no allocation per item and no
 /// merging copies (rayon's fold/reduce re-copies at every level).
 fn par_chunks_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&[T]) -> R + Sync + Send) -> Vec<R> {
-    let size = (items.len() / (8 * rayon::current_num_threads())).clamp(512, 16384);
-    items.par_chunks(size).map(f).collect()
+    items.par_chunks(chunk_size(items.len())).map(f).collect()
+}
+
+/// The chunk length of the data-parallel passes over `len` items.
+fn chunk_size(len: usize) -> usize {
+    (len / (8 * rayon::current_num_threads())).clamp(512, 16384)
 }
 
 /// What one step selects with: its state number, the threshold S, the
@@ -857,6 +1352,7 @@ fn step_winners(
     let tr: &Tracking = t;
     let Buffers {
         players,
+        spare,
         again,
         admitted: admitted_keys,
         fans,
@@ -868,21 +1364,20 @@ fn step_winners(
         let b = &tr.best[v as usize];
         (b.other != NONE && (b.error <= threshold || b.error_key <= threshold_key)).then_some(v)
     });
-    let live = &players[..];
     // The players' requests are checked before they pair up (see `validate`).
     if validating {
-        validate(s, t, live, scale, state, refused_ends, tally);
+        validate(s, t, players, scale, state, refused_ends, tally);
     }
     phases.lap("validate");
     loop {
         if !first {
             let tr: &Tracking = t;
-            par_filter_into(live, again, |&v| {
+            par_filter_into(players, again, |&v| {
                 let b = tr.request(v, state);
-                (tr.blocked[v as usize] != state
+                (tr.blocked[v as usize].load(Relaxed) != state
                     && b.other != NONE
                     && (b.error <= threshold || b.error_key <= threshold_key)
-                    && tr.blocked[b.other as usize] == state)
+                    && tr.blocked[b.other as usize].load(Relaxed) == state)
                     .then_some(v)
             });
             // The ends of a refused pair are never blocked: a winner of the
@@ -898,7 +1393,7 @@ fn step_winners(
             for &v in again.iter() {
                 let free = |b: &Best| {
                     b.other == NONE
-                        || (t.blocked[b.other as usize] != state
+                        || (t.blocked[b.other as usize].load(Relaxed) != state
                             && !known.refused(s.slot(b.corner), v, b.other))
                 };
                 match t.second[v as usize] {
@@ -922,46 +1417,72 @@ fn step_winners(
         let tr: &Tracking = t;
         let admitted = |v: u32| {
             let b = tr.request(v, state);
-            tr.blocked[v as usize] != state
+            tr.blocked[v as usize].load(Relaxed) != state
                 && b.other != NONE
                 && b.error <= threshold
-                && tr.blocked[b.other as usize] != state
+                && tr.blocked[b.other as usize].load(Relaxed) != state
                 && tr.request(b.other, state).other == v
         };
         // One key per pair, taken from its lower endpoint, so that both
         // endpoints compare alike (their cached errors may come from
         // different steps).
-        par_filter_into(live, admitted_keys, |&v| {
+        par_filter_into(players, admitted_keys, |&v| {
             admitted(v).then(|| {
-                let low = v.min(tr.request(v, state).other);
-                (v, pair_key(tr.request(low, state), low))
+                let other = tr.request(v, state).other;
+                let low = v.min(other);
+                let key = pair_key(tr.request(low, state), low);
+                // Both ends (the partner may not be a player: its
+                // request's key can date from another scale); both write
+                // the same key, and nothing reads keys until the pass's
+                // minima.
+                tr.keys[v as usize].store(key, Relaxed);
+                tr.keys[other as usize].store(key, Relaxed);
+                (v, key)
             })
         });
-        for &(v, key) in admitted_keys.iter() {
-            // Both ends: the partner may not be a player (its request's key
-            // can date from another scale).
-            let other = t.request(v, state).other;
-            t.keys[v as usize] = key;
-            t.keys[other as usize] = key;
-        }
         phases.lap("admit");
         let tr: &Tracking = t;
         let s_now: &State = s;
-        // Local minima, checked; a valid one lists the vertices it blocks
-        // (from the fans its check walked).
+        // Local minima, checked; a valid one blocks its endpoints and their
+        // neighbours (from the fans its check walked).
         let checked: Vec<Checked> = par_chunks_map(admitted_keys, |chunk| {
             let mut scratch = CheckScratch::default();
             let mut out = Checked::default();
-            for &(v, key) in chunk {
+            for (i, &(v, key)) in chunk.iter().enumerate() {
+                // Both fans and quadrics of the pairs ahead (see
+                // `prefetch_ahead`).
+                if let Some(&(w, _)) = chunk.get(i + 12) {
+                    let u = tr.request(w, state).other;
+                    if w < u {
+                        prefetch(&s_now.table.corner_of, w as usize);
+                        prefetch(&s_now.table.corner_of, u as usize);
+                    }
+                }
+                if let Some(&(w, _)) = chunk.get(i + 6) {
+                    let u = tr.request(w, state).other;
+                    if w < u {
+                        prefetch_fan(s_now, w);
+                        prefetch_fan(s_now, u);
+                        prefetch(&s_now.quadrics, w as usize);
+                        prefetch(&s_now.quadrics, u as usize);
+                    }
+                }
                 let b = tr.request(v, state);
                 let c = b.other;
                 if v > c {
                     continue;
                 }
                 // C's fan only if P's neighbours do not already beat the pair.
-                if !is_local_minimum(s_now, v, c, key, &tr.keys, scratch.walk_p(s_now, v))
-                    || !is_local_minimum(s_now, v, c, key, &tr.keys, scratch.walk_c(s_now, c))
-                {
+                // The check reads every neighbour's position: ask for them
+                // as soon as the fans are known.
+                let fan = scratch.walk_p(s_now, v);
+                prefetch_neighbours(s_now, fan);
+                if !is_local_minimum(s_now, v, c, key, &tr.keys, fan) {
+                    continue;
+                }
+                let fan = scratch.walk_c(s_now, c);
+                prefetch_neighbours(s_now, fan);
+                if !is_local_minimum(s_now, v, c, key, &tr.keys, fan) {
                     continue;
                 }
                 // The merged position, as the slot's evaluation found it.
@@ -970,7 +1491,11 @@ fn step_winners(
                 debug_assert_eq!(error, b.error, "slot of ({v}, {c}) up to date");
                 let result = check_walked(s_now, v, c, s_now.to_metric(target), &mut scratch);
                 if result.is_ok() {
-                    out.blocks.extend(scratch.neighbourhood());
+                    // The winner's endpoints and neighbours leave the
+                    // game; no check of this pass reads the flags.
+                    for x in scratch.neighbourhood() {
+                        tr.blocked[x as usize].store(state, Relaxed);
+                    }
                     let (fan_p, fan_c) = scratch.fans();
                     let start = out.corners.len() as u32;
                     out.corners.extend_from_slice(&fan_p.corners);
@@ -988,11 +1513,12 @@ fn step_winners(
             }
             out
         });
-        for &(v, _) in admitted_keys.iter() {
-            let other = t.request(v, state).other;
-            t.keys[v as usize] = u64::MAX;
-            t.keys[other as usize] = u64::MAX;
-        }
+        let tr: &Tracking = t;
+        admitted_keys.par_iter().for_each(|&(v, _)| {
+            let other = tr.request(v, state).other;
+            tr.keys[v as usize].store(u64::MAX, Relaxed);
+            tr.keys[other as usize].store(u64::MAX, Relaxed);
+        });
         phases.lap("minima+check");
         if checked.iter().all(|out| out.results.is_empty()) {
             break;
@@ -1042,26 +1568,36 @@ fn step_winners(
             }
             continue;
         }
-        // The winners' endpoints and neighbours leave the game.
-        for out in &checked {
-            for &x in &out.blocks {
-                t.blocked[x as usize] = state;
-            }
-        }
         phases.lap("block");
         counted += 1;
         if counted == PASSES || passes == MAX_PASSES {
             break;
         }
+        // Blocked players take no further part in the step: the next
+        // passes sweep the others only.
+        let tr: &Tracking = t;
+        par_filter_into(players, spare, |&v| {
+            (tr.blocked[v as usize].load(Relaxed) != state).then_some(v)
+        });
+        std::mem::swap(players, spare);
+        phases.lap("retain players");
     }
     winners.sort_unstable_by_key(|w| w.p);
     winners
 }
 
+/// Prefetches the positions of the vertices of `fan`'s triangles.
+fn prefetch_neighbours(s: &State, fan: &Fan) {
+    for &corner in &fan.corners {
+        prefetch(&s.positions, s.table.v(next(corner)) as usize);
+        prefetch(&s.positions, s.table.v(prev(corner)) as usize);
+    }
+}
+
 /// Whether no neighbour in `fan` (of P or C) other than P and C has an
 /// admitted request with a key below `key`.
-fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[u64], fan: &Fan) -> bool {
-    let beaten = |x: u32| x != p && x != c && keys[x as usize] < key;
+fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[AtomicU64], fan: &Fan) -> bool {
+    let beaten = |x: u32| x != p && x != c && keys[x as usize].load(Relaxed) < key;
     // Each neighbour once: the next vertex of every corner, and the previous
     // one where the fan is open after it.
     fan.corners.iter().all(|&corner| {
@@ -1093,26 +1629,42 @@ pub(super) fn try_apply_collapse(
 fn prepare(s: &State, p: u32, b: Best, target: [u32; 3], plan: Plan) -> (Collapse, Quadric) {
     let c = b.other;
     let q = s.quadrics[p as usize] + s.quadrics[c as usize];
+    let ends = [p, c].map(|v| (s.positions[v as usize], s.split_valence[v as usize]));
+    let record = record(b, p, target, plan, &q, ends, &s.orig);
+    (record, q)
+}
+
+/// The record of the collapse of `p` and `b.other` to `target`, given the
+/// merged quadric and the positions and split valences of P and C.
+fn record(
+    b: Best,
+    p: u32,
+    target: [u32; 3],
+    plan: Plan,
+    q: &Quadric,
+    ends: [([u32; 3], u8); 2],
+    orig: &[u32],
+) -> Collapse {
     let weight = q.c[0] + q.c[4] + q.c[7];
     let distance = if weight > 0.0 {
         (b.error / weight).sqrt()
     } else {
         0.0
     };
-    let record = Collapse {
-        p,
-        c,
-        wing_a: plan.wing_a,
-        wing_b: plan.wing_b,
-        position_p: s.positions[p as usize],
-        position_c: s.positions[c as usize],
+    let input = |v: u32| if v == NONE { NONE } else { orig[v as usize] };
+    Collapse {
+        p: input(p),
+        c: input(b.other),
+        wing_a: input(plan.wing_a),
+        wing_b: input(plan.wing_b),
+        position_p: ends[0].0,
+        position_c: ends[1].0,
         position_r: target,
-        split_valence_p: s.split_valence[p as usize],
-        split_valence_c: s.split_valence[c as usize],
+        split_valence_p: ends[0].1,
+        split_valence_c: ends[1].1,
         error: b.error,
         distance,
-    };
-    (record, q)
+    }
 }
 
 /// The merged vertex's new attributes once the corner table is collapsed.
@@ -1128,6 +1680,191 @@ fn commit(s: &mut State, p: u32, c: u32, target: [u32; 3], plan: Plan, q: Quadri
         if w != NONE {
             s.valence[w as usize] -= 1;
         }
+    }
+}
+
+/// Applies a step's winners, in parallel, returning their records in order.
+///
+/// The collapses of a step touch disjoint parts of the mesh: the triangles
+/// around P and C, and P's and C's own entries, belong to one collapse each
+/// (the endpoints of two winners are never neighbours: each winner blocks
+/// its endpoints' 1-rings). Only a wing can be shared, so the wings' new
+/// corners and valences are set afterwards, in winner order, as one
+/// collapse after the other would leave them.
+fn apply_collapses(s: &mut State, winners: &[Winner], fans: &[u32]) -> Vec<Collapse> {
+    let table = TableView {
+        vertex: Raw::new(&mut s.table.vertex),
+        opposite: Raw::new(&mut s.table.opposite),
+        corner_of: Raw::new(&mut s.table.corner_of),
+    };
+    let positions = Raw::new(&mut s.positions);
+    let quadrics = Raw::new(&mut s.quadrics);
+    let boundary = Raw::new(&mut s.boundary);
+    let alive = Raw::new(&mut s.alive);
+    let split_valence = Raw::new(&mut s.split_valence);
+    let valence = Raw::new(&mut s.valence);
+    let orig: &[u32] = &s.orig;
+    let applied: Vec<(Collapse, [(u32, u32); 2])> = winners
+        .par_chunks(chunk_size(winners.len()))
+        .flat_map_iter(|chunk| {
+            chunk.iter().enumerate().map(move |(i, w)| {
+                // The next winners' vertices and fans (see `prefetch_ahead`).
+                if let Some(w) = chunk.get(i + 4) {
+                    for x in [w.p, w.best.other] {
+                        quadrics.prefetch(x as usize);
+                        positions.prefetch(x as usize);
+                    }
+                    let start = w.fans.0 as usize;
+                    for &c in &fans[start..start + (w.fans.1 + w.fans.2) as usize] {
+                        table.vertex.prefetch(c as usize);
+                        table.opposite.prefetch(c as usize);
+                    }
+                }
+                let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
+                let fan_p = &fans[start..start + np];
+                let fan_c = &fans[start + np..start + np + nc];
+                let (p, c) = (w.p as usize, w.best.other as usize);
+                // SAFETY: P's and C's entries belong to this collapse alone
+                // (see above), and nothing else reads these arrays meanwhile.
+                let (q, ends) = unsafe {
+                    (
+                        quadrics.get(p) + quadrics.get(c),
+                        [p, c].map(|v| (positions.get(v), split_valence.get(v))),
+                    )
+                };
+                // Built from P and C before the collapse, as its check saw them.
+                let record = record(w.best, w.p, w.target, w.plan, &q, ends, orig);
+                let mut view = table;
+                let anchors = collapse_in(
+                    &mut view,
+                    w.p,
+                    w.best.other,
+                    w.plan.left,
+                    w.plan.right,
+                    fan_p,
+                    fan_c,
+                );
+                // SAFETY: as above.
+                unsafe {
+                    positions.set(p, w.target);
+                    quadrics.set(p, q);
+                    boundary.set(p, boundary.get(p) | boundary.get(c));
+                    alive.set(c, false);
+                    split_valence.set(p, w.plan.valence_r as u8);
+                    valence.set(p, w.plan.valence_r as u32);
+                }
+                (record, anchors)
+            })
+        })
+        .collect();
+    let mut records = Vec::with_capacity(applied.len());
+    for (w, (record, anchors)) in winners.iter().zip(applied) {
+        for (x, corner) in anchors {
+            if x != NONE {
+                s.table.corner_of[x as usize] = corner;
+            }
+        }
+        for wing in [w.plan.wing_a, w.plan.wing_b] {
+            if wing != NONE {
+                s.valence[wing as usize] -= 1;
+            }
+        }
+        records.push(record);
+    }
+    records
+}
+
+/// A slice's elements for writes from parallel tasks, each to elements no
+/// other task touches (see [`apply_collapses`]).
+struct Raw<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+impl<T> Clone for Raw<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for Raw<T> {}
+
+// SAFETY: a `Raw` is only used for disjoint accesses (see `apply_collapses`).
+unsafe impl<T: Send> Send for Raw<T> {}
+unsafe impl<T: Send> Sync for Raw<T> {}
+
+impl<T: Copy> Raw<T> {
+    fn new(items: &mut [T]) -> Raw<T> {
+        Raw {
+            ptr: items.as_mut_ptr(),
+            len: items.len(),
+        }
+    }
+
+    /// [`prefetch`] of element `i` (reads nothing the program sees).
+    fn prefetch(self, i: usize) {
+        #[cfg(target_arch = "x86_64")]
+        if i < self.len {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let first = self.ptr.wrapping_add(i).cast::<i8>().cast_const();
+            let last = first.wrapping_add(std::mem::size_of::<T>() - 1);
+            // SAFETY: SSE is part of the x86-64 baseline, and a prefetch
+            // never faults.
+            unsafe {
+                _mm_prefetch::<_MM_HINT_T0>(first);
+                if std::mem::size_of::<T>() > 64 {
+                    _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(64));
+                }
+                _mm_prefetch::<_MM_HINT_T0>(last);
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = i;
+    }
+
+    /// # Safety
+    /// No other task writes element `i` meanwhile.
+    unsafe fn get(self, i: usize) -> T {
+        assert!(i < self.len);
+        // SAFETY: in bounds; no concurrent write (the caller's promise).
+        unsafe { *self.ptr.add(i) }
+    }
+
+    /// # Safety
+    /// No other task reads or writes element `i` meanwhile.
+    unsafe fn set(self, i: usize, value: T) {
+        assert!(i < self.len);
+        // SAFETY: in bounds; no concurrent access (the caller's promise).
+        unsafe { *self.ptr.add(i) = value }
+    }
+}
+
+/// The corner table as [`Raw`] views, for one collapse of a parallel step:
+/// it reads and writes only its own triangles (see [`collapse_in`]).
+#[derive(Clone, Copy)]
+struct TableView {
+    vertex: Raw<u32>,
+    opposite: Raw<u32>,
+    corner_of: Raw<u32>,
+}
+
+// SAFETY (all methods): a `TableView` exists only inside `apply_collapses`,
+// whose collapses touch disjoint corners and vertices.
+impl CornerAccess for TableView {
+    fn v(&self, c: u32) -> u32 {
+        unsafe { self.vertex.get(c as usize) }
+    }
+    fn o(&self, c: u32) -> u32 {
+        unsafe { self.opposite.get(c as usize) }
+    }
+    fn set_v(&mut self, c: u32, v: u32) {
+        unsafe { self.vertex.set(c as usize, v) }
+    }
+    fn set_o(&mut self, c: u32, o: u32) {
+        unsafe { self.opposite.set(c as usize, o) }
+    }
+    fn set_corner_of(&mut self, v: u32, c: u32) {
+        unsafe { self.corner_of.set(v as usize, c) }
     }
 }
 
@@ -1148,65 +1885,111 @@ fn refresh_edges(
     next_state: u32,
     scale: Option<Scale>,
     choosers: &mut Vec<u32>,
-    offers: &mut Vec<Offer>,
+    chunks: &mut Vec<RefreshChunk>,
 ) {
     let s_now: &State = s;
-    let chunks = par_chunks_map(merged, |chunk| {
-        // About six edges a vertex.
-        let mut updates = Vec::with_capacity(7 * chunk.len());
-        let mut offers = Vec::with_capacity(7 * chunk.len());
-        let mut choices = Vec::with_capacity(if scale.is_some() { chunk.len() } else { 0 });
-        for &r in chunk {
-            let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
-            let mut refresh = |x: u32, facing: u32| {
-                let slot = edge_slot(s_now, facing);
-                updates.push((s_now.slot_index(facing) as u32, slot));
-                offers.push(Offer { x, r, facing });
-                if let Some(ranking) = &mut ranking {
-                    ranking.consider(x, facing, &slot);
+    let size = chunk_size(merged.len());
+    let count = merged.len().div_ceil(size);
+    if chunks.len() < count {
+        chunks.resize_with(count, RefreshChunk::default);
+    }
+    // Chunks past this step's keep their capacity and nothing else.
+    for chunk in &mut chunks[count..] {
+        chunk.clear();
+    }
+    merged
+        .par_chunks(size)
+        .zip(chunks[..count].par_iter_mut())
+        .for_each(|(chunk, out)| {
+            out.clear();
+            let mut edges: Vec<(u32, u32)> = Vec::with_capacity(16);
+            for (i, &r) in chunk.iter().enumerate() {
+                prefetch_ahead(s_now, chunk, i);
+                // Edge (r, prev c) faces next c; a boundary edge (r, next c)
+                // faces prev c.
+                edges.clear();
+                s_now.table.for_each_corner(r, |c| {
+                    edges.push((s_now.table.v(prev(c)), next(c)));
+                    if s_now.table.o(prev(c)) == NONE {
+                        edges.push((s_now.table.v(next(c)), prev(c)));
+                    }
+                });
+                // The neighbours' quadrics are the evaluations' cache misses:
+                // ask for them all at once.
+                for &(x, _) in &edges {
+                    prefetch(&s_now.quadrics, x as usize);
+                    prefetch(&s_now.positions, x as usize);
                 }
-            };
-            // Edge (r, prev c) faces next c; a boundary edge (r, next c)
-            // faces prev c.
-            s_now.table.for_each_corner(r, |c| {
-                refresh(s_now.table.v(prev(c)), next(c));
-                if s_now.table.o(prev(c)) == NONE {
-                    refresh(s_now.table.v(next(c)), prev(c));
+                let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
+                for &(x, facing) in &edges {
+                    let slot = edge_slot(s_now, facing);
+                    out.updates.push((s_now.slot_index(facing) as u32, slot));
+                    out.offers.push(Offer { x, r, facing });
+                    if let Some(ranking) = &mut ranking {
+                        ranking.consider(x, facing, &slot);
+                    }
                 }
-            });
-            if let Some(ranking) = ranking {
-                choices.push(ranking.choices());
+                if let Some(ranking) = ranking {
+                    out.choices.push(ranking.choices());
+                }
             }
-        }
-        (updates, offers, choices)
-    });
-    offers.clear();
-    let mut chosen = Vec::with_capacity(merged.len());
-    for (updates, chunk_offers, choices) in chunks {
-        for (c, slot) in updates {
+            out.measure_span();
+        });
+    let mut chosen = chunks.iter().flat_map(|chunk| chunk.choices.iter());
+    for chunk in chunks.iter() {
+        for &(c, slot) in &chunk.updates {
             s.edges[c as usize] = slot;
         }
-        offers.extend(chunk_offers);
-        chosen.extend(choices);
     }
-    for (i, &r) in merged.iter().enumerate() {
+    for &r in merged {
         let v = r as usize;
         t.changed[v] = next_state;
         t.merged[v] = next_state;
         // Never listed already: merged vertices are not refused ends.
         t.listed[v] = next_state;
-        match chosen.get(i) {
+        match chosen.next() {
             Some(choices) => {
                 t.best[v] = choices.best;
                 t.second[v] = choices.second;
+                t.bound[v] = choices.bound;
                 // Its edges are all fresh: nothing refused to forget.
                 t.refusals[v] = 0;
             }
             None => choosers.push(r),
         }
     }
-    for o in offers.iter() {
+    for o in chunks.iter().flat_map(|chunk| chunk.offers.iter()) {
         t.changed[o.x as usize] = next_state;
+    }
+}
+
+/// One chunk's part of a refresh, kept from step to step for its capacity:
+/// the refreshed slots (index, slot), the offers to the other ends, and the
+/// merged vertices' choices. The offers stay until the next step takes them.
+#[derive(Default)]
+struct RefreshChunk {
+    updates: Vec<(u32, EdgeSlot)>,
+    offers: Vec<Offer>,
+    choices: Vec<Choices>,
+    /// The smallest and largest vertex the offers go to (`take_offers`
+    /// skips the chunk in the parts of the vertex range it misses).
+    span: (u32, u32),
+}
+
+impl RefreshChunk {
+    fn clear(&mut self) {
+        self.updates.clear();
+        self.offers.clear();
+        self.choices.clear();
+        self.span = (u32::MAX, 0);
+    }
+
+    /// Sets `span` from the offers.
+    fn measure_span(&mut self) {
+        self.span = self
+            .offers
+            .iter()
+            .fold((u32::MAX, 0), |(lo, hi), o| (lo.min(o.x), hi.max(o.x)));
     }
 }
 
@@ -1328,5 +2111,64 @@ impl Simplification {
     /// Largest quadric error of any collapse.
     pub fn max_error(&self) -> f64 {
         self.step_errors.iter().copied().fold(0.0, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::input::{fractal_terrain, icosphere};
+    use crate::quantize::{Units, quantize};
+
+    /// A terrain with a square hole cut out (inner boundary edges too).
+    fn holed_terrain() -> crate::Mesh {
+        let mut mesh = fractal_terrain(24, 5);
+        let side = 24u32;
+        let inside = |v: u32| (8..14).contains(&(v % side)) && (8..14).contains(&(v / side));
+        mesh.triangles.retain(|t| !t.iter().all(|&v| inside(v)));
+        mesh
+    }
+
+    #[test]
+    fn fan_quadrics_are_the_vertex_quadrics_bit_for_bit() {
+        for mesh in [fractal_terrain(40, 3), icosphere(3), holed_terrain()] {
+            let q = quantize(&mesh, 14, Units::Linear);
+            let s = State::new(&q, &SimplifyOptions::default());
+            assert!(s.manifold);
+            let geometry: Vec<[f64; 3]> = (0..q.positions.len() as u32)
+                .map(|v| s.geometry(v))
+                .collect();
+            for weight in [0.0, crate::quadric::DEFAULT_BOUNDARY_WEIGHT] {
+                let want = vertex_quadrics(&geometry, &q.triangles, weight);
+                let got = s.fan_quadrics(weight).expect("manifold");
+                assert_eq!(got, want);
+            }
+        }
+    }
+
+    #[test]
+    fn renumbering_keeps_the_collapses() {
+        // Compaction happens at every halving; a mesh small enough that the
+        // loop also runs many steps after the last one.
+        let q = quantize(&fractal_terrain(48, 9), 14, Units::Linear);
+        for constrained in [false, true] {
+            let options = SimplifyOptions {
+                target_vertices: 8,
+                constrained,
+                ..SimplifyOptions::default()
+            };
+            let s = simplify(&q, &options, |_| {});
+            let mut alive = vec![true; q.positions.len()];
+            for c in s.steps.iter().flatten() {
+                assert!(c.p < c.c, "P is the lower input id");
+                assert!(alive[c.p as usize] && alive[c.c as usize]);
+                alive[c.c as usize] = false;
+            }
+            assert_eq!(alive, s.alive);
+            assert_eq!(s.alive.iter().filter(|&&a| a).count(), s.alive_count);
+            for t in s.table.vertex.chunks_exact(3).filter(|t| t[0] != NONE) {
+                assert!(t.iter().all(|&v| s.alive[v as usize]));
+            }
+        }
     }
 }
