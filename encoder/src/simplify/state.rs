@@ -1692,6 +1692,10 @@ fn commit(s: &mut State, p: u32, c: u32, target: [u32; 3], plan: Plan, q: Quadri
 /// corners and valences are set afterwards, in winner order, as one
 /// collapse after the other would leave them.
 fn apply_collapses(s: &mut State, winners: &[Winner], fans: &[u32]) -> Vec<Collapse> {
+    // The unsafe writes below rely on this; debug builds (every test run)
+    // check it.
+    #[cfg(debug_assertions)]
+    assert_disjoint(winners, fans);
     let table = TableView {
         vertex: Raw::new(&mut s.table.vertex),
         opposite: Raw::new(&mut s.table.opposite),
@@ -1772,6 +1776,28 @@ fn apply_collapses(s: &mut State, winners: &[Winner], fans: &[u32]) -> Vec<Colla
         records.push(record);
     }
     records
+}
+
+/// Panics unless the winners' endpoints and the triangles around them
+/// (their fans, as the checks walked them) belong to one winner each: what
+/// makes the parallel writes of [`apply_collapses`] disjoint.
+#[cfg(debug_assertions)]
+fn assert_disjoint(winners: &[Winner], fans: &[u32]) {
+    let mut owner: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    let mut endpoints = std::collections::HashSet::new();
+    for (i, w) in winners.iter().enumerate() {
+        for v in [w.p, w.best.other] {
+            assert!(
+                endpoints.insert(v),
+                "vertex {v} is an endpoint of two collapses"
+            );
+        }
+        let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
+        for &c in &fans[start..start + np + nc] {
+            let j = *owner.entry(c / 3).or_insert(i);
+            assert_eq!(j, i, "collapses {j} and {i} share triangle {}", c / 3);
+        }
+    }
 }
 
 /// A slice's elements for writes from parallel tasks, each to elements no
