@@ -7,7 +7,7 @@ use std::hash::{Hash, Hasher};
 use std::time::Instant;
 
 use splitstream_encoder::input::fractal_terrain;
-use splitstream_encoder::quantize::{Quantization, Units, quantize_with};
+use splitstream_encoder::quantize::{Lattice, Quantization, Units, quantize_with};
 use splitstream_encoder::simplify::{SimplifyOptions, simplify};
 
 fn main() {
@@ -23,7 +23,13 @@ fn main() {
         )
         .expect("read"),
     };
-    let q = quantize_with(&mesh, 14, Units::Linear, Quantization::PerAxis);
+    let q = quantize_with(
+        &mesh,
+        14,
+        Units::Linear,
+        Quantization::PerAxis,
+        Lattice::Ignore,
+    );
     let options = SimplifyOptions {
         target_vertices: 16,
         constrained,

@@ -9,6 +9,13 @@
 //! fair setting for size comparisons with such codecs. The simplifier
 //! measures errors in metric space through separate per-axis factors
 //! ([`QuantizedMesh::metric`]), not in grid units.
+//!
+//! [`Lattice::Keep`] quantizes an axis whose coordinates all lie on a
+//! regular lattice coarser than that step (a raster's columns and rows,
+//! heights stored in whole metres) on the lattice itself: the axis is then
+//! exact, and a split's vectors on it are small integers (one cell), which
+//! the position residuals code in a few bits where a finer step leaves the
+//! prediction's fractions of a cell to code.
 
 use crate::mesh::Mesh;
 
@@ -24,6 +31,8 @@ pub struct QuantizedMesh {
     /// turns file units into metres (1 for projected data, about 111 km per
     /// degree for longitude/latitude).
     pub metric: [f64; 3],
+    /// The axes quantized on their own lattice ([`Lattice::Keep`]): exact.
+    pub on_lattice: [bool; 3],
 }
 
 impl QuantizedMesh {
@@ -76,14 +85,32 @@ pub enum Quantization {
     Uniform,
 }
 
+/// Whether an axis whose coordinates lie on a regular lattice keeps it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Lattice {
+    /// Every axis gets the step [`Quantization`] says.
+    #[default]
+    Ignore,
+    /// An axis whose coordinates all lie on `lo + i * s` with `s` at least
+    /// the step [`Quantization`] says is quantized with step `s`, exactly.
+    Keep,
+}
+
 /// Quantizes `mesh` to `bits` (1..=31) per axis over its bounding box, each
 /// axis with its own step.
 pub fn quantize(mesh: &Mesh, bits: u8, units: Units) -> QuantizedMesh {
-    quantize_with(mesh, bits, units, Quantization::PerAxis)
+    quantize_with(mesh, bits, units, Quantization::PerAxis, Lattice::Ignore)
 }
 
-/// Quantizes `mesh` to `bits` (1..=31) per axis with the steps `how` says.
-pub fn quantize_with(mesh: &Mesh, bits: u8, units: Units, how: Quantization) -> QuantizedMesh {
+/// Quantizes `mesh` to `bits` (1..=31) per axis with the steps `how` says,
+/// or on the axes' own lattices where `lattice` keeps them.
+pub fn quantize_with(
+    mesh: &Mesh,
+    bits: u8,
+    units: Units,
+    how: Quantization,
+    lattice: Lattice,
+) -> QuantizedMesh {
     let (lo, hi) = mesh.bounding_box().unwrap_or(([0.0; 3], [0.0; 3]));
     let top = ((1u64 << bits) - 1) as f64;
     let metres = units.metres_per_unit(lo, hi);
@@ -100,6 +127,14 @@ pub fn quantize_with(mesh: &Mesh, bits: u8, units: Units, how: Quantization) -> 
             std::array::from_fn(|k| step / metres[k])
         }
     };
+    let lattices: [Option<f64>; 3] = std::array::from_fn(|k| match lattice {
+        Lattice::Ignore => None,
+        Lattice::Keep => {
+            let axis = mesh.positions.iter().map(|p| p[k]);
+            lattice_step(axis, lo[k], hi[k], top).filter(|&s| s >= scale[k])
+        }
+    });
+    let scale: [f64; 3] = std::array::from_fn(|k| lattices[k].unwrap_or(scale[k]));
     let positions = mesh
         .positions
         .iter()
@@ -114,7 +149,66 @@ pub fn quantize_with(mesh: &Mesh, bits: u8, units: Units, how: Quantization) -> 
         origin: lo,
         scale,
         metric: std::array::from_fn(|k| scale[k] * metres[k]),
+        on_lattice: lattices.map(|l| l.is_some()),
     }
+}
+
+/// How far (in steps) a value may lie from its lattice point: the f64
+/// rounding of `origin + i * spacing` for any `i` below 2^31.
+const LATTICE_TOLERANCE: f64 = 1e-6;
+
+/// Values checked before sorting them all: enough that coordinates off any
+/// lattice (a scanned mesh's) are rejected from the sample alone.
+const LATTICE_SAMPLE: usize = 1024;
+
+/// The spacing `s` of the regular lattice `lo + i * s`, `0 <= i <= top`, that
+/// every one of `values` (all in `lo ..= hi`, `lo` among them) lies on, `s`
+/// being the smallest gap between two values (a raster's cell); `None` when
+/// they do not (or `hi == lo`).
+pub fn lattice_step(
+    values: impl Iterator<Item = f64> + Clone,
+    lo: f64,
+    hi: f64,
+    top: f64,
+) -> Option<f64> {
+    let extent = hi - lo;
+    if extent.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+        return None;
+    }
+    // Any two values on the lattice differ by a multiple of its spacing, so
+    // the smallest gap among some of them bounds the spacing from above: a
+    // sample whose gaps are too fine for `top` steps rejects the whole axis
+    // without sorting every value.
+    let smallest_gap = |offsets: &mut Vec<f64>| {
+        offsets.sort_unstable_by(f64::total_cmp);
+        offsets.dedup();
+        offsets
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .fold(f64::INFINITY, f64::min)
+    };
+    let fits = |gap: f64| gap.is_finite() && (extent / gap).round() <= top;
+    let mut sample: Vec<f64> = values
+        .clone()
+        .take(LATTICE_SAMPLE)
+        .map(|x| x - lo)
+        .collect();
+    if sample.len() == LATTICE_SAMPLE && !fits(smallest_gap(&mut sample)) {
+        return None;
+    }
+    let mut offsets: Vec<f64> = values.map(|x| x - lo).collect();
+    let gap = smallest_gap(&mut offsets);
+    if !fits(gap) {
+        return None;
+    }
+    // The spacing is the gap, spread over the whole extent so that its
+    // rounding does not add up across the steps.
+    let step = extent / (extent / gap).round();
+    let on_lattice = offsets.iter().all(|&x| {
+        let i = x / step;
+        (i - i.round()).abs() < LATTICE_TOLERANCE
+    });
+    on_lattice.then_some(step)
 }
 
 #[cfg(test)]
@@ -128,6 +222,89 @@ mod tests {
         }
     }
 
+    /// A 5 x 3 raster: x on 10.5 + 0.25 i, y on -3 + 0.1 j, z in whole
+    /// metres but for `odd_z`.
+    fn raster(odd_z: Option<f64>) -> Mesh {
+        let mut positions = Vec::new();
+        for j in 0..3 {
+            for i in 0..5 {
+                let z = [100.0, 103.0, 101.0][(i + j) % 3];
+                positions.push([10.5 + i as f64 * 0.25, -3.0 + j as f64 * 0.1, z]);
+            }
+        }
+        if let Some(z) = odd_z {
+            positions[7][2] = z;
+        }
+        let triangles = vec![[0, 1, 5], [1, 6, 5]];
+        Mesh {
+            positions,
+            triangles,
+        }
+    }
+
+    #[test]
+    fn a_raster_axis_is_found_on_its_lattice() {
+        let m = raster(None);
+        let axis = |k: usize| m.positions.iter().map(move |p| p[k]);
+        let x = lattice_step(axis(0), 10.5, 11.5, 16383.0).unwrap();
+        assert!((x - 0.25).abs() < 1e-12);
+        // 0.1 is not exact in binary: -3 + 2 * 0.1 still lies on the lattice.
+        let y = lattice_step(axis(1), -3.0, -2.8, 16383.0).unwrap();
+        assert!((y - 0.1).abs() < 1e-12);
+        assert_eq!(lattice_step(axis(2), 100.0, 103.0, 16383.0), Some(1.0));
+        // More lattice points than the grid has steps: no lattice.
+        assert_eq!(lattice_step(axis(0), 10.5, 11.5, 3.0), None);
+        // One value off the lattice, or all values equal: none either.
+        let odd = raster(Some(101.3));
+        assert_eq!(
+            lattice_step(odd.positions.iter().map(|p| p[2]), 100.0, 103.0, 16383.0),
+            None
+        );
+        assert_eq!(
+            lattice_step([2.0, 2.0].into_iter(), 2.0, 2.0, 16383.0),
+            None
+        );
+    }
+
+    #[test]
+    fn coordinates_off_any_lattice_are_rejected_from_a_sample() {
+        // A scanned mesh's coordinates: the first 1024 already have gaps far
+        // too fine for 2^14 steps.
+        let values = (0..5000u64).map(|i| ((i * 2_654_435_761) % 1_000_003) as f64 / 1_000_003.0);
+        let (lo, hi) = values
+            .clone()
+            .fold((f64::MAX, f64::MIN), |(l, h), x| (l.min(x), h.max(x)));
+        assert_eq!(lattice_step(values, lo, hi, 16383.0), None);
+    }
+
+    #[test]
+    fn kept_lattices_are_exact_and_never_finer_than_the_step() {
+        let m = raster(None);
+        let q = quantize_with(&m, 14, Units::Linear, Quantization::PerAxis, Lattice::Keep);
+        for (p, real) in q.positions.iter().zip(&m.positions) {
+            let back = q.dequantize(*p);
+            for k in 0..3 {
+                assert!((back[k] - real[k]).abs() < 1e-9, "{back:?} {real:?}");
+            }
+        }
+        assert_eq!(q.positions[7], [2, 1, 0]);
+        assert_eq!(q.positions[14], [4, 2, 0]);
+        assert_eq!(q.scale[2], 1.0);
+        assert_eq!(q.on_lattice, [true; 3]);
+        // Two bits give 3 steps: x's 4 cells do not fit, y's 2 and z's 3 do.
+        let q = quantize_with(&m, 2, Units::Linear, Quantization::PerAxis, Lattice::Keep);
+        assert!((q.scale[0] - 1.0 / 3.0).abs() < 1e-12);
+        assert!((q.scale[1] - 0.1).abs() < 1e-12);
+        assert_eq!(q.on_lattice, [false, true, true]);
+        assert_eq!(q.scale[2], 1.0);
+        // Uniform: one step of 1.0 (z's extent of 3 over 3 steps) for all
+        // axes; the lattices of x (0.25) and y (0.1) are finer, so they keep
+        // it; z's lattice is that step, and z stays exact.
+        let q = quantize_with(&m, 2, Units::Linear, Quantization::Uniform, Lattice::Keep);
+        assert_eq!(q.scale, [1.0; 3]);
+        assert_eq!(q.on_lattice, [false, false, true]);
+    }
+
     #[test]
     fn per_axis_uses_each_extent() {
         let q = quantize(&slab(), 10, Units::Linear);
@@ -137,7 +314,13 @@ mod tests {
 
     #[test]
     fn uniform_uses_one_step() {
-        let q = quantize_with(&slab(), 10, Units::Linear, Quantization::Uniform);
+        let q = quantize_with(
+            &slab(),
+            10,
+            Units::Linear,
+            Quantization::Uniform,
+            Lattice::Ignore,
+        );
         assert_eq!(q.scale, [1000.0 / 1023.0; 3]);
         assert_eq!(q.positions[1], [1023, 0, 0]);
         assert_eq!(q.positions[2], [0, 512, 10]);
@@ -146,7 +329,13 @@ mod tests {
             positions: vec![[10.0, 50.0, 0.0], [10.01, 50.0, 100.0], [10.0, 50.01, 0.0]],
             triangles: vec![[0, 1, 2]],
         };
-        let q = quantize_with(&geo, 12, Units::Geographic, Quantization::Uniform);
+        let q = quantize_with(
+            &geo,
+            12,
+            Units::Geographic,
+            Quantization::Uniform,
+            Lattice::Ignore,
+        );
         let metric: Vec<f64> = q.metric.to_vec();
         assert!(
             metric

@@ -8,7 +8,7 @@ use roundtrip_check::assert_roundtrip;
 
 use splitstream_decoder_core::{PlanePolicy, PositionMode};
 use splitstream_encoder::emit::EncodeOptions;
-use splitstream_encoder::quantize::{Quantization, Units};
+use splitstream_encoder::quantize::{Lattice, Quantization, Units};
 
 #[test]
 fn closed_sphere_roundtrips() {
@@ -85,4 +85,39 @@ fn every_plane_policy_roundtrips_at_31_bits() {
         };
         assert_roundtrip(&common::bumpy_grid(21, 17, 1), &options);
     }
+}
+
+#[test]
+fn rasters_keep_their_lattice_exactly() {
+    // Heights in whole units (as the Jacksboro DEM's metres): all three
+    // axes lie on a lattice; x and y step 10 with 23 and 17 samples.
+    let mut mesh = common::bumpy_grid(23, 17, 4);
+    for p in &mut mesh.positions {
+        p[2] = (p[2] * 10.0).round();
+    }
+    let constrained = EncodeOptions {
+        position_mode: PositionMode::Constrained,
+        ..EncodeOptions::default()
+    };
+    // Decoded positions are checked to be exact on every lattice axis.
+    assert_roundtrip(&mesh, &constrained);
+    let encoded = splitstream_encoder::emit::encode(&mesh, &constrained, |_| {}).unwrap();
+    assert_eq!(encoded.on_lattice, [true; 3]);
+    // Optimal mode ignores lattices unless asked; forced, it keeps them.
+    let optimal = EncodeOptions::default();
+    let encoded = splitstream_encoder::emit::encode(&mesh, &optimal, |_| {}).unwrap();
+    assert_eq!(encoded.on_lattice, [false; 3]);
+    let forced = EncodeOptions {
+        lattice: Some(Lattice::Keep),
+        ..EncodeOptions::default()
+    };
+    assert_roundtrip(&mesh, &forced);
+    // And constrained mode can be told to ignore them.
+    let ignored = EncodeOptions {
+        lattice: Some(Lattice::Ignore),
+        ..constrained
+    };
+    assert_roundtrip(&mesh, &ignored);
+    let encoded = splitstream_encoder::emit::encode(&mesh, &ignored, |_| {}).unwrap();
+    assert_eq!(encoded.on_lattice, [false; 3]);
 }

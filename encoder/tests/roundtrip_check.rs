@@ -3,8 +3,7 @@
 
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_encoder::Mesh;
-use splitstream_encoder::emit::{EncodeOptions, encode};
-use splitstream_encoder::quantize::quantize_with;
+use splitstream_encoder::emit::{EncodeOptions, encode, quantize_for};
 
 fn canonical(t: [u32; 3]) -> [u32; 3] {
     let r = (0..3).min_by_key(|&i| t[i]).unwrap();
@@ -15,10 +14,22 @@ fn canonical(t: [u32; 3]) -> [u32; 3] {
 pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {
     let encoded = encode(mesh, options, |_| {}).expect("encode");
     let decoded = decode_all(&encoded.stream, false).expect("decode");
-    let q = quantize_with(mesh, options.bits, options.units, options.quantization);
+    let q = quantize_for(mesh, options);
+    assert_eq!(encoded.on_lattice, q.on_lattice);
     assert_eq!(decoded.positions.len(), mesh.positions.len());
     for (d, &e) in encoded.permutation.iter().enumerate() {
         assert_eq!(decoded.positions[d], q.positions[e as usize], "vertex {e}");
+        // An axis on its own lattice comes back exactly (up to the f64
+        // rounding of origin + i * step).
+        let real = q.dequantize(decoded.positions[d]);
+        let input = mesh.positions[e as usize];
+        for k in (0..3).filter(|&k| q.on_lattice[k]) {
+            let tolerance = 1e-9 * (q.scale[k] * (1u64 << q.bits) as f64);
+            assert!(
+                (real[k] - input[k]).abs() <= tolerance,
+                "vertex {e} axis {k}"
+            );
+        }
     }
     let mut got: Vec<[u32; 3]> = decoded
         .triangles

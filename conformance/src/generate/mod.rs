@@ -17,6 +17,7 @@ use splitstream_decoder_core::{
 };
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
+use splitstream_encoder::quantize::Lattice;
 
 use crate::builtin;
 use crate::manifest::{FinalMesh, Manifest, SUITE_VERSION, Vector, hex};
@@ -466,7 +467,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
     );
     s.valid(
         "terrain-constrained-deflate",
-        "33x33 fractal terrain (the demo's generator), constrained positions, deflate, 6 levels.",
+        "33x33 fractal terrain (the demo's generator), constrained positions, deflate, 6 levels; x and y quantized on the raster's own lattice (one step a cell).",
         &["encoded", "terrain"],
         encoded(
             &terrain,
@@ -575,6 +576,8 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
                         position_mode: mode,
                         bits: 31,
                         codec: ChunkCodec::RansAlways { lanes: 2 },
+                        // Every axis on the 31-bit grid, a raster's too.
+                        lattice: Some(Lattice::Ignore),
                         ..opts()
                     },
                 ),
@@ -627,6 +630,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
                     bits: 31,
                     codec: ChunkCodec::Stored,
                     plane: Some(PlanePolicy::Dominant),
+                    lattice: Some(Lattice::Ignore),
                     ..opts()
                 },
             ),

@@ -214,9 +214,15 @@ fn size_row(
             ChunkCodec::Stored => "stored",
             _ => "rans",
         },
-        match quantization {
-            Quantization::PerAxis => "per-axis",
-            Quantization::Uniform => "uniform",
+        {
+            let how = match quantization {
+                Quantization::PerAxis => "per-axis",
+                Quantization::Uniform => "uniform",
+            };
+            match super::encode::lattice_axes(encoded.on_lattice).as_str() {
+                "" => how.to_string(),
+                axes => format!("{how}, lattice {axes}"),
+            }
         },
         bpv(stream.len() as u64),
         bpv(connectivity),

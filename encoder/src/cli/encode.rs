@@ -11,7 +11,7 @@ use splitstream_encoder::emit::{EncodeOptions, SEED_VERTICES, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::{Quantization, Units};
 
-use super::{BackendArg, CliResult, Codec, PlaneArg, Position, QuantizationArg};
+use super::{BackendArg, CliResult, Codec, LatticeArg, PlaneArg, Position, QuantizationArg};
 
 /// `splitstream encode`'s arguments.
 #[derive(clap::Args)]
@@ -69,6 +69,12 @@ pub struct Args {
     /// metres with --geographic), as Draco does at the same bit count.
     #[arg(long, value_enum, default_value_t = QuantizationArg::PerAxis)]
     pub quantization: QuantizationArg,
+    /// Axes whose coordinates all lie on a regular lattice coarser than the
+    /// step (a raster's x and y, heights in whole metres) are quantized on
+    /// it, exactly: smaller streams for terrain. `auto` keeps them in
+    /// constrained mode only.
+    #[arg(long, value_enum, default_value_t = LatticeArg::Auto)]
+    pub lattice: LatticeArg,
     /// Which axis of each position residual the split's plane predicts
     /// (SPEC §7.4); `auto` picks the cheapest per level.
     #[arg(long, value_enum, default_value_t = PlaneArg::Auto)]
@@ -129,6 +135,7 @@ pub fn run(a: Args) -> CliResult {
             Units::Linear
         },
         quantization: a.quantization.into(),
+        lattice: a.lattice.lattice(),
         backend: a.backend.into(),
         plane: a.plane.policy(),
     };
@@ -184,11 +191,25 @@ pub fn run(a: Args) -> CliResult {
         encoded.level_vertex_counts.len(),
         encoded.rounds,
     );
+    let exact = lattice_axes(encoded.on_lattice);
+    if !exact.is_empty() {
+        println!("lattice: {exact} quantized on the input's own lattice (exact)");
+    }
     println!(
         "time: read+check {:.2} s, simplify {:.2} s, emit {:.2} s",
         read_seconds, encoded.simplify_seconds, encoded.emit_seconds
     );
     Ok(())
+}
+
+/// The names of the axes on their lattice, as "x, y" ("" when none).
+pub fn lattice_axes(on_lattice: [bool; 3]) -> String {
+    let names: Vec<&str> = ["x", "y", "z"]
+        .into_iter()
+        .zip(on_lattice)
+        .filter_map(|(name, on)| on.then_some(name))
+        .collect();
+    names.join(", ")
 }
 
 /// Degrees-sized x/y extents inside lon/lat ranges next to a z range in

@@ -57,6 +57,32 @@ impl From<QuantizationArg> for splitstream_encoder::quantize::Quantization {
     }
 }
 
+/// Whether axes whose coordinates lie on a regular lattice keep it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum LatticeArg {
+    /// Keep lattices in constrained mode, where positions are input
+    /// vertices or midpoints; ignore them in optimal mode.
+    #[default]
+    Auto,
+    /// A raster's x and y (and heights in whole units) quantized exactly on
+    /// their lattice whenever it is coarser than the step.
+    Keep,
+    /// Every axis on the step of --quantization.
+    Ignore,
+}
+
+impl LatticeArg {
+    /// The encoder option (`None`: decided by the position mode).
+    pub fn lattice(self) -> Option<splitstream_encoder::quantize::Lattice> {
+        use splitstream_encoder::quantize::Lattice;
+        match self {
+            LatticeArg::Auto => None,
+            LatticeArg::Keep => Some(Lattice::Keep),
+            LatticeArg::Ignore => Some(Lattice::Ignore),
+        }
+    }
+}
+
 /// Which axis of each position residual the split's plane predicts (SPEC §7.4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum PlaneArg {

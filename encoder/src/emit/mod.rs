@@ -10,7 +10,7 @@ use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, a
 use splitstream_decoder_core::{PlanePolicy, PositionMode};
 
 use crate::mesh::Mesh;
-use crate::quantize::{Quantization, QuantizedMesh, Units, quantize_with};
+use crate::quantize::{Lattice, Quantization, QuantizedMesh, Units, quantize_with};
 use crate::simplify::{Backend, GpuError, SimplifyOptions, simplify_on};
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
@@ -40,6 +40,12 @@ pub struct EncodeOptions {
     pub units: Units,
     /// One quantization step per axis (default) or one for all axes.
     pub quantization: Quantization,
+    /// Whether axes on a regular lattice (a raster's x and y) keep it
+    /// exactly; `None`: in constrained mode only, where every position is
+    /// an input vertex or a midpoint (optimal mode's merged vertices would
+    /// be rounded to the lattice's cells, and its coarse levels lose
+    /// accuracy: on the jacksboro DEM the levels' errors grow 1.4x).
+    pub lattice: Option<Lattice>,
     /// Where the simplification's data-parallel passes run.
     pub backend: Backend,
     /// The plane policy of every level (SPEC §7.4); `None`: per level, the
@@ -61,6 +67,7 @@ impl Default for EncodeOptions {
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,
             quantization: Quantization::PerAxis,
+            lattice: None,
             backend: Backend::Cpu,
             plane: None,
         }
@@ -77,6 +84,9 @@ pub struct Encoded {
     pub rounds: usize,
     pub simplify_seconds: f64,
     pub emit_seconds: f64,
+    /// The axes quantized exactly on their own lattice
+    /// ([`EncodeOptions::lattice`]).
+    pub on_lattice: [bool; 3],
 }
 
 /// Why encoding failed.
@@ -114,8 +124,24 @@ pub fn encode(
     if options.levels == 0 {
         return Err(EncodeError::BadOption("--levels must be at least 1".into()));
     }
-    let quantized = quantize_with(mesh, options.bits, options.units, options.quantization);
+    let quantized = quantize_for(mesh, options);
     encode_quantized(&quantized, options, progress)
+}
+
+/// The quantized mesh [`encode`] codes: `options`' bits, units, steps and
+/// lattice rule.
+pub fn quantize_for(mesh: &Mesh, options: &EncodeOptions) -> QuantizedMesh {
+    let lattice = options.lattice.unwrap_or(match options.position_mode {
+        PositionMode::Constrained => Lattice::Keep,
+        PositionMode::Optimal => Lattice::Ignore,
+    });
+    quantize_with(
+        mesh,
+        options.bits,
+        options.units,
+        options.quantization,
+        lattice,
+    )
 }
 
 /// Encodes an already quantized mesh.
@@ -173,5 +199,6 @@ pub fn encode_quantized(
         rounds,
         simplify_seconds,
         emit_seconds: started.elapsed().as_secs_f64(),
+        on_lattice: mesh.on_lattice,
     })
 }
