@@ -121,3 +121,33 @@ fn rasters_keep_their_lattice_exactly() {
     let encoded = splitstream_encoder::emit::encode(&mesh, &ignored, |_| {}).unwrap();
     assert_eq!(encoded.on_lattice, [false; 3]);
 }
+
+#[test]
+fn the_automatic_position_mode_follows_the_lattice() {
+    use splitstream_encoder::emit::encode_auto_position;
+    let mut raster = common::bumpy_grid(19, 13, 5);
+    for p in &mut raster.positions {
+        p[2] = (p[2] * 4.0).round();
+    }
+    let options = EncodeOptions::default();
+    let (encoded, mode) = encode_auto_position(&raster, &options, |_| {}).unwrap();
+    assert_eq!(mode, PositionMode::Constrained);
+    assert_eq!(encoded.on_lattice, [true; 3]);
+    // The same stream as asking for constrained mode.
+    let constrained = EncodeOptions {
+        position_mode: PositionMode::Constrained,
+        ..EncodeOptions::default()
+    };
+    let bytes = splitstream_encoder::emit::encode(&raster, &constrained, |_| {})
+        .unwrap()
+        .stream;
+    assert_eq!(encoded.stream, bytes);
+    // A mesh without a lattice: optimal mode, the same stream as asked for.
+    let sphere = common::icosphere(2);
+    let (encoded, mode) = encode_auto_position(&sphere, &options, |_| {}).unwrap();
+    assert_eq!(mode, PositionMode::Optimal);
+    let bytes = splitstream_encoder::emit::encode(&sphere, &options, |_| {})
+        .unwrap()
+        .stream;
+    assert_eq!(encoded.stream, bytes);
+}

@@ -7,7 +7,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::Mesh;
-use splitstream_encoder::emit::{EncodeOptions, SEED_VERTICES, encode};
+use splitstream_encoder::emit::{EncodeOptions, SEED_VERTICES, encode, encode_auto_position};
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::{Quantization, Units};
 
@@ -28,7 +28,7 @@ pub struct Args {
     /// Base mesh vertex count (default: vertices / 2^(levels-1)).
     #[arg(long)]
     pub base_vertices: Option<usize>,
-    #[arg(long, value_enum, default_value_t = Position::Optimal)]
+    #[arg(long, value_enum, default_value_t = Position::Auto)]
     pub position: Position,
     /// Largest quadric error a collapse may have.
     #[arg(long)]
@@ -117,7 +117,7 @@ pub fn run(a: Args) -> CliResult {
         levels: a.levels,
         base_vertices: a.base_vertices,
         position_mode: match a.position {
-            Position::Optimal => PositionMode::Optimal,
+            Position::Optimal | Position::Auto => PositionMode::Optimal,
             Position::Constrained => PositionMode::Constrained,
         },
         max_error: a.max_error,
@@ -152,8 +152,12 @@ pub fn run(a: Args) -> CliResult {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     bar.set_message("simplifying");
-    let encoded =
-        encode(&mesh, &options, |done| bar.set_position(done as u64)).map_err(|e| e.to_string())?;
+    let progress = |done| bar.set_position(done as u64);
+    let (encoded, mode) = match a.position {
+        Position::Auto => encode_auto_position(&mesh, &options, progress),
+        _ => encode(&mesh, &options, progress).map(|e| (e, options.position_mode)),
+    }
+    .map_err(|e| e.to_string())?;
     bar.finish_and_clear();
     if encoded.rounds == 0 && n > SEED_VERTICES {
         // Seen on a DEM in degrees quantized with one step for degrees and
@@ -192,8 +196,14 @@ pub fn run(a: Args) -> CliResult {
         encoded.rounds,
     );
     let exact = lattice_axes(encoded.on_lattice);
-    if !exact.is_empty() {
-        println!("lattice: {exact} quantized on the input's own lattice (exact)");
+    let mode = match mode {
+        PositionMode::Optimal => "optimal",
+        PositionMode::Constrained => "constrained",
+    };
+    if exact.is_empty() {
+        println!("positions: {mode}");
+    } else {
+        println!("positions: {mode}; {exact} on the input's own lattice (exact)");
     }
     println!(
         "time: read+check {:.2} s, simplify {:.2} s, emit {:.2} s",

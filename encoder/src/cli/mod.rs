@@ -30,6 +30,9 @@ pub struct Cli {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Position {
+    /// Constrained when an axis lies on the input's own lattice (a raster's
+    /// x and y), which constrained mode keeps exactly; optimal otherwise.
+    Auto,
     /// Two deltas per split: the merged vertex anywhere (QEM optimum).
     Optimal,
     /// One delta and a placement code: the merged vertex on P, C or midway.

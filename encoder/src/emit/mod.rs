@@ -115,6 +115,45 @@ pub fn encode(
     options: &EncodeOptions,
     progress: impl FnMut(usize),
 ) -> Result<Encoded, EncodeError> {
+    check_options(options)?;
+    let quantized = quantize_for(mesh, options);
+    encode_quantized(&quantized, options, progress)
+}
+
+/// Encodes like [`encode`] in the position mode that suits the mesh
+/// (`options.position_mode` is ignored): constrained when the quantization
+/// can keep an axis on the input's own lattice (a raster: constrained mode
+/// keeps it exactly, and its streams were a third to a half the size of
+/// optimal mode's on the Jacksboro DEM), optimal otherwise. Returns the
+/// mode chosen with the stream.
+pub fn encode_auto_position(
+    mesh: &Mesh,
+    options: &EncodeOptions,
+    progress: impl FnMut(usize),
+) -> Result<(Encoded, PositionMode), EncodeError> {
+    check_options(options)?;
+    // Quantized as constrained mode would: when no axis is on a lattice,
+    // that is also optimal mode's quantization (a lattice is all that
+    // differs), so the mesh is quantized once either way.
+    let constrained = EncodeOptions {
+        position_mode: PositionMode::Constrained,
+        ..options.clone()
+    };
+    let quantized = quantize_for(mesh, &constrained);
+    let mode = if quantized.on_lattice.contains(&true) {
+        PositionMode::Constrained
+    } else {
+        PositionMode::Optimal
+    };
+    let options = EncodeOptions {
+        position_mode: mode,
+        ..options.clone()
+    };
+    let encoded = encode_quantized(&quantized, &options, progress)?;
+    Ok((encoded, mode))
+}
+
+fn check_options(options: &EncodeOptions) -> Result<(), EncodeError> {
     if !(1..=31).contains(&options.bits) {
         return Err(EncodeError::BadOption(format!(
             "--bits {} is outside 1..=31",
@@ -124,8 +163,7 @@ pub fn encode(
     if options.levels == 0 {
         return Err(EncodeError::BadOption("--levels must be at least 1".into()));
     }
-    let quantized = quantize_for(mesh, options);
-    encode_quantized(&quantized, options, progress)
+    Ok(())
 }
 
 /// The quantized mesh [`encode`] codes: `options`' bits, units, steps and

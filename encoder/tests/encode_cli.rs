@@ -1,0 +1,104 @@
+//! `splitstream encode` and `decode` from the command line: the position
+//! mode chosen for a raster, and the raster's lattice kept exactly.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn temp(name: &str, contents: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("splitstream-encode-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, contents).unwrap();
+    path
+}
+
+fn splitstream(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_splitstream"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+fn succeeded(out: &Output) -> String {
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}
+
+/// A 12 x 10 ESRI ASCII raster, 30 m cells, heights in whole metres.
+fn raster() -> PathBuf {
+    let mut s = String::from(
+        "ncols 12\nnrows 10\nxllcorner 500000\nyllcorner 4100000\ncellsize 30\nNODATA_value -9999\n",
+    );
+    for r in 0..10 {
+        let row: Vec<String> = (0..12)
+            .map(|c| format!("{}", 200 + (r * 7 + c * 13) % 23 + r * c / 4))
+            .collect();
+        s.push_str(&row.join(" "));
+        s.push('\n');
+    }
+    temp("raster.asc", &s)
+}
+
+/// The `v x y z` lines of an OBJ file.
+fn obj_positions(path: &PathBuf) -> Vec<[f64; 3]> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| {
+            let v: Vec<f64> = l.split_whitespace().map(|x| x.parse().unwrap()).collect();
+            [v[0], v[1], v[2]]
+        })
+        .collect()
+}
+
+#[test]
+fn a_raster_is_encoded_constrained_and_decodes_exactly() {
+    let input = raster();
+    let stream = input.with_file_name("raster.sps");
+    let out = splitstream(&[
+        "encode",
+        input.to_str().unwrap(),
+        "-o",
+        stream.to_str().unwrap(),
+    ]);
+    let stdout = succeeded(&out);
+    assert!(
+        stdout.contains("positions: constrained; x, y, z on the input's own lattice (exact)"),
+        "{stdout}"
+    );
+    let decoded = input.with_file_name("raster.obj");
+    succeeded(&splitstream(&[
+        "decode",
+        stream.to_str().unwrap(),
+        "-o",
+        decoded.to_str().unwrap(),
+    ]));
+    let positions = obj_positions(&decoded);
+    assert_eq!(positions.len(), 120);
+    // Every sample comes back on its cell and at its whole-metre height.
+    let (x0, y0) = positions
+        .iter()
+        .fold((f64::MAX, f64::MAX), |(x, y), p| (x.min(p[0]), y.min(p[1])));
+    let on_lattice = |v: f64| (v - v.round()).abs() < 1e-6;
+    for p in &positions {
+        assert!(on_lattice((p[0] - x0) / 30.0), "{p:?}");
+        assert!(on_lattice((p[1] - y0) / 30.0), "{p:?}");
+        assert!(on_lattice(p[2]), "{p:?}");
+    }
+    // Told to ignore the lattice, the same raster is encoded in optimal mode.
+    let out = splitstream(&[
+        "encode",
+        input.to_str().unwrap(),
+        "-o",
+        stream.to_str().unwrap(),
+        "--lattice",
+        "ignore",
+    ]);
+    assert!(succeeded(&out).contains("positions: optimal\n"));
+}
