@@ -1,22 +1,15 @@
 //! `splitstream encode` and `decode` from the command line: the position
 //! mode chosen for a raster, and the raster's lattice kept exactly.
 
+mod cli;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
+
+use cli::splitstream;
 
 fn temp(name: &str, contents: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("splitstream-encode-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    std::fs::write(&path, contents).unwrap();
-    path
-}
-
-fn splitstream(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_splitstream"))
-        .args(args)
-        .output()
-        .unwrap()
+    cli::temp("encode-cli", name, contents)
 }
 
 fn succeeded(out: &Output) -> String {

@@ -1,15 +1,15 @@
 //! `splitstream grid`: the client-side grid-tile simplifier from the
 //! command line.
 
+mod cli;
+
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::Output;
+
+use cli::splitstream;
 
 fn temp(name: &str, contents: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("splitstream-grid-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(name);
-    std::fs::write(&path, contents).unwrap();
-    path
+    cli::temp("grid-cli", name, contents)
 }
 
 fn asc(rows: usize, cols: usize, z: impl Fn(usize, usize) -> String) -> String {
@@ -22,13 +22,6 @@ fn asc(rows: usize, cols: usize, z: impl Fn(usize, usize) -> String) -> String {
         s.push('\n');
     }
     s
-}
-
-fn splitstream(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_splitstream"))
-        .args(args)
-        .output()
-        .unwrap()
 }
 
 fn one_line_error(out: &Output) -> String {
