@@ -178,7 +178,8 @@ pub fn lattice_step(
     // Any two values on the lattice differ by a multiple of its spacing, so
     // the smallest gap among some of them bounds the spacing from above: a
     // sample whose gaps are too fine for `top` steps rejects the whole axis
-    // without sorting every value.
+    // without sorting every value. (A sample of one distinct value, a
+    // raster's first row seen along y, has no gap and decides nothing.)
     let smallest_gap = |offsets: &mut Vec<f64>| {
         offsets.sort_unstable_by(f64::total_cmp);
         offsets.dedup();
@@ -193,7 +194,8 @@ pub fn lattice_step(
         .take(LATTICE_SAMPLE)
         .map(|x| x - lo)
         .collect();
-    if sample.len() == LATTICE_SAMPLE && !fits(smallest_gap(&mut sample)) {
+    let sample_gap = smallest_gap(&mut sample);
+    if sample_gap.is_finite() && !fits(sample_gap) {
         return None;
     }
     let mut offsets: Vec<f64> = values.map(|x| x - lo).collect();
@@ -264,6 +266,16 @@ mod tests {
             lattice_step([2.0, 2.0].into_iter(), 2.0, 2.0, 16383.0),
             None
         );
+    }
+
+    #[test]
+    fn a_wide_rasters_rows_are_found_past_the_sample() {
+        // 3 rows of 2,000 columns: the first 1,024 values of y are all row
+        // 0 (no gap in the sample), and the lattice is still found.
+        let y = (0..6000).map(|i| 7.0 + (i / 2000) as f64 * 0.5);
+        assert_eq!(lattice_step(y, 7.0, 8.0, 16383.0), Some(0.5));
+        let x = (0..6000).map(|i| (i % 2000) as f64 * 0.25);
+        assert_eq!(lattice_step(x, 0.0, 499.75, 16383.0), Some(0.25));
     }
 
     #[test]
