@@ -1,0 +1,901 @@
+#!/usr/bin/env python3
+"""A second splitstream 3.0 decoder, in Python, written from
+decoder-core/SPEC.md and the protocol of conformance/README.md alone,
+without reading the reference code: the check that the specification is
+enough to decode bit-exactly. It speaks the conformance protocol (a stream
+on stdin; the state hash after the seed and after every round, then `ok`,
+or `error <class>`), so that .ci/test runs the vectors through it:
+
+    target/debug/splitstream-conformance run \
+        --decoder "python3 conformance/python/splitstream_decoder.py" --timeout 120
+
+Standard library only. Written for clarity against the SPEC, not speed:
+fine for the vectors, slow for large meshes.
+"""
+import struct
+import sys
+import zlib
+
+MAGIC = b"\x89SPS\r\n\x1a\n"
+LEAF = 0xFF
+GHOST = -1
+MAX_VERTICES = 0xFFFFFFFE
+MAX_TRIANGLES = 0x55555554
+STATE_LOW = 1 << 23
+RANS_SLOT_BYTES = 1856
+NCTX = {1: 1, 2: 8, 3: 8, 4: 1, 5: 5, 6: 3, 7: 5, 8: 3, 9: 1, 10: 1}
+
+
+class Fail(Exception):
+    def __init__(self, cls):
+        Exception.__init__(self, cls)
+        self.cls = cls
+
+
+def crc32(b):
+    return zlib.crc32(b) & 0xFFFFFFFF
+
+
+def u16(s, o):
+    return struct.unpack_from("<H", s, o)[0]
+
+
+def u32(s, o):
+    return struct.unpack_from("<I", s, o)[0]
+
+
+def u64(s, o):
+    return struct.unpack_from("<Q", s, o)[0]
+
+
+def f64(s, o):
+    return struct.unpack_from("<d", s, o)[0]
+
+
+def f32(s, o):
+    return struct.unpack_from("<f", s, o)[0]
+
+
+def finite(x):
+    return x == x and x not in (float("inf"), float("-inf"))
+
+
+def round8(x):
+    return (x + 7) // 8 * 8
+
+
+def wrap(x):
+    x &= 0xFFFFFFFF
+    return x - (1 << 32) if x >= (1 << 31) else x
+
+
+def rnd(p, q):
+    if q < 0:
+        p, q = -p, -q
+    return (2 * p + q) // (2 * q)
+
+
+def bitlen(x):
+    return x.bit_length()
+
+
+# ---------------------------------------------------------------- rANS
+class Lane:
+    __slots__ = ("x", "cur", "end", "data")
+
+
+class Table:
+    def __init__(self, freqs):
+        self.f = freqs
+        cum = [0]
+        for f in freqs:
+            cum.append(cum[-1] + f)
+        self.cum = cum
+        # slot -> token lookup
+        look = bytearray(4096)
+        for t, f in enumerate(freqs):
+            for s in range(cum[t], cum[t + 1]):
+                look[s] = t
+        self.look = look
+
+
+def payload_varint(p, q):
+    v = 0
+    for i in range(5):
+        if q >= len(p):
+            raise Fail("malformed")
+        b = p[q]
+        q += 1
+        if i == 4 and b > 0x0F:
+            raise Fail("malformed")
+        v |= (b & 0x7F) << (7 * i)
+        if b & 0x80 == 0:
+            if b == 0 and i > 0:
+                raise Fail("malformed")
+            return v, q
+    raise Fail("malformed")  # unreachable
+
+
+def parse_rans(p, nctx, raw_len, lane_count):
+    q = 0
+    tables = []
+    for _ in range(nctx):
+        if q >= len(p):
+            raise Fail("malformed")
+        n = p[q]
+        q += 1
+        if n > 44:
+            raise Fail("malformed")
+        if n == 0:
+            tables.append(None)
+            continue
+        c = []
+        for _i in range(n):
+            v, q = payload_varint(p, q)
+            c.append(v)
+        if c[n - 1] == 0:
+            raise Fail("malformed")
+        total = sum(c)
+        f = [0 if ci == 0 else max(1, ci * 4096 // total) for ci in c]
+        mx = max(f)
+        j = f.index(mx)
+        f[j] += 4096 - sum(f)
+        if f[j] < 1:
+            raise Fail("malformed")
+        tables.append(Table(f))
+    lens = []
+    for _ in range(lane_count):
+        v, q = payload_varint(p, q)
+        lens.append(v)
+    lanes = []
+    start = q
+    for i in range(lane_count):
+        ln = lens[i]
+        if start + ln > len(p):
+            raise Fail("malformed")
+        if i >= raw_len:
+            if ln != 0:
+                raise Fail("malformed")
+            lanes.append(None)
+        else:
+            if ln < 4:
+                raise Fail("malformed")
+            x = u32(p, start)
+            if not (STATE_LOW <= x < (1 << 31)):
+                raise Fail("malformed")
+            L = Lane()
+            L.x = x
+            L.cur = start + 4
+            L.end = start + ln
+            L.data = p
+            lanes.append(L)
+        start += ln
+    if start != len(p):
+        raise Fail("malformed")
+    return tables, lanes
+
+
+def renorm(L):
+    while L.x < STATE_LOW:
+        if L.cur == L.end:
+            raise Fail("malformed")
+        L.x = ((L.x << 8) | L.data[L.cur]) & 0xFFFFFFFFFFFF
+        L.cur += 1
+
+
+def decode_value(L, tab):
+    if tab is None:
+        raise Fail("malformed")
+    x = L.x
+    slot = x & 4095
+    t = tab.look[slot]
+    c0 = tab.cum[t]
+    L.x = tab.f[t] * (x >> 12) + slot - c0
+    renorm(L)
+    if t < 16:
+        return t
+    e = t - 12
+    low = 0
+    done = 0
+    while done < e:
+        step = min(e - done, 16)
+        low |= (L.x & ((1 << step) - 1)) << done
+        L.x >>= step
+        renorm(L)
+        done += step
+    return (1 << e) + low
+
+
+# ---------------------------------------------------------------- substreams
+class Sub:
+    def __init__(self, sid, chunks, lane_count):
+        self.sid = sid
+        self.chunks = chunks  # list of (codec, raw_len, crc, payload)
+        self.rans = bool(chunks) and chunks[0][0] == 2
+        self.idx = 0
+        self.buf = b""
+        self.pos = 0
+        self.len = 0
+        self.cur = 0
+        self.bi = 8
+        self.lane_count = lane_count
+        self.tables = None
+        self.lanes = None
+
+    def load(self):
+        if self.idx >= len(self.chunks):
+            raise Fail("count-mismatch")
+        codec, raw_len, crc, payload = self.chunks[self.idx]
+        self.idx += 1
+        if crc32(payload) != crc:
+            raise Fail("checksum-mismatch")
+        if codec == 0:
+            self.buf = payload
+        elif codec == 1:
+            try:
+                d = zlib.decompressobj(-15)
+                out = d.decompress(payload, raw_len + 1)
+            except zlib.error:
+                raise Fail("malformed")
+            if (not d.eof) or d.unused_data or d.unconsumed_tail or len(out) != raw_len:
+                raise Fail("malformed")
+            self.buf = out
+        else:
+            self.tables, self.lanes = parse_rans(payload, NCTX[self.sid], raw_len, self.lane_count)
+        self.len = raw_len
+        self.pos = 0
+
+    def value(self, ctx):
+        if self.pos == self.len:
+            self.load()
+        L = self.lanes[self.pos % self.lane_count]
+        v = decode_value(L, self.tables[ctx])
+        self.pos += 1
+        if self.pos == self.len:
+            for L in self.lanes:
+                if L is None:
+                    continue
+                if L.x != STATE_LOW or L.cur != L.end:
+                    raise Fail("malformed")
+        return v
+
+    def _byte(self):
+        if self.pos == self.len:
+            self.load()
+        b = self.buf[self.pos]
+        self.pos += 1
+        return b
+
+    def byte(self, ctx=0):
+        if self.rans:
+            v = self.value(ctx)
+            if v > 255:
+                raise Fail("malformed")
+            return v
+        return self._byte()
+
+    def bit(self, ctx=0):
+        if self.rans:
+            v = self.value(ctx)
+            if v > 1:
+                raise Fail("malformed")
+            return v
+        if self.bi == 8:
+            self.cur = self._byte()
+            self.bi = 0
+        b = (self.cur >> self.bi) & 1
+        self.bi += 1
+        return b
+
+    def varint(self, ctx=0):
+        if self.rans:
+            return self.value(ctx)
+        v = 0
+        for i in range(5):
+            b = self._byte()
+            if i == 4 and b > 0x0F:
+                raise Fail("malformed")
+            v |= (b & 0x7F) << (7 * i)
+            if b & 0x80 == 0:
+                if b == 0 and i > 0:
+                    raise Fail("malformed")
+                return v
+        raise Fail("malformed")
+
+    def signed(self, ctx=0):
+        u = self.varint(ctx)
+        return (u >> 1) if u % 2 == 0 else -((u >> 1) + 1)
+
+    def finish(self):
+        if self.idx != len(self.chunks):
+            raise Fail("count-mismatch")
+        if self.pos != self.len:
+            raise Fail("count-mismatch")
+        if not self.rans and (self.cur >> self.bi) != 0 and self.bi < 8:
+            raise Fail("count-mismatch")
+
+
+# ---------------------------------------------------------------- decoder
+class Decoder:
+    def __init__(self, s, out):
+        self.s = s
+        self.out = out
+
+    def emit_hash(self):
+        V = self.V
+        T = self.T
+        parts = [struct.pack("<II", V, T)]
+        pos = self.pos
+        dfc = self.deficit
+        pk = struct.Struct("<IIIB").pack
+        parts.extend(pk(p[0], p[1], p[2], dfc[v]) for v, p in enumerate(pos))
+        tri = self.tri
+        parts.append(struct.pack("<%dI" % len(tri), *tri))
+        data = b"".join(parts)
+        h = 0xCBF29CE484222325
+        for b in data:
+            h = ((h ^ b) * 0x100000001B3) & 0xFFFFFFFFFFFFFFFF
+        self.out.append("%016x" % h)
+
+    def run(self):
+        s = self.s
+        n = len(s)
+        # header
+        if n < 8:
+            raise Fail("truncated")
+        if s[0:8] != MAGIC:
+            raise Fail("bad-magic")
+        if n < 10:
+            raise Fail("truncated")
+        if s[8] != 3:
+            raise Fail("unsupported-version")
+        if n < 96:
+            raise Fail("truncated")
+        if crc32(s[0:92]) != u32(s, 92):
+            raise Fail("checksum-mismatch")
+        flags = u16(s, 10)
+        if flags & 0xFFFE:
+            raise Fail("malformed")
+        if not (1 <= s[12] <= 31):
+            raise Fail("malformed")
+        if u32(s, 28) != 0 or u32(s, 88) != 0:
+            raise Fail("malformed")
+        if not (1 <= s[13] <= 32):
+            raise Fail("malformed")
+        if u16(s, 14) == 0:
+            raise Fail("malformed")
+        vcap = u32(s, 16)
+        tcap = u32(s, 20)
+        mcl = u32(s, 24)
+        if vcap == 0 or vcap > MAX_VERTICES:
+            raise Fail("malformed")
+        if tcap == 0 or tcap > MAX_TRIANGLES:
+            raise Fail("malformed")
+        if mcl == 0:
+            raise Fail("malformed")
+        for k in range(3):
+            if not finite(f64(s, 32 + 8 * k)):
+                raise Fail("malformed")
+            sc = f64(s, 56 + 8 * k)
+            if not finite(sc) or sc <= 0:
+                raise Fail("malformed")
+        self.constrained = flags & 1
+        self.bits = s[12]
+        self.lane_count = s[13]
+        L = u16(s, 14)
+        self.vcap = vcap
+        self.tcap = tcap
+        self.mcl = mcl
+        wsb = u64(s, 80)
+        # level table
+        head_len = 96 + 32 * L + 4
+        if n < head_len:
+            raise Fail("truncated")
+        if crc32(s[96:head_len - 4]) != u32(s, head_len - 4):
+            raise Fail("checksum-mismatch")
+        expected = head_len
+        entries = []
+        for k in range(L):
+            o = 96 + 32 * k
+            e = dict(offset=u64(s, o), length=u32(s, o + 8), V=u32(s, o + 12), T=u32(s, o + 16),
+                     rounds=u32(s, o + 20), gerr=f32(s, o + 24), res=u32(s, o + 28))
+            if e["res"] != 0:
+                raise Fail("malformed")
+            if e["offset"] != expected:
+                raise Fail("malformed")
+            expected = e["offset"] + e["length"]
+            g = e["gerr"]
+            if not finite(g) or g < 0:
+                raise Fail("malformed")
+            if e["V"] > vcap or e["T"] > tcap:
+                raise Fail("capacity-exceeded")
+            if k == 0:
+                if e["V"] == 0 or e["T"] == 0 or e["rounds"] > e["V"]:
+                    raise Fail("malformed")
+            else:
+                p = entries[k - 1]
+                dv = e["V"] - p["V"]
+                dt = e["T"] - p["T"]
+                if not (e["rounds"] >= 1 and dv >= e["rounds"] and dt >= 1 and dv <= dt <= 2 * dv):
+                    raise Fail("malformed")
+            entries.append(e)
+        last = entries[-1]
+        if last["V"] != vcap or last["T"] != tcap:
+            raise Fail("malformed")
+        self.entries = entries
+        # workspace
+        if wsb != self.workspace(vcap, tcap, entries[0]["V"], entries[0]["T"], mcl):
+            raise Fail("malformed")
+        self.V = 0
+        self.T = 0
+        for li in range(L):
+            e = entries[li]
+            if e["offset"] + e["length"] > n:
+                raise Fail("truncated")
+            lvl = s[e["offset"]:e["offset"] + e["length"]]
+            self.decode_level(li, lvl, e)
+
+    @staticmethod
+    def workspace(V, T, V0, T0, M):
+        w = 3 if 3 * T <= (1 << 24) - 1 else 4
+        sizes = [12 * V, 12 * T, max(w * 3 * T + 1, 4 * (6 * T0 + V0 + 1)), w * V + 1, V,
+                 3 * 8 * ((V + 63) // 64), 7 * round8(max(M, RANS_SLOT_BYTES))]
+        return sum(round8(x) for x in sizes)
+
+    def decode_level(self, li, lvl, entry):
+        ln = len(lvl)
+        H = 20 if li == 0 else 12
+        if ln < H:
+            raise Fail("truncated")
+        R = u32(lvl, 0)
+        N = u32(lvl, 4)
+        if li == 0:
+            SV = u32(lvl, 12)
+            ST = u32(lvl, 16)
+        payload_start = H + 4 + 4 * R + 16 * N
+        if ln < payload_start:
+            raise Fail("truncated")
+        if crc32(lvl[0:payload_start - 4]) != u32(lvl, payload_start - 4):
+            raise Fail("checksum-mismatch")
+        if lvl[8] > 4:
+            raise Fail("malformed")
+        if lvl[9] or lvl[10] or lvl[11]:
+            raise Fail("malformed")
+        if li == 0 and (SV == 0 or ST == 0):
+            raise Fail("malformed")
+        allowed = range(1, 11) if li == 0 else range(1, 8)
+        prev_id = 0
+        prev_rans = False
+        total = payload_start
+        dir_off = H + 4 * R
+        chunks = {}
+        for i in range(N):
+            o = dir_off + 16 * i
+            sid = lvl[o]
+            codec = lvl[o + 1]
+            res = u16(lvl, o + 2)
+            raw_len = u32(lvl, o + 4)
+            stored_len = u32(lvl, o + 8)
+            crc = u32(lvl, o + 12)
+            if res != 0:
+                raise Fail("malformed")
+            if sid not in allowed:
+                raise Fail("malformed")
+            if sid < prev_id:
+                raise Fail("malformed")
+            rans = codec == 2
+            if sid == prev_id and rans != prev_rans:
+                raise Fail("malformed")
+            prev_id = sid
+            prev_rans = rans
+            if raw_len == 0 or raw_len > self.mcl:
+                raise Fail("malformed")
+            if codec == 0 and stored_len != raw_len:
+                raise Fail("malformed")
+            if codec > 2:
+                raise Fail("malformed")
+            chunks.setdefault(sid, []).append((codec, raw_len, crc, total, stored_len))
+            total += stored_len
+        if total > ln:
+            raise Fail("truncated")
+        if total < ln:
+            raise Fail("malformed")
+        if R != entry["rounds"]:
+            raise Fail("count-mismatch")
+        split_counts = [u32(lvl, H + 4 * r) for r in range(R)]
+        for sc in split_counts:
+            if sc == 0:
+                raise Fail("malformed")
+        before = SV if li == 0 else self.entries[li - 1]["V"]
+        if before + sum(split_counts) != entry["V"]:
+            raise Fail("count-mismatch")
+        subs = {}
+        for sid in range(1, 11):
+            lst = [(c, rl, crc, bytes(lvl[off:off + sl])) for (c, rl, crc, off, sl) in chunks.get(sid, [])]
+            subs[sid] = Sub(sid, lst, self.lane_count)
+        self.subs = subs
+        self.policy = lvl[8]
+        self.T_l = entry["T"]
+        if li == 0:
+            self.read_base(SV, ST)
+        for r in range(R):
+            self.run_round(split_counts[r])
+            self.emit_hash()
+        for sid in range(1, 8):
+            subs[sid].finish()
+        if self.V != entry["V"] or self.T != entry["T"]:
+            raise Fail("count-mismatch")
+
+    # ------------------------------------------------------------ base
+    def read_base(self, V0, T0):
+        subs = self.subs
+        sp = subs[8]
+        lim = 1 << self.bits
+        prev = [0, 0, 0]
+        pos = []
+        for v in range(V0):
+            for k in range(3):
+                prev[k] += sp.signed(k)
+            for k in range(3):
+                if prev[k] < 0 or prev[k] >= lim:
+                    raise Fail("position-out-of-range")
+            pos.append(list(prev))
+        st = subs[9]
+        tri = []
+        for t in range(T0):
+            tri.append(st.varint(0))
+            tri.append(st.varint(0))
+            tri.append(st.varint(0))
+        sd = subs[10]
+        deficit = [sd.byte(0) for v in range(V0)]
+        for sid in (8, 9, 10):
+            subs[sid].finish()
+        # validate
+        for t in range(T0):
+            a, b, c = tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]
+            if a >= V0 or b >= V0 or c >= V0:
+                raise Fail("non-manifold")
+            if a == b or b == c or a == c:
+                raise Fail("non-manifold")
+        vtri = [[] for _ in range(V0)]
+        for t in range(T0):
+            for i in range(3):
+                vtri[tri[3 * t + i]].append(t)
+        for v in range(V0):
+            if not vtri[v]:
+                raise Fail("non-manifold")
+            seen = set()
+            for t in vtri[v]:
+                for i in range(3):
+                    if tri[3 * t + i] == v:
+                        u = tri[3 * t + (i + 1) % 3]
+                        if u in seen:
+                            raise Fail("non-manifold")
+                        seen.add(u)
+        self.pos = pos
+        self.tri = tri
+        self.deficit = deficit
+        self.vtri = [set(x) for x in vtri]
+        self.V = V0
+        self.T = T0
+        for v in range(V0):
+            nxt = {}
+            for t in vtri[v]:
+                a, b, c = tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]
+                if a == v:
+                    nxt[b] = c
+                elif b == v:
+                    nxt[c] = a
+                else:
+                    nxt[a] = b
+            targets = set(nxt.values())
+            starts = [u for u in nxt if u not in targets]
+            cnt = len(nxt)
+            if starts:
+                u = starts[0]
+                steps = 0
+                while u in nxt:
+                    u = nxt[u]
+                    steps += 1
+                if steps != cnt:
+                    raise Fail("non-manifold")
+                val = cnt + 2
+            else:
+                u0 = next(iter(nxt))
+                u = nxt[u0]
+                steps = 1
+                while u != u0:
+                    u = nxt[u]
+                    steps += 1
+                if steps != cnt or cnt < 3:
+                    raise Fail("non-manifold")
+                val = cnt
+            if deficit[v] != LEAF and val + deficit[v] > 255:
+                raise Fail("valence-overflow")
+        self.emit_hash()
+
+    # ------------------------------------------------------------ rings
+    def ring(self, R):
+        tri = self.tri
+        nxt = {}
+        tof = {}
+        for t in self.vtri[R]:
+            a, b, c = tri[3 * t], tri[3 * t + 1], tri[3 * t + 2]
+            if a == R:
+                u, w = b, c
+            elif b == R:
+                u, w = c, a
+            else:
+                u, w = a, b
+            nxt[u] = w
+            tof[u] = t
+        targets = set(nxt.values())
+        starts = [u for u in nxt if u not in targets]
+        if starts:
+            u = starts[0]
+            ring = [GHOST, u]
+            while u in nxt:
+                u = nxt[u]
+                ring.append(u)
+        else:
+            u0 = min(nxt)
+            ring = [u0]
+            u = nxt[u0]
+            while u != u0:
+                ring.append(u)
+                u = nxt[u]
+        if len(ring) > 255:
+            raise Fail("valence-overflow")
+        return ring, tof
+
+    # ------------------------------------------------------------ rounds
+    def run_round(self, s):
+        n = self.V
+        if n + s > self.vcap:
+            raise Fail("capacity-exceeded")
+        deficit = self.deficit
+        cand = [v for v in range(n) if deficit[v] == 0]
+        candset = set(cand)
+        flags = self.subs[1]
+        flagged = []
+        blocked = set()
+        rings = {}
+        for v in cand:
+            if v in blocked:
+                continue
+            if flags.bit(0) == 1:
+                flagged.append(v)
+                rg = self.ring(v)
+                rings[v] = rg
+                for x in rg[0]:
+                    if x != GHOST:
+                        blocked.add(x)
+        if len(flagged) != s:
+            raise Fail("count-mismatch")
+        for j, R in enumerate(flagged):
+            ring, tof = self.ring(R)
+            rec = self.read_record(R, ring, candset)
+            self.apply_split(R, ring, tof, rec, n + j)
+
+    def read_record(self, R, ring, candset):
+        subs = self.subs
+        k = len(ring)
+        E = [i for i in range(k) if ring[i] == GHOST or ring[i] not in candset]
+        m = len(E)
+        ctx = min(max(m, 2), 9) - 2
+        op = subs[2].byte(ctx)
+        dp = subs[3].byte(ctx)
+        if dp == 0 or op + dp >= m:
+            raise Fail("ring-offset-out-of-range")
+        o = E[op]
+        d = E[op + dp] - o
+        valP = d + 2
+        valC = k - d + 2
+        dP = self.deficit_of(subs[4].byte(0), valP)
+        cctx = 4 if dP == LEAF else min(max(valC, 3), 6) - 3
+        dC = self.deficit_of(subs[5].byte(cctx), valC)
+        # arc means
+        pos = self.pos
+        pR = pos[R]
+        W = [ring[o], ring[(o + d) % k]]
+        I1 = [ring[(o + i) % k] for i in range(1, d)]
+        I2 = [ring[(o + i) % k] for i in range(d + 1, k)]
+        means = []
+        sums = []
+        cnts = []
+        for S in (W, I1, I2):
+            S = [v for v in S if v != GHOST]
+            sm = [0, 0, 0]
+            for v in S:
+                pv = pos[v]
+                for ax in range(3):
+                    sm[ax] += pv[ax] - pR[ax]
+            ns = len(S)
+            means.append([x // ns for x in sm] if ns else [0, 0, 0])
+            sums.append(sm)
+            cnts.append(ns)
+        mW, mI1, mI2 = means
+        G = [sums[0][ax] + sums[1][ax] + sums[2][ax] for ax in range(3)]
+        nG = sum(cnts)
+        a = ring[o]
+        b = ring[(o + d) % k]
+        if a != GHOST and b != GHOST:
+            e = [pos[b][ax] - pos[a][ax] for ax in range(3)]
+        else:
+            e = None
+        plane = self.plane_of(e, mI1, mI2)
+        lim = 1 << self.bits
+
+        def lin(wW, wo, wt, own, oth):
+            return [(wW * mW[ax] + wo * own[ax] + wt * oth[ax]) >> 4 for ax in range(3)]
+
+        if self.constrained:
+            aa = [mI2[ax] - mI1[ax] for ax in range(3)]
+            Tt = -(G[0] * aa[0] + G[1] * aa[1] + G[2] * aa[2])
+            Q = nG * (aa[0] ** 2 + aa[1] ** 2 + aa[2] ** 2)
+            if 10 * Tt < -5 * Q:
+                pc = 0
+            elif 10 * Tt < -Q:
+                pc = 1
+            elif 10 * Tt <= Q:
+                pc = 2
+            elif 10 * Tt <= 5 * Q:
+                pc = 3
+            else:
+                pc = 4
+            code = subs[7].byte(pc)
+            if code > 2:
+                raise Fail("malformed")
+            if code == 0:
+                lp = lin(1, 7, -2, mI2, mI1)
+            elif code == 1:
+                lp = lin(1, 7, -2, mI1, mI2)
+            else:
+                lp = lin(0, 5, -5, mI2, mI1)
+            r = self.read_vector(subs[6], plane)
+            X = [wrap(lp[ax] + r[ax]) for ax in range(3)]
+            if code == 0:
+                P = list(pR)
+                Cp = [pR[ax] + X[ax] for ax in range(3)]
+            elif code == 1:
+                P = [pR[ax] + X[ax] for ax in range(3)]
+                Cp = list(pR)
+            else:
+                P = [pR[ax] - (X[ax] >> 1) for ax in range(3)]
+                Cp = [P[ax] + X[ax] for ax in range(3)]
+        else:
+            lp = lin(1, 4, -1, mI1, mI2)
+            r = self.read_vector(subs[6], plane)
+            P = [pR[ax] + wrap(lp[ax] + r[ax]) for ax in range(3)]
+            lc = lin(1, 4, -1, mI2, mI1)
+            r = self.read_vector(subs[7], plane)
+            Cp = [pR[ax] + wrap(lc[ax] + r[ax]) for ax in range(3)]
+        for X in (P, Cp):
+            for ax in range(3):
+                if X[ax] < 0 or X[ax] >= lim:
+                    raise Fail("position-out-of-range")
+        return (o, d, dP, dC, P, Cp)
+
+    @staticmethod
+    def deficit_of(sym, val):
+        if sym == 0:
+            return LEAF
+        if sym + 2 < val or sym + 2 > 255:
+            raise Fail("valence-overflow")
+        return sym + 2 - val
+
+    def plane_of(self, e, mI1, mI2):
+        pol = self.policy
+        if pol == 0:
+            return None
+        q = [mI2[ax] - mI1[ax] for ax in range(3)]
+        if e is not None:
+            N = [e[1] * q[2] - e[2] * q[1], e[2] * q[0] - e[0] * q[2], e[0] * q[1] - e[1] * q[0]]
+        else:
+            N = [0, 0, 0]
+        s = max(0, bitlen(max(abs(x) for x in N)) - 15)
+        nn = [x >> s for x in N]
+        if pol == 1:
+            best = 0
+            for ax in (1, 2):
+                if abs(nn[ax]) > abs(nn[best]):
+                    best = ax
+            j = best
+        else:
+            j = pol - 2
+        return (nn, j)
+
+    def read_vector(self, sub, plane):
+        if plane is None:
+            return [sub.signed(0), sub.signed(1), sub.signed(2)]
+        nn, j = plane
+        j1 = (j + 1) % 3
+        j2 = (j + 2) % 3
+        if self.policy == 1:
+            c1, c2, c3 = 0, 0, 1
+        else:
+            c1, c2, c3 = j1, j2, j
+        r = [0, 0, 0]
+        r[j1] = sub.signed(c1)
+        r[j2] = sub.signed(c2)
+        rp = sub.signed(c3)
+        if nn[j] != 0:
+            r[j] = wrap(rp + rnd(-(nn[j1] * r[j1] + nn[j2] * r[j2]), nn[j]))
+        else:
+            r[j] = rp
+        return r
+
+    def apply_split(self, R, ring, tof, rec, C):
+        o, d, dP, dC, P, Cp = rec
+        k = len(ring)
+        if d == 0 or o + d >= k:
+            raise Fail("ring-offset-out-of-range")
+        a = ring[o]
+        b = ring[o + d]
+        valP = d + 2
+        valC = k - d + 2
+        if dP != LEAF and valP + dP > 255:
+            raise Fail("valence-overflow")
+        if dC != LEAF and valC + dC > 255:
+            raise Fail("valence-overflow")
+        deficit = self.deficit
+        for w in (a, b):
+            if w != GHOST and deficit[w] == 0:
+                raise Fail("valence-overflow")
+        added = (a != GHOST) + (b != GHOST)
+        if self.T + added > self.T_l:
+            raise Fail("count-mismatch")
+        if self.V + 1 > self.vcap or self.T + added > self.tcap:
+            raise Fail("capacity-exceeded")
+        for w in (a, b):
+            if w != GHOST and deficit[w] != LEAF:
+                deficit[w] -= 1
+        tri = self.tri
+        vtri = self.vtri
+        vtri.append(set())
+        for i in range(o + d, o + k):
+            ri = ring[i % k]
+            rn = ring[(i + 1) % k]
+            if ri == GHOST or rn == GHOST:
+                continue
+            t = tof[ri]
+            for c in range(3 * t, 3 * t + 3):
+                if tri[c] == R:
+                    tri[c] = C
+            vtri[R].discard(t)
+            vtri[C].add(t)
+        if a != GHOST:
+            t = self.T
+            tri.extend((R, C, a))
+            for v in (R, C, a):
+                vtri[v].add(t)
+            self.T += 1
+        if b != GHOST:
+            t = self.T
+            tri.extend((C, R, b))
+            for v in (C, R, b):
+                vtri[v].add(t)
+            self.T += 1
+        self.pos[R] = P
+        self.pos.append(Cp)
+        deficit[R] = dP
+        deficit.append(dC)
+        self.V += 1
+
+
+def main():
+    data = sys.stdin.buffer.read()
+    out = []
+    dec = Decoder(data, out)
+    try:
+        dec.run()
+        out.append("ok")
+    except Fail as f:
+        out.append("error " + f.cls)
+    except RecursionError:
+        out.append("error malformed")
+    sys.stdout.write("\n".join(out) + "\n")
+
+
+if __name__ == "__main__":
+    main()
