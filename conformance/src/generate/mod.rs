@@ -1006,19 +1006,40 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "flags-padding-not-zero",
         "count-mismatch",
-        "The top padding bit after the last flag of a refinement level set (SPEC §5.4).",
+        "The top padding bit after the last flag of a refinement level set (SPEC §5.4): every round of that level decodes, and the level's end-of-level check finds the unread bit.",
         &["records", "record-count"],
         {
-            let mut p = parts.clone();
-            // The first level whose flag count is not a multiple of 8 (its
-            // last flag byte has padding bits; unused bits are zero).
-            let level = p.levels[1..]
-                .iter_mut()
-                .find(|l| l.substreams[0].last().is_some_and(|&b| b & 0x80 == 0))
-                .expect("a flag substream with padding");
-            *level.substreams[0].last_mut().expect("flags") |= 0x80;
-            reframe(&p)
+            // The first level whose last flag byte has padding bits: its
+            // flag count is not a multiple of 8. Setting the top bit of a
+            // byte without padding would change a real flag instead (a
+            // count-mismatch within a round), so each level is tried and
+            // kept only when decoder-core decodes all its rounds first.
+            let rounds_through = |k: usize| -> usize {
+                1 + parts.levels[..=k]
+                    .iter()
+                    .map(|l| l.round_splits.len())
+                    .sum::<usize>()
+            };
+            (1..parts.levels.len())
+                .find_map(|k| {
+                    let mut p = parts.clone();
+                    *p.levels[k].substreams[0].last_mut()? |= 0x80;
+                    let bytes = reframe(&p);
+                    let outcome = builtin::decoder_core(&bytes);
+                    (outcome.verdict == Verdict::Error("count-mismatch".into())
+                        && outcome.hashes.len() == rounds_through(k))
+                    .then_some(bytes)
+                })
+                .expect("a level whose flags end with padding bits")
         },
+    );
+    s.invalid(
+        "deflate-unused-payload-byte",
+        "malformed",
+        "A deflate chunk (one stored block) followed by a zero byte inside its payload, lengths and CRCs matching: no payload byte may remain unused (SPEC §5.2).",
+        &["chunks", "deflate-stored-block"],
+        // Level 1's first chunk: level 0 decodes first.
+        wrap_chunks_in_deflate_with(&stored_subject, Some((1, 0))),
     );
     s.invalid(
         "placement-code-3",
@@ -1306,6 +1327,23 @@ fn rans_vectors(s: &mut Specs) {
             let mut w = splitstream_decoder_core::writer::SubstreamWriter::default();
             w.varint(2);
             lvl.substreams[0] = w;
+            write_stream(
+                &handmade::params(ChunkCodec::RansAlways { lanes: 1 }),
+                &[handmade::tetrahedron(), lvl],
+            )
+        },
+    );
+    s.invalid(
+        "rans-byte-value-256",
+        "malformed",
+        "The deficit-p substream, rANS-coded, holds the value 256 for a byte field (SPEC §5.5): the wings read, the split-valence symbol does not.",
+        &["rans", "handmade"],
+        {
+            let mut lvl = tetra_split_level(tetra_split());
+            let mut w = splitstream_decoder_core::writer::SubstreamWriter::default();
+            w.varint(256);
+            // Slots from substream id 1: id 4 is deficit-p.
+            lvl.substreams[3] = w;
             write_stream(
                 &handmade::params(ChunkCodec::RansAlways { lanes: 1 }),
                 &[handmade::tetrahedron(), lvl],

@@ -250,6 +250,14 @@ pub fn fix_chunk_crc(s: &mut [u8], k: u16, c: usize) {
 /// data, which no sensible encoder writes but every decoder must accept.
 /// Level lengths and offsets, and the CRCs covering them, are recomputed.
 pub fn wrap_chunks_in_deflate(stream: &[u8]) -> Vec<u8> {
+    wrap_chunks_in_deflate_with(stream, None)
+}
+
+/// [`wrap_chunks_in_deflate`], with one zero byte appended after the
+/// deflate stream of chunk `c` of level `k` when `extra_byte` is
+/// `Some((k, c))`: a payload byte the deflate stream never uses (SPEC §5.2:
+/// `malformed`), with every CRC and length made to match it.
+pub fn wrap_chunks_in_deflate_with(stream: &[u8], extra_byte: Option<(u16, usize)>) -> Vec<u8> {
     let levels = level_count(stream);
     let head = head_len(levels);
     let mut out = stream[..head].to_vec();
@@ -268,6 +276,9 @@ pub fn wrap_chunks_in_deflate(stream: &[u8]) -> Vec<u8> {
                 p.extend_from_slice(&len.to_le_bytes());
                 p.extend_from_slice(&(!len).to_le_bytes());
                 p.extend_from_slice(raw);
+                if extra_byte == Some((k, c)) {
+                    p.push(0);
+                }
                 level[entry + 1] = codec::DEFLATE;
                 level[entry + 8..entry + 12].copy_from_slice(&(p.len() as u32).to_le_bytes());
                 level[entry + 12..entry + 16].copy_from_slice(&crc32(&p).to_le_bytes());
