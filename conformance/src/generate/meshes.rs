@@ -34,13 +34,33 @@ pub use splitstream_encoder::input::icosphere;
 /// `y0..y1` are cut out (and the vertices left inside dropped), so the mesh
 /// has an outer boundary and a hole.
 pub fn grid(w: usize, h: usize, seed: u64, hole: Option<[usize; 4]>) -> Mesh {
+    height_field(w, h, hole, |fx, fy| {
+        sin(fx * 0.7 + seed as f64) * 2.0 + cos(fy * 0.45) * 3.0 + sin((fx * fy) * 0.05)
+    })
+}
+
+/// A `w` x `h` height field of whole-unit heights 0..=3, pseudo-random from
+/// `seed`: every axis lies on a lattice, so constrained mode keeps them all
+/// and the small integers make the placement context's ties (SPEC §7.4)
+/// happen.
+pub fn stepped_grid(w: usize, h: usize, seed: u64) -> Mesh {
+    height_field(w, h, None, |fx, fy| {
+        // splitmix64 of the sample's index and the seed.
+        let mut z = (fy as u64 * w as u64 + fx as u64) ^ seed.wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) % 4) as f64
+    })
+}
+
+/// Samples `z(x, y)` on a `w` x `h` grid 10 units apart, triangulated with
+/// alternating diagonals, without the cells of `hole`.
+fn height_field(w: usize, h: usize, hole: Option<[usize; 4]>, z: impl Fn(f64, f64) -> f64) -> Mesh {
     let mut positions = Vec::with_capacity(w * h);
     for y in 0..h {
         for x in 0..w {
             let (fx, fy) = (x as f64, y as f64);
-            let z =
-                sin(fx * 0.7 + seed as f64) * 2.0 + cos(fy * 0.45) * 3.0 + sin((fx * fy) * 0.05);
-            positions.push([fx * 10.0, fy * 10.0, z]);
+            positions.push([fx * 10.0, fy * 10.0, z(fx, fy)]);
         }
     }
     let mut triangles = Vec::new();

@@ -479,6 +479,19 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
         ),
     );
     s.valid(
+        "stepped-terrain-placement-ties",
+        "40x40 height field of whole-unit heights 0..3, constrained positions (every axis on its lattice), every substream rANS-coded: the placement context meets its ties 10t = -5u, u and 5u (SPEC §7.4).",
+        &["encoded", "terrain", "rans", "position-constrained", "placement-ties"],
+        encoded(
+            &meshes::checked(meshes::stepped_grid(40, 40, 1), "stepped grid"),
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::RansAlways { lanes: 4 },
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
         "icosphere-rans",
         "Icosphere (642 vertices), default encoder options: optimal positions, rANS with 4 lanes (deflate where smaller), 5 levels.",
         &["encoded", "rans"],
