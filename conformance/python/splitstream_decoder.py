@@ -99,21 +99,32 @@ class Table:
         self.look = look
 
 
-def payload_varint(p, q):
+def leb128(next_byte):
+    """SPEC §5.4 read_varint over the bytes `next_byte()` returns."""
     v = 0
     for i in range(5):
-        if q >= len(p):
-            raise Fail("malformed")
-        b = p[q]
-        q += 1
+        b = next_byte()
         if i == 4 and b > 0x0F:
             raise Fail("malformed")
         v |= (b & 0x7F) << (7 * i)
         if b & 0x80 == 0:
             if b == 0 and i > 0:
                 raise Fail("malformed")
-            return v, q
+            return v
     raise Fail("malformed")  # unreachable
+
+
+def payload_varint(p, q):
+    at = [q]
+
+    def next_byte():
+        if at[0] >= len(p):
+            raise Fail("malformed")
+        at[0] += 1
+        return p[at[0] - 1]
+
+    v = leb128(next_byte)
+    return v, at[0]
 
 
 def parse_rans(p, nctx, raw_len, lane_count):
@@ -290,17 +301,7 @@ class Sub:
     def varint(self, ctx=0):
         if self.rans:
             return self.value(ctx)
-        v = 0
-        for i in range(5):
-            b = self._byte()
-            if i == 4 and b > 0x0F:
-                raise Fail("malformed")
-            v |= (b & 0x7F) << (7 * i)
-            if b & 0x80 == 0:
-                if b == 0 and i > 0:
-                    raise Fail("malformed")
-                return v
-        raise Fail("malformed")
+        return leb128(self._byte)
 
     def signed(self, ctx=0):
         u = self.varint(ctx)

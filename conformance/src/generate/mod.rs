@@ -1330,38 +1330,32 @@ fn rans_vectors(s: &mut Specs) {
         &["rans", "handmade"],
         patched(&|b| b[layout.token_counts[0]] = 45),
     );
+    // The tetrahedron's split in rANS with one substream holding a single
+    // value out of its field's range (slots from substream id 1).
+    let out_of_range = |slot: usize, value: u32| {
+        let mut lvl = tetra_split_level(tetra_split());
+        let mut w = splitstream_decoder_core::writer::SubstreamWriter::default();
+        w.varint(value);
+        lvl.substreams[slot] = w;
+        write_stream(
+            &handmade::params(ChunkCodec::RansAlways { lanes: 1 }),
+            &[handmade::tetrahedron(), lvl],
+        )
+    };
     s.invalid(
         "rans-bit-value-2",
         "malformed",
         "The flags substream, rANS-coded, holds the value 2 for a one-bit field (SPEC §5.5).",
         &["rans", "handmade"],
-        {
-            let mut lvl = tetra_split_level(tetra_split());
-            let mut w = splitstream_decoder_core::writer::SubstreamWriter::default();
-            w.varint(2);
-            lvl.substreams[0] = w;
-            write_stream(
-                &handmade::params(ChunkCodec::RansAlways { lanes: 1 }),
-                &[handmade::tetrahedron(), lvl],
-            )
-        },
+        out_of_range(0, 2),
     );
     s.invalid(
         "rans-byte-value-256",
         "malformed",
         "The deficit-p substream, rANS-coded, holds the value 256 for a byte field (SPEC §5.5): the wings read, the split-valence symbol does not.",
         &["rans", "handmade"],
-        {
-            let mut lvl = tetra_split_level(tetra_split());
-            let mut w = splitstream_decoder_core::writer::SubstreamWriter::default();
-            w.varint(256);
-            // Slots from substream id 1: id 4 is deficit-p.
-            lvl.substreams[3] = w;
-            write_stream(
-                &handmade::params(ChunkCodec::RansAlways { lanes: 1 }),
-                &[handmade::tetrahedron(), lvl],
-            )
-        },
+        // Slot 3: substream id 4, deficit-p.
+        out_of_range(3, 256),
     );
     s.invalid(
         "rans-mixed-codecs",
