@@ -277,20 +277,21 @@ class Sub:
         self.pos += 1
         return b
 
+    def _value_at_most(self, ctx, top):
+        """A rANS value read for a field whose range ends at `top` (SPEC §5.5)."""
+        v = self.value(ctx)
+        if v > top:
+            raise Fail("malformed")
+        return v
+
     def byte(self, ctx=0):
         if self.rans:
-            v = self.value(ctx)
-            if v > 255:
-                raise Fail("malformed")
-            return v
+            return self._value_at_most(ctx, 255)
         return self._byte()
 
     def bit(self, ctx=0):
         if self.rans:
-            v = self.value(ctx)
-            if v > 1:
-                raise Fail("malformed")
-            return v
+            return self._value_at_most(ctx, 1)
         if self.bi == 8:
             self.cur = self._byte()
             self.bi = 0
@@ -865,16 +866,13 @@ class Decoder:
                     tri[c] = C
             vtri[R].discard(t)
             vtri[C].add(t)
-        if a != GHOST:
+        # The new triangles (P, C, a) and (C, P, b), SPEC §7.4, for real wings.
+        for wing, corners in ((a, (R, C, a)), (b, (C, R, b))):
+            if wing == GHOST:
+                continue
             t = self.T
-            tri.extend((R, C, a))
-            for v in (R, C, a):
-                vtri[v].add(t)
-            self.T += 1
-        if b != GHOST:
-            t = self.T
-            tri.extend((C, R, b))
-            for v in (C, R, b):
+            tri.extend(corners)
+            for v in corners:
                 vtri[v].add(t)
             self.T += 1
         self.pos[R] = P
