@@ -1,8 +1,9 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.0 decoder, in Python, written from
+"""A second splitstream 3.1 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
-enough to decode bit-exactly. It speaks the conformance protocol (a stream
+enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
+plane policy `height` was added with the SPEC section that defines it.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -459,7 +460,7 @@ class Decoder:
             raise Fail("truncated")
         if crc32(lvl[0:payload_start - 4]) != u32(lvl, payload_start - 4):
             raise Fail("checksum-mismatch")
-        if lvl[8] > 4:
+        if lvl[8] > 5:
             raise Fail("malformed")
         if lvl[9] or lvl[10] or lvl[11]:
             raise Fail("malformed")
@@ -755,7 +756,7 @@ class Decoder:
             else:
                 lp = lin(0, 5, -5, mI2, mI1)
             r = self.read_vector(subs[6], plane)
-            X = [wrap(lp[ax] + r[ax]) for ax in range(3)]
+            X = self.vector(lp, r, code, ring, pR)
             if code == 0:
                 P = list(pR)
                 Cp = [pR[ax] + X[ax] for ax in range(3)]
@@ -768,15 +769,55 @@ class Decoder:
         else:
             lp = lin(1, 4, -1, mI1, mI2)
             r = self.read_vector(subs[6], plane)
-            P = [pR[ax] + wrap(lp[ax] + r[ax]) for ax in range(3)]
+            X = self.vector(lp, r, "P", ring, pR)
+            P = [pR[ax] + X[ax] for ax in range(3)]
             lc = lin(1, 4, -1, mI2, mI1)
             r = self.read_vector(subs[7], plane)
-            Cp = [pR[ax] + wrap(lc[ax] + r[ax]) for ax in range(3)]
+            X = self.vector(lc, r, "C", ring, pR)
+            Cp = [pR[ax] + X[ax] for ax in range(3)]
         for X in (P, Cp):
             for ax in range(3):
                 if X[ax] < 0 or X[ax] >= lim:
                     raise Fail("position-out-of-range")
         return (o, d, dP, dC, P, Cp)
+
+    def vector(self, lp, r, target, ring, pR):
+        # SPEC §7.4 vector(): the linear prediction plus the residual, and
+        # under plane policy 5 (height, 3.1) z from the surface of R's fan.
+        X = [wrap(lp[ax] + r[ax]) for ax in range(3)]
+        if self.policy == 5:
+            h = self.height_of(target, X, ring, pR)
+            if h is not None:
+                X[2] = wrap(h + r[2])
+        return X
+
+    def height_of(self, target, X, ring, pR):
+        if target == 2:
+            p = (-(X[0] >> 1), -(X[1] >> 1))
+            c = (p[0] + X[0], p[1] + X[1])
+            hc = self.surface(c, ring, pR)
+            hp = self.surface(p, ring, pR)
+            if hc is None or hp is None:
+                return None
+            return hc - hp
+        return self.surface((X[0], X[1]), ring, pR)
+
+    def surface(self, y, ring, pR):
+        k = len(ring)
+        for i in range(k):
+            u, v = ring[i], ring[(i + 1) % k]
+            if u == GHOST or v == GHOST:
+                continue
+            a = [self.pos[u][ax] - pR[ax] for ax in range(3)]
+            b = [self.pos[v][ax] - pR[ax] for ax in range(3)]
+            det = a[0] * b[1] - a[1] * b[0]
+            if det == 0:
+                continue
+            s = y[0] * b[1] - y[1] * b[0]
+            t = a[0] * y[1] - a[1] * y[0]
+            if (det > 0 and s >= 0 and t >= 0) or (det < 0 and s <= 0 and t <= 0):
+                return rnd(s * a[2] + t * b[2], det)
+        return None
 
     @staticmethod
     def deficit_of(sym, val):
@@ -788,7 +829,7 @@ class Decoder:
 
     def plane_of(self, e, mI1, mI2):
         pol = self.policy
-        if pol == 0:
+        if pol == 0 or pol == 5:  # off, height (3.1): no plane
             return None
         q = [mI2[ax] - mI1[ax] for ax in range(3)]
         if e is not None:

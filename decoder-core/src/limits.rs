@@ -6,7 +6,10 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 
 /// Format version this crate reads and writes (SPEC §1).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 0;
+pub const VERSION_MINOR: u8 = 1;
+/// The minor version written when a stream uses no 3.1 feature (every
+/// reserved field zero), so that 3.0 decoders read it (SPEC §1).
+pub const VERSION_MINOR_BASELINE: u8 = 0;
 
 /// Size of the fixed header in bytes (SPEC §3).
 pub const HEADER_LEN: usize = 96;
@@ -79,8 +82,10 @@ pub mod plane {
     pub const X: u8 = 2;
     pub const Y: u8 = 3;
     pub const Z: u8 = 4;
+    /// z from the surface of R's fan over the vector's x and y (format 3.1).
+    pub const HEIGHT: u8 = 5;
     /// Number of policies; bytes from here on are reserved.
-    pub const COUNT: u8 = 5;
+    pub const COUNT: u8 = 6;
     /// The normal is shifted to at most this many significant bits.
     pub const NORMAL_BITS: u32 = 15;
 }

@@ -27,6 +27,9 @@ pub enum PlanePolicy {
     Dominant,
     /// Always this axis (0 x, 1 y, 2 z); contexts by axis.
     Axis(u8),
+    /// Format 3.1: no plane; z predicted from the surface of R's fan at the
+    /// vector's x and y, read before it (terrain). Contexts by axis.
+    Height,
 }
 
 impl PlanePolicy {
@@ -37,6 +40,7 @@ impl PlanePolicy {
         PlanePolicy::Axis(0),
         PlanePolicy::Axis(1),
         PlanePolicy::Axis(2),
+        PlanePolicy::Height,
     ];
 
     /// The policy of a level header's byte (SPEC §5.1); `None` for the
@@ -46,6 +50,7 @@ impl PlanePolicy {
             plane::OFF => Some(PlanePolicy::Off),
             plane::DOMINANT => Some(PlanePolicy::Dominant),
             plane::X..=plane::Z => Some(PlanePolicy::Axis(b - plane::X)),
+            plane::HEIGHT => Some(PlanePolicy::Height),
             _ => None,
         }
     }
@@ -56,6 +61,7 @@ impl PlanePolicy {
             PlanePolicy::Off => plane::OFF,
             PlanePolicy::Dominant => plane::DOMINANT,
             PlanePolicy::Axis(a) => plane::X + a.min(2),
+            PlanePolicy::Height => plane::HEIGHT,
         }
     }
 
@@ -67,6 +73,7 @@ impl PlanePolicy {
             PlanePolicy::Axis(0) => "x",
             PlanePolicy::Axis(1) => "y",
             PlanePolicy::Axis(_) => "z",
+            PlanePolicy::Height => "height",
         }
     }
 }
@@ -246,6 +253,149 @@ pub fn constrained_positions(parent: [u32; 3], code: u8, x: [i64; 3]) -> ([i64; 
     }
 }
 
+/// The vector a residual decodes to (SPEC §7.4): `prediction + r` modulo
+/// 2^32, with, under the plane policy `height`, the z of the surface
+/// prediction plus `r`'s z where a wedge of R's fan holds the point. `r` is
+/// the residual after the plane's offset ([`Plane::decode`]).
+#[inline]
+pub fn vector_of_residual(
+    policy: PlanePolicy,
+    positions: &[[u32; 3]],
+    parent: [u32; 3],
+    ring: &Ring,
+    target: Target,
+    prediction: [i64; 3],
+    r: [i64; 3],
+) -> [i64; 3] {
+    let mut x = add_residual(prediction, r);
+    if policy == PlanePolicy::Height
+        && let Some(h) = height_prediction(positions, parent, ring, target, x)
+    {
+        x[2] = wrap(h + r[2]);
+    }
+    x
+}
+
+/// The residual an encoder codes for the vector `x` (every component below
+/// 2^31 in magnitude), before the plane's offset ([`Plane::encode`]): the
+/// inverse of [`vector_of_residual`].
+#[inline]
+pub fn residual_of_vector(
+    policy: PlanePolicy,
+    positions: &[[u32; 3]],
+    parent: [u32; 3],
+    ring: &Ring,
+    target: Target,
+    prediction: [i64; 3],
+    x: [i64; 3],
+) -> [i64; 3] {
+    let mut r = residual(x, prediction);
+    if policy == PlanePolicy::Height
+        && let Some(h) = height_prediction(positions, parent, ring, target, x)
+    {
+        r[2] = wrap(x[2] - h);
+    }
+    r
+}
+
+/// The height policy's prediction of a vector's z (SPEC §7.4, format 3.1):
+/// the z of the surface of R's fan, relative to R, at the vector's end
+/// (`Target::P`, `Target::C`: vectors from R), or the difference of the
+/// surface's z at C and at P (`Target::Edge`, R the floor midpoint of P
+/// and C). `x` holds the decoded x and y of the vector (its z is ignored).
+/// `None` when a point lies in no real wedge of the ring: the caller keeps
+/// the linear prediction.
+#[inline]
+pub fn height_prediction(
+    positions: &[[u32; 3]],
+    parent: [u32; 3],
+    ring: &Ring,
+    target: Target,
+    x: [i64; 3],
+) -> Option<i64> {
+    match target {
+        Target::P | Target::C => surface_height(positions, parent, ring, [x[0], x[1]]),
+        Target::Edge => {
+            // P = R − (x >> 1), C = P + x (`constrained_positions`).
+            let p = [-(x[0] >> 1), -(x[1] >> 1)];
+            let c = [p[0] + x[0], p[1] + x[1]];
+            let at_c = surface_height(positions, parent, ring, c)?;
+            let at_p = surface_height(positions, parent, ring, p)?;
+            Some(wrap(at_c - at_p))
+        }
+    }
+}
+
+/// `surface(y)` of SPEC §7.4: the first real wedge `(R, r_i, r_{i+1})` of
+/// the ring, in ring order, whose projection on the xy plane holds the
+/// point `y` (relative to R) in its cone, and the z of that wedge's plane
+/// at `y`, relative to R, rounded (`round`). With `a`, `b` the wedge's
+/// entries relative to R and `det = a × b` (xy cross product, not 0), `y`
+/// is in the cone when `y × b` and `a × y` are 0 or of the sign of `det`;
+/// then `y = s a + t b` with `s = (y × b) / det`, `t = (a × y) / det`.
+///
+/// Exact in 128 bits: `|a_i|, |b_i| < 2^31`, `|y_i| < 2^32`, so the cross
+/// products are below `2^64`, `|det| < 2^63` and the numerator below
+/// `2^96`. The z is returned modulo 2^32 (as [`wrap`] gives it): the
+/// vector's z wraps modulo 2^32 anyway.
+pub fn surface_height(
+    positions: &[[u32; 3]],
+    parent: [u32; 3],
+    ring: &Ring,
+    y: [i64; 2],
+) -> Option<i64> {
+    let vertices = ring.vertices();
+    let k = vertices.len();
+    let origin = parent.map(|x| x as i64);
+    // Entries relative to R (|x| < 2^31); the ghost has no position.
+    let relative = |v: u32| -> Option<[i64; 3]> {
+        let p = positions.get(v as usize)?;
+        Some([
+            p[0] as i64 - origin[0],
+            p[1] as i64 - origin[1],
+            p[2] as i64 - origin[2],
+        ])
+    };
+    let (y0, y1) = (y[0] as i128, y[1] as i128);
+    // `e × y` for each entry e: wedge i's `t` is `r_i × y` and its `s`,
+    // `y × r_{i+1}`, is minus the next entry's, so one product per entry.
+    let with_cross = |v: u32| relative(v).map(|e| (e, e[0] as i128 * y1 - e[1] as i128 * y0));
+    let mut a = with_cross(*vertices.first()?);
+    for i in 0..k {
+        let b = with_cross(vertices[if i + 1 == k { 0 } else { i + 1 }]);
+        if let (Some((a, t)), Some((b, minus_s))) = (a, b) {
+            // Products of two values below 2^31: exact in 64 bits.
+            let det = a[0] * b[1] - a[1] * b[0];
+            let s = -minus_s;
+            let inside = if det > 0 {
+                s >= 0 && t >= 0
+            } else {
+                det < 0 && s <= 0 && t <= 0
+            };
+            if inside {
+                let z = s * a[2] as i128 + t * b[2] as i128;
+                // Only its value modulo 2^32 matters (the z adds wrap).
+                return Some(round_div_wide(z, det as i128) as i32 as i64);
+            }
+        }
+        a = b;
+    }
+    None
+}
+
+/// `round(p / q)` of SPEC §7.4 in 128 bits, for `q != 0` and `|p| < 2^126`.
+#[inline]
+fn round_div_wide(p: i128, q: i128) -> i128 {
+    let (p, q) = if q < 0 { (-p, -q) } else { (p, q) };
+    let (x, d) = (2 * p + q, 2 * q);
+    // A 64-bit division where it fits (small grids, always on terrain):
+    // the 128-bit one is a library call.
+    match (i64::try_from(x), i64::try_from(d)) {
+        (Ok(x), Ok(d)) => x.div_euclid(d) as i128,
+        _ => x.div_euclid(d),
+    }
+}
+
 /// The plane prediction of one split (SPEC §7.4): the shifted normal and
 /// the predicted axis, or nothing under the policy `off`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -264,7 +414,7 @@ impl Plane {
     #[inline]
     pub fn new(policy: PlanePolicy, means: &ArcMeans) -> Plane {
         match policy {
-            PlanePolicy::Off => Plane::with_normal(policy, [0; 3]),
+            PlanePolicy::Off | PlanePolicy::Height => Plane::with_normal(policy, [0; 3]),
             _ => Plane::with_normal(policy, normal(means)),
         }
     }
@@ -275,7 +425,7 @@ impl Plane {
     #[inline]
     pub fn with_normal(policy: PlanePolicy, n: [i64; 3]) -> Plane {
         let (normal, axis) = match policy {
-            PlanePolicy::Off => {
+            PlanePolicy::Off | PlanePolicy::Height => {
                 return Plane {
                     policy,
                     normal: [0; 3],
@@ -476,6 +626,188 @@ fn bucket(t: i128, q: i128) -> u8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::limits::NONE;
+
+    /// R at (100, 100, 50) with the 8 lattice neighbours counter-clockwise
+    /// from +x, on the plane z = 50 + 3 dx − 2 dy (so every wedge is that
+    /// plane), and the ring of vertex 0 (R) over vertices 1..=8.
+    fn plane_fan() -> ([[u32; 3]; 9], Ring) {
+        let height = |dx: i64, dy: i64| (50 + 3 * dx - 2 * dy) as u32;
+        let around = [
+            (1, 0),
+            (1, 1),
+            (0, 1),
+            (-1, 1),
+            (-1, 0),
+            (-1, -1),
+            (0, -1),
+            (1, -1),
+        ];
+        let mut positions = [[100, 100, 50]; 9];
+        for (i, (dx, dy)) in around.into_iter().enumerate() {
+            positions[i + 1] = [(100 + dx) as u32, (100 + dy) as u32, height(dx, dy)];
+        }
+        (positions, Ring::of_vertices(&[1, 2, 3, 4, 5, 6, 7, 8]))
+    }
+
+    #[test]
+    fn surface_height_is_exact_on_a_plane() {
+        let (positions, ring) = plane_fan();
+        let parent = positions[0];
+        for (x, y) in [(0, 0), (1, 0), (2, 1), (-3, 2), (-1, -1), (5, -7), (0, -2)] {
+            assert_eq!(
+                surface_height(&positions, parent, &ring, [x, y]),
+                Some(3 * x - 2 * y),
+                "({x}, {y})"
+            );
+        }
+        // The edge vector C − P with R their floor midpoint: the difference.
+        let x = [3, -2, 0];
+        let (p, c) = ([-1i64, 1], [2i64, -1]);
+        let expected = (3 * c[0] - 2 * c[1]) - (3 * p[0] - 2 * p[1]);
+        assert_eq!(
+            height_prediction(&positions, parent, &ring, Target::Edge, x),
+            Some(expected)
+        );
+        assert_eq!(
+            height_prediction(&positions, parent, &ring, Target::C, x),
+            Some(13)
+        );
+    }
+
+    #[test]
+    fn surface_height_interpolates_the_first_wedge_that_holds_the_point() {
+        // Wedge (R, r_0, r_1) with r_0 = (4, 0, 8), r_1 = (0, 4, 0), relative
+        // to R: y = s r_0 + t r_1 has z = 8 s.
+        let positions = [
+            [10, 10, 10],
+            [14, 10, 18],
+            [10, 14, 10],
+            [6, 10, 10],
+            [10, 6, 10],
+        ];
+        let ring = Ring::of_vertices(&[1, 2, 3, 4]);
+        let parent = positions[0];
+        // (1, 1): s = 1/4; (3, 1): s = 3/4; (1, 3): s = 1/4.
+        assert_eq!(surface_height(&positions, parent, &ring, [1, 1]), Some(2));
+        assert_eq!(surface_height(&positions, parent, &ring, [3, 1]), Some(6));
+        assert_eq!(surface_height(&positions, parent, &ring, [1, 3]), Some(2));
+        // Other wedges are flat (z = 0 relative to R).
+        assert_eq!(surface_height(&positions, parent, &ring, [-2, 1]), Some(0));
+        // Halves round up: with r_0 at z + 1, (2, 0) and (2, 1) have s = 1/2.
+        let positions = [
+            [10, 10, 10],
+            [14, 10, 11],
+            [10, 14, 10],
+            [6, 10, 10],
+            [10, 6, 10],
+        ];
+        assert_eq!(surface_height(&positions, parent, &ring, [2, 0]), Some(1));
+        assert_eq!(surface_height(&positions, parent, &ring, [2, 1]), Some(1));
+    }
+
+    #[test]
+    fn surface_height_skips_ghost_and_flat_wedges_and_follows_either_orientation() {
+        let (positions, _) = plane_fan();
+        let parent = positions[0];
+        // A boundary ring: the ghost first, then the fan over +y only.
+        let ring = Ring::of_vertices(&[NONE, 1, 2, 3, 4, 5]);
+        assert_eq!(surface_height(&positions, parent, &ring, [1, 1]), Some(1));
+        // Below the x axis no real wedge holds the point: no prediction.
+        assert_eq!(surface_height(&positions, parent, &ring, [0, -1]), None);
+        // The same fan clockwise (a mesh whose triangles face down).
+        let ring = Ring::of_vertices(&[8, 7, 6, 5, 4, 3, 2, 1]);
+        assert_eq!(
+            surface_height(&positions, parent, &ring, [-3, 2]),
+            Some(-13)
+        );
+        // Collinear neighbours (det = 0) hold nothing.
+        let ring = Ring::of_vertices(&[1, 5]);
+        assert_eq!(surface_height(&positions, parent, &ring, [0, 1]), None);
+    }
+
+    #[test]
+    fn surface_height_survives_31_bits() {
+        // Extreme positions: a thin wedge far from R, a point at 2^32.
+        let top = (1u32 << 31) - 1;
+        let positions = [[0, 0, 0], [top, 1, top], [top, 2, 0], [0, top, top]];
+        let ring = Ring::of_vertices(&[1, 2, 3]);
+        let parent = positions[0];
+        for y in [
+            [(1i64 << 32) - 1, 3],
+            [1, 1],
+            [-(1 << 31), -(1 << 31)],
+            [top as i64, 0],
+        ] {
+            if let Some(z) = surface_height(&positions, parent, &ring, y) {
+                assert_eq!(z, wrap(z), "{y:?}");
+            }
+        }
+        let parent = [top, top, top];
+        let ring = Ring::of_vertices(&[1, 2, 3]);
+        let h = height_prediction(
+            &positions,
+            parent,
+            &ring,
+            Target::Edge,
+            [i32::MIN as i64, i32::MAX as i64, 0],
+        );
+        assert_eq!(h, h.map(wrap));
+    }
+
+    #[test]
+    fn wide_rounding_division_agrees_in_both_widths() {
+        // round(p / q) = floor((2p + q) / 2q), halves up, as `round_div`.
+        for (p, q) in [(3, 2), (-3, 2), (-5, 3), (7, -2), (0, 5), (1, 1 << 40)] {
+            assert_eq!(
+                round_div_wide(p, q),
+                round_div(p as i64, q as i64) as i128,
+                "{p} {q}"
+            );
+        }
+        // Past 64 bits: 2^95 + 2^40 over 2^41 is 2^54 + 1/2, rounded up.
+        let big = (1i128 << 95) + (1 << 40);
+        assert_eq!(round_div_wide(big, 1 << 41), (1 << 54) + 1);
+        assert_eq!(round_div_wide(-big, 1 << 41), -(1 << 54));
+        assert_eq!(round_div_wide(big, -(1 << 41)), -(1 << 54));
+        assert_eq!(
+            round_div_wide(-(1i128 << 96) + 1, (1i128 << 63) - 1),
+            -(1 << 33)
+        );
+    }
+
+    #[test]
+    fn height_residuals_invert() {
+        let (positions, ring) = plane_fan();
+        let parent = positions[0];
+        let policy = PlanePolicy::Height;
+        for target in [Target::P, Target::C, Target::Edge] {
+            for x in [
+                [2, 1, 9],
+                [-1, 0, -4],
+                [0, 0, 0],
+                [i32::MAX as i64, -3, i32::MIN as i64],
+            ] {
+                let prediction = [1, -1, 5];
+                let r =
+                    residual_of_vector(policy, &positions, parent, &ring, target, prediction, x);
+                let back =
+                    vector_of_residual(policy, &positions, parent, &ring, target, prediction, r);
+                assert_eq!(back, x.map(wrap), "{target:?} {x:?}");
+            }
+        }
+        // On the plane the height residual of an exact vector is 0.
+        let r = residual_of_vector(
+            policy,
+            &positions,
+            parent,
+            &ring,
+            Target::C,
+            [0; 3],
+            [2, 1, 4],
+        );
+        assert_eq!(r, [2, 1, 0]);
+    }
 
     #[test]
     fn reciprocal_division_is_floor_division() {
@@ -520,7 +852,7 @@ mod tests {
             assert_eq!(p.to_byte(), i as u8);
             assert_eq!(PlanePolicy::from_byte(i as u8), Some(*p));
         }
-        assert_eq!(PlanePolicy::from_byte(5), None);
+        assert_eq!(PlanePolicy::from_byte(6), None);
         assert_eq!(PlanePolicy::from_byte(255), None);
     }
 
@@ -619,7 +951,7 @@ mod tests {
                 let plane = Plane::new(policy, &means);
                 let n = normal(&means).map(|x| x.abs());
                 let expected_axis = match policy {
-                    PlanePolicy::Off => None,
+                    PlanePolicy::Off | PlanePolicy::Height => None,
                     PlanePolicy::Dominant => {
                         Some((0..3).find(|&i| n[i] == *n.iter().max().unwrap()).unwrap())
                     }

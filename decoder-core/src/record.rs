@@ -5,7 +5,7 @@ use crate::context::{self, SINGLE};
 use crate::header::PositionMode;
 use crate::limits::substream::{self, SLOTS};
 use crate::predict::{
-    Plane, PlanePolicy, Target, add_residual, arc_means, constrained_positions, predict,
+    Plane, PlanePolicy, Target, arc_means, constrained_positions, predict, vector_of_residual,
 };
 use crate::ring::Ring;
 use crate::round::{RecordSource, all_ones};
@@ -90,8 +90,9 @@ impl RecordSource for StreamSource<'_, '_, '_> {
             )?,
             valence_c,
         )?;
-        let parent = state.positions()[r as usize];
-        let means = arc_means(state.positions(), parent, ring, o, d);
+        let positions = state.positions();
+        let parent = positions[r as usize];
+        let means = arc_means(positions, parent, ring, o, d);
         let plane = Plane::new(self.plane, &means);
         let origin = parent.map(|x| x as i64);
         let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|i| a[i] + b[i]) };
@@ -100,7 +101,9 @@ impl RecordSource for StreamSource<'_, '_, '_> {
                 let code = s.byte(slot(substream::PLACEMENT), context::placement(&means))?;
                 let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
                 let prediction = predict(&means, self.mode, target);
-                let x = add_residual(prediction, read_vector(s, slot(substream::EDGE), &plane)?);
+                let r = read_vector(s, slot(substream::EDGE), &plane)?;
+                let x =
+                    vector_of_residual(self.plane, positions, parent, ring, target, prediction, r);
                 constrained_positions(parent, code, x)
             }
             PositionMode::Optimal => {
@@ -108,10 +111,25 @@ impl RecordSource for StreamSource<'_, '_, '_> {
                 let c_hat = predict(&means, self.mode, Target::C);
                 let s_vec = read_vector(s, slot(substream::EDGE), &plane)?;
                 let t_vec = read_vector(s, slot(substream::PLACEMENT), &plane)?;
-                (
-                    add(origin, add_residual(p_hat, s_vec)),
-                    add(origin, add_residual(c_hat, t_vec)),
-                )
+                let p = vector_of_residual(
+                    self.plane,
+                    positions,
+                    parent,
+                    ring,
+                    Target::P,
+                    p_hat,
+                    s_vec,
+                );
+                let c = vector_of_residual(
+                    self.plane,
+                    positions,
+                    parent,
+                    ring,
+                    Target::C,
+                    c_hat,
+                    t_vec,
+                );
+                (add(origin, p), add(origin, c))
             }
         };
         let bits = state.bits();

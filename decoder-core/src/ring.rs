@@ -75,6 +75,17 @@ impl Default for FansAhead {
 }
 
 impl Ring {
+    /// A ring of the given neighbours, without corners (unit tests).
+    #[cfg(test)]
+    pub(crate) fn of_vertices(vertices: &[u32]) -> Ring {
+        let mut ring = Ring {
+            len: vertices.len(),
+            ..Ring::default()
+        };
+        ring.vertices[..vertices.len()].copy_from_slice(vertices);
+        ring
+    }
+
     /// Valence: ring length, the ghost counted (SPEC §6.1).
     pub fn len(&self) -> usize {
         self.len

@@ -9,7 +9,9 @@ use crate::context;
 use crate::header::{Header, PositionMode};
 use crate::layout::Layout;
 use crate::level_table::{LevelInfo, head_len, write_level_table};
-use crate::limits::{CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, codec, substream};
+use crate::limits::{
+    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, VERSION_MINOR_BASELINE, codec, substream,
+};
 use crate::predict::PlanePolicy;
 use crate::rans_writer::{Symbol, encode_chunk};
 
@@ -286,8 +288,15 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
+    // SPEC §1: 3.1 only where a 3.1 feature (the plane policy `height`) is
+    // used; every other stream stays readable by 3.0 decoders.
+    let uses_3_1 = levels.iter().any(|l| l.plane == PlanePolicy::Height);
     let header = Header {
-        version_minor: VERSION_MINOR,
+        version_minor: if uses_3_1 {
+            VERSION_MINOR
+        } else {
+            VERSION_MINOR_BASELINE
+        },
         position_mode: params.position_mode,
         bits: params.bits,
         lane_count: params.codec.lane_count(),

@@ -77,7 +77,7 @@ proptest! {
         subs in proptest::collection::vec(proptest::collection::vec(any::<u8>(), 0..24), 8),
         constrained in any::<bool>(),
         extra_triangles in 0u32..8,
-        plane in 0u8..5,
+        plane in 0u8..splitstream_decoder_core::limits::plane::COUNT,
     ) {
         let b = &bases()[base];
         let nv = b.positions.len();

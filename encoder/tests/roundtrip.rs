@@ -7,7 +7,7 @@ mod roundtrip_check;
 use roundtrip_check::assert_roundtrip;
 
 use splitstream_decoder_core::{PlanePolicy, PositionMode};
-use splitstream_encoder::emit::EncodeOptions;
+use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::quantize::{Lattice, Quantization, Units};
 
 #[test]
@@ -84,6 +84,29 @@ fn every_plane_policy_roundtrips_at_31_bits() {
             ..EncodeOptions::default()
         };
         assert_roundtrip(&common::bumpy_grid(21, 17, 1), &options);
+    }
+}
+
+/// Format 3.1's plane policy `height` on terrain, in both position modes,
+/// at 14 and 31 bits; a stream that uses it says minor version 1, one that
+/// does not stays 3.0 (SPEC §1).
+#[test]
+fn height_policy_roundtrips_and_sets_the_minor_version() {
+    let terrain = common::bumpy_grid(21, 17, 3);
+    for mode in [PositionMode::Constrained, PositionMode::Optimal] {
+        for bits in [14, 31] {
+            for (plane, minor) in [(PlanePolicy::Height, 1), (PlanePolicy::Axis(2), 0)] {
+                let options = EncodeOptions {
+                    bits,
+                    plane: Some(plane),
+                    position_mode: mode,
+                    ..EncodeOptions::default()
+                };
+                assert_roundtrip(&terrain, &options);
+                let encoded = encode(&terrain, &options, |_| {}).expect("encode");
+                assert_eq!(encoded.stream[9], minor, "{mode:?} {bits} {plane:?}");
+            }
+        }
     }
 }
 

@@ -630,6 +630,45 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
                 },
             ),
         );
+        // Format 3.1's height prediction at its widest: 128-bit surface
+        // arithmetic, points far outside thin wedges, folded fans (the
+        // sphere) where no wedge holds the point.
+        for (mesh, name) in [(&terrain, "terrain"), (&sphere2, "icosphere")] {
+            s.valid(
+                &format!("bits-31-{name}-{what}-height"),
+                &format!(
+                    "{name}, {what} positions, 31 bits per axis, plane policy `height` (3.1) in every level: z predicted from the surface of R's fan, modulo 2^32 (SPEC §7.4)."
+                ),
+                &["encoded", "bits-31", "plane-policy", "height", "wrapped-residuals"],
+                encoded(
+                    mesh,
+                    EncodeOptions {
+                        position_mode: mode,
+                        bits: 31,
+                        codec: ChunkCodec::RansAlways { lanes: 2 },
+                        plane: Some(PlanePolicy::Height),
+                        lattice: Some(Lattice::Ignore),
+                        ..opts()
+                    },
+                ),
+            );
+        }
+        s.valid(
+            &format!("grid-hole-{what}-height"),
+            &format!(
+                "Small height field with a hole, {what} positions, plane policy `height` (3.1) in every level: boundary fans whose open side holds no wedge keep the linear prediction."
+            ),
+            &["encoded", "plane-policy", "height", "boundary"],
+            encoded(
+                &small_holed,
+                EncodeOptions {
+                    position_mode: mode,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Height),
+                    ..opts()
+                },
+            ),
+        );
         s.valid(
             &format!("bits-31-grid-hole-{what}-dominant"),
             &format!(
@@ -907,9 +946,9 @@ fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "plane-policy-reserved",
         "malformed",
-        "Level 1's plane policy byte (level header byte 8) set to 5, a reserved value (level header CRC recomputed).",
+        "Level 1's plane policy byte (level header byte 8) set to 6, the first value 3.1 reserves (level header CRC recomputed).",
         &["reserved", "plane-policy"],
-        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1), 5),
+        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1), 6),
     );
     s.invalid(
         "plane-policy-255",

@@ -29,8 +29,8 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Decoder, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane, PlanePolicy,
-    PositionMode, RecordSource, Ring, SplitRecord, Target, add_residual, arc_means,
-    constrained_positions, context, predict, residual, workspace_len,
+    PositionMode, RecordSource, Ring, SplitRecord, Target, arc_means, constrained_positions,
+    context, predict, residual_of_vector, vector_of_residual, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -321,13 +321,24 @@ impl RecordSource for GenSource<'_, '_> {
                 }
                 let p_hat = predict(&means, self.mode, Target::P);
                 let c_hat = predict(&means, self.mode, Target::C);
-                let cs = plane.encode(residual(sub(p, parent64), p_hat));
-                let ct = plane.encode(residual(sub(q, parent64), c_hat));
+                let positions = state.positions();
+                let policy = self.plane;
+                let code = |target, hat, x| {
+                    plane.encode(residual_of_vector(
+                        policy, positions, parent, ring, target, hat, x,
+                    ))
+                };
+                let cs = code(Target::P, p_hat, sub(p, parent64));
+                let ct = code(Target::C, c_hat, sub(q, parent64));
                 write(&mut self.subs[5], cs);
                 write(&mut self.subs[6], ct);
+                let decode = |target, hat, coded| {
+                    let r = plane.decode(coded);
+                    vector_of_residual(policy, positions, parent, ring, target, hat, r)
+                };
                 (
-                    add(parent64, add_residual(p_hat, plane.decode(cs))),
-                    add(parent64, add_residual(c_hat, plane.decode(ct))),
+                    add(parent64, decode(Target::P, p_hat, cs)),
+                    add(parent64, decode(Target::C, c_hat, ct)),
                 )
             }
             PositionMode::Constrained => {
@@ -356,9 +367,15 @@ impl RecordSource for GenSource<'_, '_> {
                     edge = [0; 3];
                 }
                 let prediction = predict(&means, self.mode, target);
-                let coded = plane.encode(residual(vector(code, &edge), prediction));
+                let (positions, policy) = (state.positions(), self.plane);
+                let x = vector(code, &edge);
+                let coded = plane.encode(residual_of_vector(
+                    policy, positions, parent, ring, target, prediction, x,
+                ));
                 write(&mut self.subs[5], coded);
-                constrained_positions(parent, code, add_residual(prediction, plane.decode(coded)))
+                let r = plane.decode(coded);
+                let x = vector_of_residual(policy, positions, parent, ring, target, prediction, r);
+                constrained_positions(parent, code, x)
             }
         };
         if !in_grid(&p) || !in_grid(&q) {

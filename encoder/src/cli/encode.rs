@@ -75,8 +75,9 @@ pub struct Args {
     /// constrained mode only.
     #[arg(long, value_enum, default_value_t = LatticeArg::Auto)]
     pub lattice: LatticeArg,
-    /// Which axis of each position residual the split's plane predicts
-    /// (SPEC §7.4); `auto` picks the cheapest per level.
+    /// Which axis of each position residual the split's plane predicts, or
+    /// `height`: z from the surface of the split vertex's fan (terrain,
+    /// format 3.1) (SPEC §7.4); `auto` picks the cheapest per level.
     #[arg(long, value_enum, default_value_t = PlaneArg::Auto)]
     pub plane: PlaneArg,
     /// Where the simplification's data-parallel passes run (GPU backends:

@@ -97,6 +97,9 @@ pub enum PlaneArg {
     X,
     Y,
     Z,
+    /// z from the surface of the split vertex's fan at the vector's x and y
+    /// (terrain; format 3.1).
+    Height,
 }
 
 impl PlaneArg {
@@ -109,6 +112,7 @@ impl PlaneArg {
             PlaneArg::X => Some(PlanePolicy::Axis(0)),
             PlaneArg::Y => Some(PlanePolicy::Axis(1)),
             PlaneArg::Z => Some(PlanePolicy::Axis(2)),
+            PlaneArg::Height => Some(PlanePolicy::Height),
         }
     }
 }

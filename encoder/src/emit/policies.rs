@@ -26,8 +26,26 @@ pub struct SplitResiduals {
     /// Optimal mode's second vector (the placement substream); unused in
     /// constrained mode.
     pub second: [i64; 3],
+    /// The z of `first` and `second` under the plane policy `height`
+    /// (format 3.1): the vector's z less the surface prediction, or the
+    /// linear residual's z where no wedge holds the point.
+    pub height: [i64; 2],
     /// The collapse's vertex, for error messages.
     pub id: u32,
+}
+
+impl SplitResiduals {
+    /// The residual vectors the policy codes: the linear residuals, with
+    /// the height residuals' z under `height`.
+    pub fn vectors(&self, policy: PlanePolicy) -> ([i64; 3], [i64; 3]) {
+        match policy {
+            PlanePolicy::Height => (
+                [self.first[0], self.first[1], self.height[0]],
+                [self.second[0], self.second[1], self.height[1]],
+            ),
+            _ => (self.first, self.second),
+        }
+    }
 }
 
 /// A level's residual substreams under one plane policy.
@@ -63,10 +81,11 @@ pub fn code_policies(
             }
             for split in &batch {
                 let plane = Plane::with_normal(*policy, split.normal);
-                residuals.usable &= write_vector(&mut residuals.edge, &plane, split.first, split)?;
+                let (first, second) = split.vectors(*policy);
+                residuals.usable &= write_vector(&mut residuals.edge, &plane, first, split)?;
                 if optimal {
                     residuals.usable &=
-                        write_vector(&mut residuals.placement, &plane, split.second, split)?;
+                        write_vector(&mut residuals.placement, &plane, second, split)?;
                 }
             }
         }
@@ -180,6 +199,7 @@ mod tests {
                 normal: [i % 5 - 2, 7, -(i % 3)],
                 first: [i, -2 * i, 3],
                 second: [1 - i, i % 4, -i],
+                height: [i % 7 - 3, 2 - i],
                 id: i as u32,
             })
             .collect()
@@ -195,7 +215,8 @@ mod tests {
                 (SubstreamWriter::default(), SubstreamWriter::default());
             for s in &splits {
                 let plane = Plane::with_normal(*policy, s.normal);
-                for (w, r) in [(&mut edge, s.first), (&mut placement, s.second)] {
+                let (first, second) = s.vectors(*policy);
+                for (w, r) in [(&mut edge, first), (&mut placement, second)] {
                     let c = plane.encode(r);
                     for axis in plane.order() {
                         w.signed_in(plane.context(axis), c[axis] as i32);

@@ -10,7 +10,7 @@ use splitstream_decoder_core::writer::{
 use splitstream_decoder_core::{
     CornerRefs, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource, Ring,
     SplitOutcome, SplitRecord, StateMemory, Target, add_residual, arc_means, constrained_positions,
-    context, predict, residual,
+    context, predict, residual, residual_of_vector,
 };
 
 use std::sync::mpsc;
@@ -222,7 +222,7 @@ impl RecordSource for StepSource<'_> {
         let (origin, p_wide, c_wide) = (wide(parent), wide(p), wide(c));
         let mode = self.mode;
         let consistent;
-        let (first, second) = match mode {
+        let (first, second, height) = match mode {
             PositionMode::Optimal => {
                 let p_hat = predict(&means, mode, Target::P);
                 let c_hat = predict(&means, mode, Target::C);
@@ -232,7 +232,11 @@ impl RecordSource for StepSource<'_> {
                 // plane policy's coding is checked to give them back).
                 consistent = add(origin, add_residual(p_hat, rs)) == p_wide
                     && add(origin, add_residual(c_hat, rt)) == c_wide;
-                (rs, rt)
+                let height = [
+                    height_residual(state, parent, ring, Target::P, p_hat, sub(p_wide, origin)),
+                    height_residual(state, parent, ring, Target::C, c_hat, sub(c_wide, origin)),
+                ];
+                (rs, rt, height)
             }
             PositionMode::Constrained => {
                 let e = sub(c_wide, p_wide);
@@ -254,13 +258,15 @@ impl RecordSource for StepSource<'_> {
                 let r = residual(x, prediction);
                 consistent = constrained_positions(parent, code, add_residual(prediction, r))
                     == (p_wide, c_wide);
-                (r, [0; 3])
+                let height = height_residual(state, parent, ring, target, prediction, x);
+                (r, [0; 3], [height, 0])
             }
         };
         self.residuals.push(SplitResiduals {
             normal: Plane::new(PlanePolicy::Dominant, &means).normal,
             first,
             second,
+            height,
             id,
         });
         if !consistent {
@@ -293,6 +299,28 @@ impl RecordSource for StepSource<'_> {
             self.dec2enc.push(new);
         }
     }
+}
+
+/// The z of the residual of vector `x` under the plane policy `height`
+/// (SPEC §7.4, format 3.1).
+fn height_residual(
+    state: &MeshState<'_>,
+    parent: [u32; 3],
+    ring: &Ring,
+    target: Target,
+    prediction: [i64; 3],
+    x: [i64; 3],
+) -> i64 {
+    let policy = PlanePolicy::Height;
+    residual_of_vector(
+        policy,
+        state.positions(),
+        parent,
+        ring,
+        target,
+        prediction,
+        x,
+    )[2]
 }
 
 /// A level's payload and its framed bytes with its largest chunk
