@@ -2,10 +2,11 @@
 //! the choice of the cheapest.
 //!
 //! The replay records each split's residual vectors once, with the split's
-//! plane normal; coding them under the five policies runs on another thread,
-//! batch by batch while the replay goes on, so that it stays off the
-//! replay's critical path. The values written are the same as if each split
-//! had been coded five ways on the spot.
+//! plane normal and its height residuals (format 3.1); coding them under
+//! the six policies runs on another thread, batch by batch while the replay
+//! goes on, so that it stays off the replay's critical path. The values
+//! written are the same as if each split had been coded six ways on the
+//! spot.
 
 use std::sync::mpsc::Receiver;
 

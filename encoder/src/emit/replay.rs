@@ -111,6 +111,9 @@ struct StepSource<'a> {
     /// another thread (`policies`).
     residuals: &'a mut Vec<SplitResiduals>,
     mode: PositionMode,
+    /// Whether the policy `height` may be chosen: only then are the
+    /// height residuals worth computing (a surface search per vector).
+    heights: bool,
     pending: Option<usize>,
     /// Whether the pending split gives the collapse's C index R (SPEC §7.4).
     swapped: bool,
@@ -232,10 +235,14 @@ impl RecordSource for StepSource<'_> {
                 // plane policy's coding is checked to give them back).
                 consistent = add(origin, add_residual(p_hat, rs)) == p_wide
                     && add(origin, add_residual(c_hat, rt)) == c_wide;
-                let height = [
-                    height_residual(state, parent, ring, Target::P, p_hat, sub(p_wide, origin)),
-                    height_residual(state, parent, ring, Target::C, c_hat, sub(c_wide, origin)),
-                ];
+                let height = if self.heights {
+                    [
+                        height_residual(state, parent, ring, Target::P, p_hat, sub(p_wide, origin)),
+                        height_residual(state, parent, ring, Target::C, c_hat, sub(c_wide, origin)),
+                    ]
+                } else {
+                    [0; 2]
+                };
                 (rs, rt, height)
             }
             PositionMode::Constrained => {
@@ -258,7 +265,11 @@ impl RecordSource for StepSource<'_> {
                 let r = residual(x, prediction);
                 consistent = constrained_positions(parent, code, add_residual(prediction, r))
                     == (p_wide, c_wide);
-                let height = height_residual(state, parent, ring, target, prediction, x);
+                let height = if self.heights {
+                    height_residual(state, parent, ring, target, prediction, x)
+                } else {
+                    0
+                };
                 (r, [0; 3], [height, 0])
             }
         };
@@ -391,7 +402,7 @@ pub fn replay(
     let mut current = vec![NONE; n];
     let mut flagged = Vec::new();
     let mut ring = Ring::default();
-    // A level's residuals are coded under the five plane policies on one
+    // A level's residuals are coded under the six plane policies on one
     // thread while the level replays; choosing the policy and framing the
     // level run on another while the next level replays (same bytes: the
     // replay itself is sequential).
@@ -422,6 +433,7 @@ pub fn replay(
                     subs: &mut subs,
                     residuals: &mut residuals,
                     mode,
+                    heights: plane.is_none_or(|p| p == PlanePolicy::Height),
                     pending: None,
                     swapped: false,
                     problem: None,
@@ -553,6 +565,7 @@ mod tests {
             subs: &mut subs,
             residuals: &mut residuals,
             mode: PositionMode::Optimal,
+            heights: true,
             pending: None,
             swapped: false,
             problem: None,
