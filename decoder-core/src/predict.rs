@@ -344,22 +344,45 @@ pub fn surface_height(
     ring: &Ring,
     y: [i64; 2],
 ) -> Option<i64> {
+    // With |y_i| <= 2^31 every cross product with an entry (|e_i| < 2^31)
+    // is below 2^63: 64-bit arithmetic, the common case; 128 bits beyond.
+    if y.iter().all(|c| c.unsigned_abs() <= 1 << 31) {
+        surface_search(positions, parent, ring, |e| e[0] * y[1] - e[1] * y[0])
+    } else {
+        let (y0, y1) = (y[0] as i128, y[1] as i128);
+        surface_search(positions, parent, ring, |e| {
+            e[0] as i128 * y1 - e[1] as i128 * y0
+        })
+    }
+}
+
+/// The wedge search of [`surface_height`], with `cross(e)` = `e × y` (xy)
+/// in a type wide enough for it: wedge i's `t` is `r_i × y` and its `s`,
+/// `y × r_{i+1}`, is minus the next entry's, so one product per entry.
+#[inline(always)]
+fn surface_search<T>(
+    positions: &[[u32; 3]],
+    parent: [u32; 3],
+    ring: &Ring,
+    cross: impl Fn([i64; 3]) -> T,
+) -> Option<i64>
+where
+    T: Copy + Default + PartialOrd + core::ops::Neg<Output = T> + Into<i128>,
+{
     let vertices = ring.vertices();
     let k = vertices.len();
     let origin = parent.map(|x| x as i64);
     // Entries relative to R (|x| < 2^31); the ghost has no position.
-    let relative = |v: u32| -> Option<[i64; 3]> {
+    let with_cross = |v: u32| -> Option<([i64; 3], T)> {
         let p = positions.get(v as usize)?;
-        Some([
+        let e = [
             p[0] as i64 - origin[0],
             p[1] as i64 - origin[1],
             p[2] as i64 - origin[2],
-        ])
+        ];
+        Some((e, cross(e)))
     };
-    let (y0, y1) = (y[0] as i128, y[1] as i128);
-    // `e × y` for each entry e: wedge i's `t` is `r_i × y` and its `s`,
-    // `y × r_{i+1}`, is minus the next entry's, so one product per entry.
-    let with_cross = |v: u32| relative(v).map(|e| (e, e[0] as i128 * y1 - e[1] as i128 * y0));
+    let zero = T::default();
     let mut a = with_cross(*vertices.first()?);
     for i in 0..k {
         let b = with_cross(vertices[if i + 1 == k { 0 } else { i + 1 }]);
@@ -368,12 +391,12 @@ pub fn surface_height(
             let det = a[0] * b[1] - a[1] * b[0];
             let s = -minus_s;
             let inside = if det > 0 {
-                s >= 0 && t >= 0
+                s >= zero && t >= zero
             } else {
-                det < 0 && s <= 0 && t <= 0
+                det < 0 && s <= zero && t <= zero
             };
             if inside {
-                let z = s * a[2] as i128 + t * b[2] as i128;
+                let z = s.into() * a[2] as i128 + t.into() * b[2] as i128;
                 // Only its value modulo 2^32 matters (the z adds wrap).
                 return Some(round_div_wide(z, det as i128) as i32 as i64);
             }
@@ -753,6 +776,40 @@ mod tests {
             [i32::MIN as i64, i32::MAX as i64, 0],
         );
         assert_eq!(h, h.map(wrap));
+    }
+
+    #[test]
+    fn surface_search_agrees_in_both_widths() {
+        // A pseudo-random fan (xorshift) and points up to 2^31: the 64-bit
+        // and the 128-bit searches give the same height.
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = |m: u64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x % m
+        };
+        for _ in 0..200 {
+            let top = 1u64 << (8 + next(24));
+            let mut positions = [[0u32; 3]; 7];
+            for p in &mut positions {
+                *p = [next(top) as u32, next(top) as u32, next(top) as u32];
+            }
+            let ring = Ring::of_vertices(&[1, 2, 3, 4, 5, 6]);
+            let parent = positions[0];
+            let span = 1i64 << 31;
+            let y = [
+                next(2 * span as u64) as i64 - span,
+                next(2 * span as u64) as i64 - span,
+            ];
+            let narrow = surface_search(&positions, parent, &ring, |e| e[0] * y[1] - e[1] * y[0]);
+            let (y0, y1) = (y[0] as i128, y[1] as i128);
+            let wide = surface_search(&positions, parent, &ring, |e| {
+                e[0] as i128 * y1 - e[1] as i128 * y0
+            });
+            assert_eq!(narrow, wide, "{positions:?} {y:?}");
+            assert_eq!(surface_height(&positions, parent, &ring, y), wide);
+        }
     }
 
     #[test]
