@@ -243,3 +243,42 @@ fn faults(ctx: &Device) {
     assert_eq!(&s.deficits[..2], &[0, 0]);
     check_adjacency(&s.corners, &s.opposite, &s.vertex_corner).expect("adjacency");
 }
+
+/// A stream too large for the device's buffer limits gets a typed
+/// `TooLarge` error naming the buffer, not a validation panic (a 4M-vertex
+/// terrain's split records exceed lavapipe's 128 MiB binding limit).
+#[cfg(feature = "wgpu")]
+#[test]
+fn buffers_over_the_device_limits_are_a_typed_error() {
+    use splitstream_kernels::decode::host::RefineError;
+    use splitstream_kernels::decode::refine::Refiner;
+    for device in devices() {
+        #[allow(irrefutable_let_patterns)]
+        let Device::Wgpu(ctx) = device else { continue };
+        let deficits = [LEAF as u8; 6];
+        let base = BaseMesh {
+            positions: &POSITIONS,
+            triangles: &OCTAHEDRON,
+            deficits: &deficits,
+            bits: 8,
+        };
+        // 16 M vertices (the most one dispatch grid takes): 768 MB of split
+        // records, over lavapipe's 128 MiB; a device that binds that much
+        // creates the buffers instead.
+        let vertices = 16_000_000u32;
+        let needed = 48 * vertices as u64;
+        let limit = ctx
+            .limits
+            .max_storage_buffer_binding_size
+            .min(ctx.limits.max_buffer_size);
+        match Refiner::new(&ctx, base, vertices, 2 * vertices) {
+            Err(RefineError::Gpu(GpuError::TooLarge {
+                what, bytes, limit, ..
+            })) => {
+                assert!(bytes > limit, "{what}: {bytes} <= {limit}");
+            }
+            Err(e) => panic!("expected TooLarge, got {e}"),
+            Ok(_) => assert!(needed <= limit, "{needed} bytes of records over {limit}"),
+        }
+    }
+}

@@ -169,9 +169,16 @@ fn gpu_decoder(sides: &[usize], require_gpu: bool) -> CliResult {
         let encoded = encode(&mesh, &EncodeOptions::default(), |_| {})
             .map_err(|e| format!("terrain {side}: {e}"))?;
         let stream = &encoded.stream;
-        verify(&ctx, stream, false)
-            .result
-            .map_err(|e| format!("GPU decoder, terrain {side}: {e}"))?;
+        match verify(&ctx, stream, false).result {
+            Err(e) if e.is_too_large() => {
+                println!(
+                    "| {side}x{side} | {} | | | | | | | | does not fit this device: {e} |",
+                    encoded.permutation.len()
+                );
+                continue;
+            }
+            result => result.map_err(|e| format!("GPU decoder, terrain {side}: {e}"))?,
+        }
         let r = bench(&ctx, stream, 3).map_err(|e| format!("GPU decoder, terrain {side}: {e}"))?;
         println!(
             "| {side}x{side} | {} | {} | {} | {:.1} | {:.0} | {:.1} | {:.0} | {:.1} | {:.2}x |",

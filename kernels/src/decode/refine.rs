@@ -17,7 +17,7 @@ use super::host::{check_base, check_round, position_limit};
 use super::layout::*;
 use super::schedule::{Entry, round_schedule, scan_words};
 use super::sources::DecodeModule;
-use crate::gpu::{Api, WgpuContext};
+use crate::gpu::{Api, GpuError, WgpuContext};
 
 fn kernel_error(detail: impl ToString) -> RefineError {
     super::host::kernel_error(Api::Wgpu, detail)
@@ -120,6 +120,34 @@ impl<'c> Refiner<'c> {
         };
         let vcap = vertex_capacity as u64;
         let tcap = triangle_capacity as u64;
+        // Each buffer is bound whole: it must fit the device's binding limit
+        // (lavapipe: 128 MiB, so about 2.8 M splits of records), or creating
+        // the bind group fails validation.
+        let limit = ctx
+            .limits
+            .max_storage_buffer_binding_size
+            .min(ctx.limits.max_buffer_size);
+        for (what, bytes) in [
+            ("the positions buffer", 12 * vcap),
+            ("the corner buffers", 12 * tcap),
+            ("the split records buffer", 48 * split_capacity as u64),
+            (
+                "the splits buffer",
+                4 * SPLIT_WORDS as u64 * split_capacity as u64,
+            ),
+            ("the candidates buffer", 4 * sort_capacity as u64),
+            ("the scan buffer", 4 * scan_words(scan_len)),
+        ] {
+            if bytes > limit {
+                return Err(GpuError::TooLarge {
+                    api: Api::Wgpu,
+                    what,
+                    bytes,
+                    limit,
+                }
+                .into());
+            }
+        }
         let corners: Vec<u32> = base.triangles.iter().flatten().copied().collect();
         let deficits: Vec<u32> = base.deficits.iter().map(|&d| d as u32).collect();
         let counts: [u32; COUNT_WORDS] = [v0, t0, 0, NONE];

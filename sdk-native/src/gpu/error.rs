@@ -42,6 +42,15 @@ impl GpuDecodeError {
     pub fn is_unavailable(&self) -> bool {
         matches!(self, GpuDecodeError::Device(RefineError::Gpu(e)) if e.is_unavailable())
     }
+
+    /// Whether the stream's mesh is too large for the device's buffer
+    /// limits (a capacity of this device, not a fault of the stream).
+    pub fn is_too_large(&self) -> bool {
+        matches!(
+            self,
+            GpuDecodeError::Device(RefineError::Gpu(GpuError::TooLarge { .. }))
+        )
+    }
 }
 
 impl core::fmt::Display for GpuDecodeError {
