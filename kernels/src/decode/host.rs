@@ -156,7 +156,34 @@ pub fn check_round(
     Ok(())
 }
 
+/// The most splits one round can hold, the room of the per-round record
+/// and split buffers: a round of `s` splits starts with `n >= s` vertices
+/// (the flagged ones are distinct) and ends with `n + s <= vertex_capacity`,
+/// so `s <= vertex_capacity / 2`; and `s <= vertex_capacity - v0`.
+pub fn round_split_capacity(vertex_capacity: u32, v0: u32) -> u32 {
+    (vertex_capacity / 2)
+        .min(vertex_capacity.saturating_sub(v0))
+        .max(1)
+}
+
 /// 2^bits, or 0 when every u32 is a valid coordinate.
 pub fn position_limit(bits: u8) -> u32 {
     if bits >= 32 { 0 } else { 1u32 << bits }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_split_capacity;
+
+    #[test]
+    fn a_round_holds_at_most_half_the_capacity() {
+        // 4M vertices from a 16-vertex seed: 2,097,152 splits a round at
+        // most (48-byte records: 100 MB, under lavapipe's 128 MiB binding).
+        assert_eq!(round_split_capacity(4_194_304, 16), 2_097_152);
+        // A seed of most of the vertices: the splits left bound it.
+        assert_eq!(round_split_capacity(10, 8), 2);
+        assert_eq!(round_split_capacity(10, 10), 1);
+        assert_eq!(round_split_capacity(1, 1), 1);
+        assert_eq!(round_split_capacity(u32::MAX, 0), u32::MAX / 2);
+    }
 }

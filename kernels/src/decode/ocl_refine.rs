@@ -5,7 +5,7 @@
 
 use super::adjacency::build_adjacency;
 pub use super::host::{BaseMesh, RefineError, RoundInput, Snapshot};
-use super::host::{check_base, check_round, position_limit};
+use super::host::{check_base, check_round, position_limit, round_split_capacity};
 use super::layout::*;
 use super::schedule::{Entry, round_schedule, scan_words};
 use super::sources::opencl_program;
@@ -61,7 +61,7 @@ impl<'c> OclRefiner<'c> {
         let t0 = base.triangles.len() as u32;
         let (opposite, vertex_corner) =
             build_adjacency(base.triangles, v0).map_err(RefineError::Base)?;
-        let split_capacity = vertex_capacity.saturating_sub(v0).max(1);
+        let split_capacity = round_split_capacity(vertex_capacity, v0);
         let sort_capacity = vertex_capacity.max(WORKGROUP).next_power_of_two();
         let scan_len = vertex_capacity.max(1);
         let (vcap, tcap) = (vertex_capacity as usize, triangle_capacity as usize);
