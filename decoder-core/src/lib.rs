@@ -64,8 +64,8 @@ pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader};
 pub use level_table::{LevelInfo, LevelTable, head_len, write_level_table};
 pub use predict::{
-    ArcMeans, Plane, PlanePolicy, Target, add_residual, arc_means, constrained_positions,
-    height_prediction, predict, residual, residual_of_vector, surface_height, vector_of_residual,
+    ArcMeans, Plane, PlanePolicy, SplitFan, Target, add_residual, arc_means, constrained_positions,
+    height_prediction, predict, residual, surface_height,
 };
 pub use rans::token_of;
 pub use ring::Ring;

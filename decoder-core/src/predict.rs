@@ -253,49 +253,62 @@ pub fn constrained_positions(parent: [u32; 3], code: u8, x: [i64; 3]) -> ([i64; 
     }
 }
 
-/// The vector a residual decodes to (SPEC §7.4): `prediction + r` modulo
-/// 2^32, with, under the plane policy `height`, the z of the surface
-/// prediction plus `r`'s z where a wedge of R's fan holds the point. `r` is
-/// the residual after the plane's offset ([`Plane::decode`]).
-#[inline]
-pub fn vector_of_residual(
-    policy: PlanePolicy,
-    positions: &[[u32; 3]],
-    parent: [u32; 3],
-    ring: &Ring,
-    target: Target,
-    prediction: [i64; 3],
-    r: [i64; 3],
-) -> [i64; 3] {
-    let mut x = add_residual(prediction, r);
-    if policy == PlanePolicy::Height
-        && let Some(h) = height_prediction(positions, parent, ring, target, x)
-    {
-        x[2] = wrap(h + r[2]);
-    }
-    x
+/// What a split's vectors are predicted from besides the arc means: the
+/// positions, R's position (`parent`) and R's ring (SPEC §7.4).
+#[derive(Clone, Copy)]
+pub struct SplitFan<'a> {
+    pub positions: &'a [[u32; 3]],
+    pub parent: [u32; 3],
+    pub ring: &'a Ring,
 }
 
-/// The residual an encoder codes for the vector `x` (every component below
-/// 2^31 in magnitude), before the plane's offset ([`Plane::encode`]): the
-/// inverse of [`vector_of_residual`].
-#[inline]
-pub fn residual_of_vector(
-    policy: PlanePolicy,
-    positions: &[[u32; 3]],
-    parent: [u32; 3],
-    ring: &Ring,
-    target: Target,
-    prediction: [i64; 3],
-    x: [i64; 3],
-) -> [i64; 3] {
-    let mut r = residual(x, prediction);
-    if policy == PlanePolicy::Height
-        && let Some(h) = height_prediction(positions, parent, ring, target, x)
-    {
-        r[2] = wrap(x[2] - h);
+impl SplitFan<'_> {
+    /// The vector a residual decodes to (SPEC §7.4 `vector`): `prediction +
+    /// r` modulo 2^32, with, under the plane policy `height`, the z of the
+    /// surface prediction plus `r`'s z where a wedge of R's fan holds the
+    /// point. `r` is the residual after the plane's offset ([`Plane::decode`]).
+    #[inline]
+    pub fn vector(
+        &self,
+        policy: PlanePolicy,
+        target: Target,
+        prediction: [i64; 3],
+        r: [i64; 3],
+    ) -> [i64; 3] {
+        let mut x = add_residual(prediction, r);
+        if let Some(h) = self.height_under(policy, target, x) {
+            x[2] = wrap(h + r[2]);
+        }
+        x
     }
-    r
+
+    /// The residual an encoder codes for the vector `x` (every component
+    /// below 2^31 in magnitude), before the plane's offset
+    /// ([`Plane::encode`]): the inverse of [`SplitFan::vector`].
+    #[inline]
+    pub fn residual(
+        &self,
+        policy: PlanePolicy,
+        target: Target,
+        prediction: [i64; 3],
+        x: [i64; 3],
+    ) -> [i64; 3] {
+        let mut r = residual(x, prediction);
+        if let Some(h) = self.height_under(policy, target, x) {
+            r[2] = wrap(x[2] - h);
+        }
+        r
+    }
+
+    /// The height prediction of `x`'s z under `policy`: only under
+    /// `height`, and only where a wedge holds the point.
+    #[inline]
+    fn height_under(&self, policy: PlanePolicy, target: Target, x: [i64; 3]) -> Option<i64> {
+        if policy != PlanePolicy::Height {
+            return None;
+        }
+        height_prediction(self.positions, self.parent, self.ring, target, x)
+    }
 }
 
 /// The height policy's prediction of a vector's z (SPEC §7.4, format 3.1):
@@ -836,7 +849,11 @@ mod tests {
     #[test]
     fn height_residuals_invert() {
         let (positions, ring) = plane_fan();
-        let parent = positions[0];
+        let fan = SplitFan {
+            positions: &positions,
+            parent: positions[0],
+            ring: &ring,
+        };
         let policy = PlanePolicy::Height;
         for target in [Target::P, Target::C, Target::Edge] {
             for x in [
@@ -846,23 +863,16 @@ mod tests {
                 [i32::MAX as i64, -3, i32::MIN as i64],
             ] {
                 let prediction = [1, -1, 5];
-                let r =
-                    residual_of_vector(policy, &positions, parent, &ring, target, prediction, x);
-                let back =
-                    vector_of_residual(policy, &positions, parent, &ring, target, prediction, r);
+                let r = fan.residual(policy, target, prediction, x);
+                let back = fan.vector(policy, target, prediction, r);
                 assert_eq!(back, x.map(wrap), "{target:?} {x:?}");
+                // Under any other policy, the plain linear residual.
+                let off = fan.residual(PlanePolicy::Off, target, prediction, x);
+                assert_eq!(off, residual(x, prediction));
             }
         }
         // On the plane the height residual of an exact vector is 0.
-        let r = residual_of_vector(
-            policy,
-            &positions,
-            parent,
-            &ring,
-            Target::C,
-            [0; 3],
-            [2, 1, 4],
-        );
+        let r = fan.residual(policy, Target::C, [0; 3], [2, 1, 4]);
         assert_eq!(r, [2, 1, 0]);
     }
 

@@ -5,7 +5,7 @@ use crate::context::{self, SINGLE};
 use crate::header::PositionMode;
 use crate::limits::substream::{self, SLOTS};
 use crate::predict::{
-    Plane, PlanePolicy, Target, arc_means, constrained_positions, predict, vector_of_residual,
+    Plane, PlanePolicy, SplitFan, Target, arc_means, constrained_positions, predict,
 };
 use crate::ring::Ring;
 use crate::round::{RecordSource, all_ones};
@@ -96,14 +96,18 @@ impl RecordSource for StreamSource<'_, '_, '_> {
         let plane = Plane::new(self.plane, &means);
         let origin = parent.map(|x| x as i64);
         let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|i| a[i] + b[i]) };
+        let fan = SplitFan {
+            positions,
+            parent,
+            ring,
+        };
         let (p, c) = match self.mode {
             PositionMode::Constrained => {
                 let code = s.byte(slot(substream::PLACEMENT), context::placement(&means))?;
                 let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
                 let prediction = predict(&means, self.mode, target);
                 let r = read_vector(s, slot(substream::EDGE), &plane)?;
-                let x =
-                    vector_of_residual(self.plane, positions, parent, ring, target, prediction, r);
+                let x = fan.vector(self.plane, target, prediction, r);
                 constrained_positions(parent, code, x)
             }
             PositionMode::Optimal => {
@@ -111,24 +115,8 @@ impl RecordSource for StreamSource<'_, '_, '_> {
                 let c_hat = predict(&means, self.mode, Target::C);
                 let s_vec = read_vector(s, slot(substream::EDGE), &plane)?;
                 let t_vec = read_vector(s, slot(substream::PLACEMENT), &plane)?;
-                let p = vector_of_residual(
-                    self.plane,
-                    positions,
-                    parent,
-                    ring,
-                    Target::P,
-                    p_hat,
-                    s_vec,
-                );
-                let c = vector_of_residual(
-                    self.plane,
-                    positions,
-                    parent,
-                    ring,
-                    Target::C,
-                    c_hat,
-                    t_vec,
-                );
+                let p = fan.vector(self.plane, Target::P, p_hat, s_vec);
+                let c = fan.vector(self.plane, Target::C, c_hat, t_vec);
                 (add(origin, p), add(origin, c))
             }
         };

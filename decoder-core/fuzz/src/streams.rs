@@ -29,8 +29,8 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Decoder, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane, PlanePolicy,
-    PositionMode, RecordSource, Ring, SplitRecord, Target, arc_means, constrained_positions,
-    context, predict, residual_of_vector, vector_of_residual, workspace_len,
+    PositionMode, RecordSource, Ring, SplitFan, SplitRecord, Target, arc_means,
+    constrained_positions, context, predict, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -321,21 +321,19 @@ impl RecordSource for GenSource<'_, '_> {
                 }
                 let p_hat = predict(&means, self.mode, Target::P);
                 let c_hat = predict(&means, self.mode, Target::C);
-                let positions = state.positions();
-                let policy = self.plane;
-                let code = |target, hat, x| {
-                    plane.encode(residual_of_vector(
-                        policy, positions, parent, ring, target, hat, x,
-                    ))
+                let fan = SplitFan {
+                    positions: state.positions(),
+                    parent,
+                    ring,
                 };
+                let policy = self.plane;
+                let code = |target, hat, x| plane.encode(fan.residual(policy, target, hat, x));
                 let cs = code(Target::P, p_hat, sub(p, parent64));
                 let ct = code(Target::C, c_hat, sub(q, parent64));
                 write(&mut self.subs[5], cs);
                 write(&mut self.subs[6], ct);
-                let decode = |target, hat, coded| {
-                    let r = plane.decode(coded);
-                    vector_of_residual(policy, positions, parent, ring, target, hat, r)
-                };
+                let decode =
+                    |target, hat, coded| fan.vector(policy, target, hat, plane.decode(coded));
                 (
                     add(parent64, decode(Target::P, p_hat, cs)),
                     add(parent64, decode(Target::C, c_hat, ct)),
@@ -367,14 +365,16 @@ impl RecordSource for GenSource<'_, '_> {
                     edge = [0; 3];
                 }
                 let prediction = predict(&means, self.mode, target);
-                let (positions, policy) = (state.positions(), self.plane);
-                let x = vector(code, &edge);
-                let coded = plane.encode(residual_of_vector(
-                    policy, positions, parent, ring, target, prediction, x,
-                ));
+                let fan = SplitFan {
+                    positions: state.positions(),
+                    parent,
+                    ring,
+                };
+                let policy = self.plane;
+                let coded =
+                    plane.encode(fan.residual(policy, target, prediction, vector(code, &edge)));
                 write(&mut self.subs[5], coded);
-                let r = plane.decode(coded);
-                let x = vector_of_residual(policy, positions, parent, ring, target, prediction, r);
+                let x = fan.vector(policy, target, prediction, plane.decode(coded));
                 constrained_positions(parent, code, x)
             }
         };

@@ -8,9 +8,9 @@ use splitstream_decoder_core::writer::{
     Chunk, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level_with,
 };
 use splitstream_decoder_core::{
-    CornerRefs, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource, Ring,
+    CornerRefs, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource, Ring, SplitFan,
     SplitOutcome, SplitRecord, StateMemory, Target, add_residual, arc_means, constrained_positions,
-    context, predict, residual, residual_of_vector,
+    context, predict, residual,
 };
 
 use std::sync::mpsc;
@@ -322,16 +322,12 @@ fn height_residual(
     prediction: [i64; 3],
     x: [i64; 3],
 ) -> i64 {
-    let policy = PlanePolicy::Height;
-    residual_of_vector(
-        policy,
-        state.positions(),
+    let fan = SplitFan {
+        positions: state.positions(),
         parent,
         ring,
-        target,
-        prediction,
-        x,
-    )[2]
+    };
+    fan.residual(PlanePolicy::Height, target, prediction, x)[2]
 }
 
 /// A level's payload and its framed bytes with its largest chunk
