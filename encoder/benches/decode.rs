@@ -7,7 +7,7 @@
 use std::path::PathBuf;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use splitstream_decoder_core::limits::VERSION_MAJOR;
+use splitstream_decoder_core::limits::{VERSION_MAJOR, VERSION_MINOR};
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::emit::{EncodeOptions, encode};
@@ -17,7 +17,9 @@ const SIDE: usize = 1000;
 
 fn terrain_stream(name: &str, codec: ChunkCodec) -> Vec<u8> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/bench-data");
-    let path = dir.join(format!("terrain-{SIDE}-v{VERSION_MAJOR}-{name}.sps"));
+    let path = dir.join(format!(
+        "terrain-{SIDE}-v{VERSION_MAJOR}.{VERSION_MINOR}-{name}.sps"
+    ));
     if let Ok(bytes) = std::fs::read(&path) {
         return bytes;
     }
