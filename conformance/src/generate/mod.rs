@@ -576,6 +576,16 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
         (PositionMode::Optimal, "optimal"),
         (PositionMode::Constrained, "constrained"),
     ] {
+        // rANS on the whole 31-bit grid (every axis, a raster's too), with
+        // the plane policy `plane` or, without one, chosen per level.
+        let wide_rans = |plane: Option<PlanePolicy>| EncodeOptions {
+            position_mode: mode,
+            bits: 31,
+            codec: ChunkCodec::RansAlways { lanes: 2 },
+            plane,
+            lattice: Some(Lattice::Ignore),
+            ..opts()
+        };
         for (mesh, name) in [(&sphere3, "icosphere"), (&terrain, "terrain")] {
             s.valid(
                 &format!("bits-31-{name}-{what}"),
@@ -583,17 +593,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
                     "{name}, {what} positions, 31 bits per axis (the largest grid), rANS, plane policy chosen per level."
                 ),
                 &["encoded", "bits-31", "rans"],
-                encoded(
-                    mesh,
-                    EncodeOptions {
-                        position_mode: mode,
-                        bits: 31,
-                        codec: ChunkCodec::RansAlways { lanes: 2 },
-                        // Every axis on the 31-bit grid, a raster's too.
-                        lattice: Some(Lattice::Ignore),
-                        ..opts()
-                    },
-                ),
+                encoded(mesh, wide_rans(None)),
             );
         }
         s.valid(
@@ -640,17 +640,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
                     "{name}, {what} positions, 31 bits per axis, plane policy `height` (3.1) in every level: z predicted from the surface of R's fan, modulo 2^32 (SPEC §7.4)."
                 ),
                 &["encoded", "bits-31", "plane-policy", "height", "wrapped-residuals"],
-                encoded(
-                    mesh,
-                    EncodeOptions {
-                        position_mode: mode,
-                        bits: 31,
-                        codec: ChunkCodec::RansAlways { lanes: 2 },
-                        plane: Some(PlanePolicy::Height),
-                        lattice: Some(Lattice::Ignore),
-                        ..opts()
-                    },
-                ),
+                encoded(mesh, wide_rans(Some(PlanePolicy::Height))),
             );
         }
         s.valid(
