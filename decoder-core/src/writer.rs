@@ -27,6 +27,17 @@ pub struct SubstreamWriter {
 }
 
 impl SubstreamWriter {
+    /// An empty substream with room for `values` values of `bytes` bytes
+    /// in all (an encoder that knows a level's split count saves the
+    /// copies of growing its substreams).
+    pub fn with_capacity(values: usize, bytes: usize) -> SubstreamWriter {
+        SubstreamWriter {
+            bytes: Vec::with_capacity(bytes),
+            bit_count: 0,
+            symbols: Vec::with_capacity(values),
+        }
+    }
+
     pub fn byte(&mut self, b: u8) {
         self.byte_in(0, b);
     }

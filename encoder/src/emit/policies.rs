@@ -59,22 +59,36 @@ pub struct PolicyResiduals {
     pub usable: bool,
 }
 
-/// Codes the batches arriving on `batches` (a level's splits in split
-/// order) under every policy, or only `forced`; returns the substreams in
-/// `PlanePolicy::ALL` order (unused policies stay empty and unusable).
+/// Codes the batches arriving on `batches` (a level's `splits` splits in
+/// split order) under every policy, or only `forced`; returns the
+/// substreams in `PlanePolicy::ALL` order (unused policies stay empty and
+/// unusable).
 pub fn code_policies(
     batches: Receiver<Vec<SplitResiduals>>,
     mode: PositionMode,
     forced: Option<PlanePolicy>,
+    splits: usize,
 ) -> Result<Vec<PolicyResiduals>, String> {
+    let optimal = mode == PositionMode::Optimal;
+    // Room for every value from the start: growing six policies' vectors
+    // by doubling copied and faulted in about a quarter of the encoder's
+    // fresh pages on the 1M terrain. A residual's varint is mostly 1 or 2
+    // bytes.
+    let writer = |used: bool, vectors: usize| {
+        let values = if used { 3 * vectors * splits } else { 0 };
+        SubstreamWriter::with_capacity(values, 2 * values)
+    };
     let mut out: Vec<PolicyResiduals> = PlanePolicy::ALL
         .iter()
-        .map(|&p| PolicyResiduals {
-            usable: forced.is_none_or(|f| f == p),
-            ..PolicyResiduals::default()
+        .map(|&p| {
+            let used = forced.is_none_or(|f| f == p);
+            PolicyResiduals {
+                usable: used,
+                edge: writer(used, 1),
+                placement: writer(used && optimal, 1),
+            }
         })
         .collect();
-    let optimal = mode == PositionMode::Optimal;
     for batch in batches {
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(out.iter_mut()) {
             if forced.is_some_and(|f| f != *policy) {
@@ -209,7 +223,8 @@ mod tests {
     #[test]
     fn every_policy_codes_what_coding_each_split_on_the_spot_gives() {
         let splits = splits();
-        let coded = code_policies(batches(&splits), PositionMode::Optimal, None).unwrap();
+        let coded =
+            code_policies(batches(&splits), PositionMode::Optimal, None, splits.len()).unwrap();
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(&coded) {
             assert!(residuals.usable);
             let (mut edge, mut placement) =
@@ -233,8 +248,13 @@ mod tests {
     #[test]
     fn a_forced_policy_is_the_only_one_coded() {
         let forced = PlanePolicy::ALL[2];
-        let coded =
-            code_policies(batches(&splits()), PositionMode::Constrained, Some(forced)).unwrap();
+        let coded = code_policies(
+            batches(&splits()),
+            PositionMode::Constrained,
+            Some(forced),
+            40,
+        )
+        .unwrap();
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(&coded) {
             assert_eq!(residuals.usable, *policy == forced);
             assert_eq!(residuals.edge.as_bytes().is_empty(), *policy != forced);

@@ -410,11 +410,13 @@ pub fn replay(
             // The level's residuals go round by round to a thread that
             // codes them under every plane policy.
             let (batches, coded_batches) = mpsc::channel();
-            let coder = scope.spawn(move || code_policies(coded_batches, mode, plane));
+            let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
+            let coder = scope.spawn(move || code_policies(coded_batches, mode, plane, splits));
             let mut residuals = Vec::new();
             let mut round_splits = Vec::with_capacity(steps.len());
             for &k in steps {
                 let collapses = &s.steps[k];
+                residuals.reserve_exact(collapses.len());
                 flagged.clear();
                 for (i, col) in collapses.iter().enumerate() {
                     let r = enc2dec[col.p as usize];
