@@ -135,11 +135,41 @@ impl<'h> LevelTable<'h> {
         }
     }
 
+    /// The coarsest level within `max_error` ([`level_within_error`] over
+    /// this table).
+    pub fn level_within_error(&self, max_error: f32) -> u16 {
+        level_within_error((0..self.count).map(|k| self.get(k)), max_error).unwrap_or(0)
+    }
+
     /// End of the stream: offset just past the last level.
     pub fn stream_len(&self) -> u64 {
         let last = self.get(self.count - 1);
         last.offset + last.length as u64
     }
+}
+
+/// The coarsest level whose geometric error (SPEC §4.1) is at most
+/// `max_error`: the first of `levels`, in level order, with
+/// `geometric_error <= max_error`, or the last level when none is (or when
+/// `max_error` is NaN). A client decodes levels 0 ..= that one to stay
+/// within the bound, for example `max_error` = the model-space size of a
+/// pixel at the object's distance (screen-space error selection). `None`
+/// only for an empty table. The field is the encoder's estimate, in model
+/// units (metres for a DEM encoded with `--geographic`); the format does
+/// not interpret it, so this is a client's choice, not a decoding rule.
+pub fn level_within_error(
+    levels: impl IntoIterator<Item = LevelInfo>,
+    max_error: f32,
+) -> Option<u16> {
+    let mut last = None;
+    for (k, level) in levels.into_iter().enumerate() {
+        let k = u16::try_from(k).ok()?;
+        if level.geometric_error <= max_error {
+            return Some(k);
+        }
+        last = Some(k);
+    }
+    last
 }
 
 /// Serialises a level table (entries then CRC-32) for encoders.
@@ -157,4 +187,42 @@ pub fn write_level_table(entries: &[LevelInfo], out: &mut [u8]) {
     let body = entries.len() * LEVEL_ENTRY_LEN;
     let crc = crc32(&out[..body]);
     out[body..body + 4].copy_from_slice(&crc.to_le_bytes());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn levels(errors: &[f32]) -> impl Iterator<Item = LevelInfo> + '_ {
+        errors.iter().map(|&geometric_error| LevelInfo {
+            offset: 0,
+            length: 0,
+            vertex_count: 0,
+            triangle_count: 0,
+            round_count: 0,
+            geometric_error,
+        })
+    }
+
+    #[test]
+    fn the_coarsest_level_within_the_bound_is_chosen() {
+        let errors = [4.0, 2.0, 1.0, 0.5, 0.0];
+        assert_eq!(level_within_error(levels(&errors), 10.0), Some(0));
+        assert_eq!(level_within_error(levels(&errors), 4.0), Some(0));
+        assert_eq!(level_within_error(levels(&errors), 3.9), Some(1));
+        assert_eq!(level_within_error(levels(&errors), 0.7), Some(3));
+        assert_eq!(level_within_error(levels(&errors), 0.0), Some(4));
+        // Nothing is that exact, or the bound is not a number: the finest.
+        assert_eq!(level_within_error(levels(&errors), -1.0), Some(4));
+        assert_eq!(level_within_error(levels(&errors), f32::NAN), Some(4));
+        assert_eq!(level_within_error(levels(&[]), 1.0), None);
+    }
+
+    #[test]
+    fn an_estimate_that_grows_again_does_not_hide_the_first_level_within() {
+        // Estimates need not fall level by level: the first within wins.
+        let errors = [3.0, 1.0, 2.0, 0.0];
+        assert_eq!(level_within_error(levels(&errors), 1.5), Some(1));
+        assert_eq!(level_within_error(levels(&errors), 2.5), Some(1));
+    }
 }

@@ -62,7 +62,7 @@ pub use header::{Header, PositionMode};
 pub use inflate::Inflater;
 pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader};
-pub use level_table::{LevelInfo, LevelTable, head_len, write_level_table};
+pub use level_table::{LevelInfo, LevelTable, head_len, level_within_error, write_level_table};
 pub use predict::{
     ArcMeans, Plane, PlanePolicy, SplitFan, Target, add_residual, arc_means, constrained_positions,
     height_prediction, predict, residual, surface_height,

@@ -140,6 +140,30 @@ uint16_t ss_decoder_level_count(const SsDecoder *decoder);
 // `decoder` is null or a live handle; `out` is writable.
 SsStatus ss_decoder_level_info(const SsDecoder *decoder, uint16_t level, SsLevelInfo *out);
 
+// The coarsest level whose geometric error (decoder-core SPEC §4.1,
+// model units) is at most `max_error`, the last level when none is, into
+// `*out`: decode levels 0 ..= it.
+//
+// # Safety
+// `decoder` is null or a live handle; `out` is null or writable.
+SsStatus ss_decoder_level_within_error(const SsDecoder *decoder, float max_error, uint16_t *out);
+
+// The coarsest level whose geometric error covers at most `max_pixels`
+// pixels on screen, for a perspective camera with a viewport
+// `viewport_height` pixels high and a vertical field of view of `fov_y`
+// radians, at `distance` model units from the object, into `*out`.
+// Parameters that describe no camera are `SS_STATUS_INVALID_ARGUMENT`,
+// with the reason in `ss_last_error_message`.
+//
+// # Safety
+// `decoder` is null or a live handle; `out` is null or writable.
+SsStatus ss_decoder_level_for_screen_error(const SsDecoder *decoder,
+                                           float viewport_height,
+                                           float fov_y,
+                                           float distance,
+                                           float max_pixels,
+                                           uint16_t *out);
+
 // Bytes of working memory the decoder holds (decoder-core SPEC §9).
 //
 // # Safety

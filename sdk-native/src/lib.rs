@@ -6,6 +6,8 @@
 //! * [`grid_tile`]: a client-side simplifier for regular elevation tiles
 //!   (quad-tree split and merge with edge straightening, after Rishe et al.,
 //!   "Mesh Simplification Algorithm for Online 3D GIS", 2005).
+//! * [`view`]: how many levels a viewer needs, from each level's geometric
+//!   error projected on screen ([`Session::level_for_screen_error`]).
 //! * [`gpu`] (feature `gpu`): the refinement rounds on a wgpu device,
 //!   checked round by round against decoder-core.
 //! * [`ffi`]: the C ABI (header `include/splitstream.h`). `unsafe` code is
@@ -16,5 +18,7 @@ pub mod ffi;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod grid_tile;
+pub mod view;
 
 pub use ffi::Session;
+pub use view::{ScreenView, ViewError};

@@ -142,3 +142,31 @@ fn dropped_half_way_and_misused() {
         "bad-magic"
     );
 }
+
+#[test]
+fn the_level_for_a_screen_error_is_the_coarsest_within_it() {
+    use splitstream_sdk_native::ScreenView;
+    let view = ScreenView::perspective(1080.0, 60f32.to_radians()).unwrap();
+    for (name, stream, _) in valid_vectors(12) {
+        let s = Session::open(&stream).unwrap();
+        let errors: Vec<f32> = (0..s.level_count())
+            .map(|k| s.level_info(k).unwrap().geometric_error)
+            .collect();
+        let mut previous = s.level_count() - 1;
+        for distance in [0.0, 1e-3, 0.1, 1.0, 10.0, 1e3, 1e6, 1e12] {
+            let k = s.level_for_screen_error(&view, distance, 2.0).unwrap();
+            let bound = view.error_for_pixels(2.0, distance).unwrap();
+            assert_eq!(k, s.level_within_error(bound), "{name}");
+            // Coarser levels are all beyond the bound; this one is within
+            // it unless it is the finest.
+            assert!(errors[..k as usize].iter().all(|&e| e > bound), "{name}");
+            assert!(
+                errors[k as usize] <= bound || k + 1 == s.level_count(),
+                "{name}"
+            );
+            // Farther away never needs more levels.
+            assert!(k <= previous, "{name} at {distance}");
+            previous = k;
+        }
+    }
+}

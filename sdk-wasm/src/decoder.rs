@@ -1,7 +1,7 @@
 //! `StreamDecoder`: the progressive decoder for JavaScript.
 
 use splitstream_decoder_core::LevelInfo;
-use splitstream_sdk_native::Session;
+use splitstream_sdk_native::{ScreenView, Session};
 use wasm_bindgen::prelude::*;
 
 use crate::error::SdkError;
@@ -100,6 +100,34 @@ impl StreamDecoder {
     #[wasm_bindgen(js_name = levelGeometricError)]
     pub fn level_geometric_error(&self, level: u16) -> Result<f32, SdkError> {
         Ok(self.info(level)?.geometric_error)
+    }
+
+    /// The coarsest level whose geometric error (model units) is at most
+    /// `maxError`, the last level when none is: decode levels 0 to it.
+    #[wasm_bindgen(js_name = levelWithinError)]
+    pub fn level_within_error(&self, max_error: f32) -> u16 {
+        self.session.level_within_error(max_error)
+    }
+
+    /// The coarsest level whose geometric error covers at most `maxPixels`
+    /// pixels for a perspective camera `viewportHeight` pixels high with a
+    /// vertical field of view of `fovY` radians, at `distance` model units
+    /// from the object: how many levels to fetch and decode for this view.
+    /// Throws `invalid-argument` for parameters that describe no camera.
+    #[wasm_bindgen(js_name = levelForScreenError)]
+    pub fn level_for_screen_error(
+        &self,
+        viewport_height: f32,
+        fov_y: f32,
+        distance: f32,
+        max_pixels: f32,
+    ) -> Result<u16, SdkError> {
+        ScreenView::perspective(viewport_height, fov_y)
+            .and_then(|view| {
+                self.session
+                    .level_for_screen_error(&view, distance, max_pixels)
+            })
+            .map_err(|e| SdkError::argument(e.to_string()))
     }
 
     /// Decodes level `level` whole from exactly its bytes.

@@ -145,6 +145,26 @@ fn misuse_gives_api_misuse_errors() {
 }
 
 #[test]
+fn the_level_for_a_screen_error_follows_the_distance() {
+    let stream = first_valid_multilevel();
+    let d = StreamDecoder::new(&stream).unwrap();
+    let fov = std::f32::consts::FRAC_PI_3;
+    let last = d.level_count() - 1;
+    // Close up, the level within error 0; very far, the base level.
+    assert_eq!(
+        d.level_for_screen_error(1080.0, fov, 0.0, 2.0),
+        Ok(d.level_within_error(0.0))
+    );
+    assert!(d.level_within_error(0.0) <= last);
+    assert_eq!(d.level_for_screen_error(1080.0, fov, 1e30, 2.0), Ok(0));
+    let err = d
+        .level_for_screen_error(1080.0, 4.0, 10.0, 2.0)
+        .unwrap_err();
+    assert_eq!(err.class, "invalid-argument");
+    assert!(err.message.contains("field of view"), "{}", err.message);
+}
+
+#[test]
 fn dropping_mid_level_frees_cleanly() {
     let stream = first_valid_multilevel();
     for rounds in 0..3 {

@@ -20,7 +20,10 @@ use core::ptr::NonNull;
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::{
     Decoder, Error, Header, LevelDecoder, LevelInfo, MeshState, RoundInfo, head_len,
+    level_within_error,
 };
+
+use crate::view::{ScreenView, ViewError};
 
 /// A progressive decoding session: created from the stream head (header and
 /// level table), fed level by level, decoded level by level or round by
@@ -128,6 +131,25 @@ impl Session {
     pub fn level_range(&self, k: u16) -> Option<Range<u64>> {
         self.level_info(k)
             .map(|e| e.offset..e.offset + e.length as u64)
+    }
+
+    /// The coarsest level whose geometric error (SPEC §4.1, model units) is
+    /// at most `max_error`, the last when none is: decode levels 0 ..= it
+    /// (`splitstream_decoder_core::level_within_error`).
+    pub fn level_within_error(&self, max_error: f32) -> u16 {
+        level_within_error(self.levels.iter().copied(), max_error).unwrap_or(0)
+    }
+
+    /// The coarsest level whose geometric error covers at most
+    /// `max_pixels` pixels of `view` at `distance` model units from the
+    /// camera: what a viewer needs to decode for this object now.
+    pub fn level_for_screen_error(
+        &self,
+        view: &ScreenView,
+        distance: f32,
+        max_pixels: f32,
+    ) -> Result<u16, ViewError> {
+        Ok(self.level_within_error(view.error_for_pixels(max_pixels, distance)?))
     }
 
     /// Bytes of working memory the session holds (SPEC §9, with alignment).

@@ -56,6 +56,15 @@ static int decode(const char *path) {
         free(stream);
         return fail();
     }
+    /* How many levels a viewer 500 units away needs (2 pixels, 1080 p,
+       60 degrees); a field of view of 4 radians is no camera. */
+    uint16_t needed = 0;
+    if (ss_decoder_level_for_screen_error(d, 1080.0f, 1.0472f, 500.0f, 2.0f, &needed) != SS_STATUS_OK)
+        goto failed;
+    if (ss_decoder_level_for_screen_error(d, 1080.0f, 4.0f, 500.0f, 2.0f, &needed) != SS_STATUS_INVALID_ARGUMENT) {
+        fprintf(stderr, "a field of view of 4 radians accepted\n");
+        return 3;
+    }
     int32_t k;
     while ((k = ss_decoder_next_level(d)) >= 0) {
         SsLevelInfo info;

@@ -108,6 +108,12 @@ assert.ok(valid >= 5, 'too few valid vectors');
   const [s, e] = d.levelRange(1);
   assert.throws(() => d.decodeLevel(1, stream.subarray(s, e)), (err) => err.class === 'api-misuse');
   assert.throws(() => d.levelRange(d.levelCount), (err) => err.class === 'invalid-argument');
+  // Screen-space error: close up every level, far away the base level; a
+  // field of view of 4 radians is no camera.
+  const fov = Math.PI / 3;
+  assert.equal(d.levelForScreenError(1080, fov, 0, 2), d.levelWithinError(0));
+  assert.equal(d.levelForScreenError(1080, fov, 1e30, 2), 0);
+  assert.throws(() => d.levelForScreenError(1080, 4, 10, 2), (err) => err.class === 'invalid-argument');
   d.free();
 }
 

@@ -4,6 +4,7 @@ use std::ptr;
 
 use super::error::{SsStatus, fail_argument, fail_decoder, guard};
 use crate::ffi::Session;
+use crate::view::ScreenView;
 
 /// A progressive decoder (opaque). Create with `ss_decoder_open`, release
 /// with `ss_decoder_free`.
@@ -183,6 +184,67 @@ pub unsafe extern "C" fn ss_decoder_level_info(
     // SAFETY: checked non-null; writable per the contract.
     unsafe { out.write(info) };
     SsStatus::Ok
+}
+
+/// The coarsest level whose geometric error (decoder-core SPEC §4.1,
+/// model units) is at most `max_error`, the last level when none is, into
+/// `*out`: decode levels 0 ..= it.
+///
+/// # Safety
+/// `decoder` is null or a live handle; `out` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ss_decoder_level_within_error(
+    decoder: *const SsDecoder,
+    max_error: f32,
+    out: *mut u16,
+) -> SsStatus {
+    // SAFETY: per the contract.
+    let Some(s) = (unsafe { session(decoder) }) else {
+        return fail_argument("null decoder");
+    };
+    if out.is_null() {
+        return fail_argument("null output pointer");
+    }
+    // SAFETY: checked non-null; writable per the contract.
+    unsafe { out.write(s.level_within_error(max_error)) };
+    SsStatus::Ok
+}
+
+/// The coarsest level whose geometric error covers at most `max_pixels`
+/// pixels on screen, for a perspective camera with a viewport
+/// `viewport_height` pixels high and a vertical field of view of `fov_y`
+/// radians, at `distance` model units from the object, into `*out`.
+/// Parameters that describe no camera are `SS_STATUS_INVALID_ARGUMENT`,
+/// with the reason in `ss_last_error_message`.
+///
+/// # Safety
+/// `decoder` is null or a live handle; `out` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ss_decoder_level_for_screen_error(
+    decoder: *const SsDecoder,
+    viewport_height: f32,
+    fov_y: f32,
+    distance: f32,
+    max_pixels: f32,
+    out: *mut u16,
+) -> SsStatus {
+    // SAFETY: per the contract.
+    let Some(s) = (unsafe { session(decoder) }) else {
+        return fail_argument("null decoder");
+    };
+    if out.is_null() {
+        return fail_argument("null output pointer");
+    }
+    let level = ScreenView::perspective(viewport_height, fov_y)
+        .and_then(|view| s.level_for_screen_error(&view, distance, max_pixels));
+    match level {
+        Ok(k) => {
+            // SAFETY: checked non-null; writable per the contract.
+            unsafe { out.write(k) };
+            SsStatus::Ok
+        }
+        Err(e) => fail_argument(&e.to_string()),
+    }
 }
 
 /// Bytes of working memory the decoder holds (decoder-core SPEC §9).
