@@ -12,8 +12,7 @@ use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::record::{StreamSource, read_base};
 use splitstream_decoder_core::substream::Substreams;
 use splitstream_decoder_core::{
-    Error, Header, Inflater, LevelHeader, LevelTable, MeshState, RecordSource, Ring, SplitRecord,
-    layout_for,
+    Error, Header, Inflater, LevelTable, MeshState, RecordSource, Ring, SplitRecord, layout_for,
 };
 
 use crate::protocol::{Outcome, Verdict};
@@ -164,26 +163,7 @@ fn pieces(stream: &[u8], broken: bool, hashes: &mut Vec<u64>) -> Result<(), Erro
             .ok_or(Error::Truncated)?;
         // SPEC §5.1: the level header against the table entry.
         let is_base = k == 0;
-        let level_header = LevelHeader::parse(bytes, is_base, header.max_chunk_len)?;
-        if level_header.round_count != info.round_count {
-            return Err(Error::LevelCountMismatch);
-        }
-        let before = if is_base {
-            level_header.seed_vertices
-        } else {
-            table.get(k - 1).vertex_count
-        };
-        let mut added = 0u64;
-        for r in 0..level_header.round_count {
-            let s = level_header.split_count(r);
-            if s == 0 {
-                return Err(Error::InvalidLevelHeader("a round without splits"));
-            }
-            added += s as u64;
-        }
-        if before as u64 + added != info.vertex_count as u64 {
-            return Err(Error::LevelCountMismatch);
-        }
+        let level_header = table.level_header(k, bytes, header.max_chunk_len)?;
         // SPEC §7.6: no split may take the level past its triangle count.
         state.set_triangle_limit(info.triangle_count);
         let rounds = level_header.round_count;

@@ -168,7 +168,10 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
             });
         }
         let info = self.table.get(level);
-        let header = match prepare_level(self, level, info, bytes) {
+        let header = match self
+            .table
+            .level_header(level, bytes, self.header.max_chunk_len)
+        {
             Ok(h) => h,
             Err(e) => {
                 self.poisoned = true;
@@ -222,42 +225,6 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
     pub fn dequantize(&self, q: [u32; 3]) -> [f64; 3] {
         self.header.dequantize(q)
     }
-}
-
-/// Validates a level's header against its table entry (SPEC §5.1).
-fn prepare_level<'l>(
-    decoder: &Decoder<'_, '_>,
-    level: u16,
-    info: LevelInfo,
-    bytes: &'l [u8],
-) -> Result<LevelHeader<'l>, Error> {
-    if bytes.len() as u64 != info.length as u64 {
-        return Err(Error::Truncated);
-    }
-    let is_base = level == 0;
-    let header = LevelHeader::parse(bytes, is_base, decoder.header.max_chunk_len)?;
-    if header.round_count != info.round_count {
-        return Err(Error::LevelCountMismatch);
-    }
-    {
-        let before = if is_base {
-            header.seed_vertices as u64
-        } else {
-            decoder.table.get(level - 1).vertex_count as u64
-        };
-        let mut added = 0u64;
-        for r in 0..header.round_count {
-            let s = header.split_count(r);
-            if s == 0 {
-                return Err(Error::InvalidLevelHeader("a round without splits"));
-            }
-            added += s as u64;
-        }
-        if before + added != info.vertex_count as u64 {
-            return Err(Error::LevelCountMismatch);
-        }
-    }
-    Ok(header)
 }
 
 fn open_level<'d, 'l, 'ws>(

@@ -2,7 +2,7 @@
 
 use crate::bytes::{crc32, f32_at, u32_at, u64_at};
 use crate::limits::{HEADER_LEN, LEVEL_ENTRY_LEN};
-use crate::{ChecksumScope, Error, Header};
+use crate::{ChecksumScope, Error, Header, LevelHeader};
 
 /// One level-table entry (SPEC §4.1). Level 0 is the base mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -139,6 +139,45 @@ impl<'h> LevelTable<'h> {
     /// this table).
     pub fn level_within_error(&self, max_error: f32) -> u16 {
         level_within_error((0..self.count).map(|k| self.get(k)), max_error).unwrap_or(0)
+    }
+
+    /// Parses level `k`'s header from exactly its bytes (`bytes.len()` is
+    /// entry k's length, `Truncated` otherwise) and checks it against
+    /// entry `k` (SPEC §5.1): the same round count, no round without
+    /// splits, and the splits taking the vertex count from entry `k − 1`'s
+    /// (the seed's for the base level) to entry `k`'s.
+    pub fn level_header<'l>(
+        &self,
+        k: u16,
+        bytes: &'l [u8],
+        max_chunk_len: u32,
+    ) -> Result<LevelHeader<'l>, Error> {
+        let info = self.get(k);
+        if bytes.len() as u64 != info.length as u64 {
+            return Err(Error::Truncated);
+        }
+        let is_base = k == 0;
+        let header = LevelHeader::parse(bytes, is_base, max_chunk_len)?;
+        if header.round_count != info.round_count {
+            return Err(Error::LevelCountMismatch);
+        }
+        let before = if is_base {
+            header.seed_vertices as u64
+        } else {
+            self.get(k - 1).vertex_count as u64
+        };
+        let mut added = 0u64;
+        for r in 0..header.round_count {
+            let s = header.split_count(r);
+            if s == 0 {
+                return Err(Error::InvalidLevelHeader("a round without splits"));
+            }
+            added += s as u64;
+        }
+        if before + added != info.vertex_count as u64 {
+            return Err(Error::LevelCountMismatch);
+        }
+        Ok(header)
     }
 
     /// End of the stream: offset just past the last level.

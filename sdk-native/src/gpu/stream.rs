@@ -10,9 +10,7 @@
 use splitstream_decoder_core::limits::substream;
 use splitstream_decoder_core::record::{StreamSource, read_base};
 use splitstream_decoder_core::substream::Substreams;
-use splitstream_decoder_core::{
-    Error, Header, Inflater, LevelHeader, LevelTable, MeshState, Ring, layout_for,
-};
+use splitstream_decoder_core::{Error, Header, Inflater, LevelTable, MeshState, Ring, layout_for};
 
 use super::capture::{Capture, CapturedRound};
 
@@ -140,26 +138,7 @@ fn capture_into(
             .ok_or(Error::Truncated)?;
         // SPEC §5.1: the level header against the table entry.
         let is_base = k == 0;
-        let level_header = LevelHeader::parse(bytes, is_base, header.max_chunk_len)?;
-        if level_header.round_count != info.round_count {
-            return Err(Error::LevelCountMismatch.into());
-        }
-        let before = if is_base {
-            level_header.seed_vertices
-        } else {
-            table.get(k - 1).vertex_count
-        };
-        let mut added = 0u64;
-        for r in 0..level_header.round_count {
-            let s = level_header.split_count(r);
-            if s == 0 {
-                return Err(Error::InvalidLevelHeader("a round without splits").into());
-            }
-            added += s as u64;
-        }
-        if before as u64 + added != info.vertex_count as u64 {
-            return Err(Error::LevelCountMismatch.into());
-        }
+        let level_header = table.level_header(k, bytes, header.max_chunk_len)?;
         state.set_triangle_limit(info.triangle_count);
         if is_base {
             let slots = buffers.each_mut().map(|b| &mut **b);
