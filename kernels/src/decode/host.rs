@@ -94,6 +94,57 @@ pub struct Snapshot {
     pub fault: Option<KernelFault>,
 }
 
+/// A state buffer a snapshot reads back.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateBuffer {
+    /// Three words per vertex.
+    Positions,
+    /// One word per vertex (a byte's value).
+    Deficit,
+    /// Three words per triangle.
+    Corners,
+    /// Three words per triangle.
+    Opposite,
+    /// One word per vertex.
+    VertexCorner,
+}
+
+impl Snapshot {
+    /// The state of `v` vertices and `t` triangles (and their adjacency
+    /// when `adjacency`), each buffer read by `read(buffer, words)`: both
+    /// hosts' snapshots, after their own read of the counts.
+    pub fn read(
+        v: usize,
+        t: usize,
+        adjacency: bool,
+        fault: Option<KernelFault>,
+        mut read: impl FnMut(StateBuffer, usize) -> Result<Vec<u32>, RefineError>,
+    ) -> Result<Snapshot, RefineError> {
+        let positions = read(StateBuffer::Positions, 3 * v)?;
+        let deficits = read(StateBuffer::Deficit, v)?;
+        let corners = read(StateBuffer::Corners, 3 * t)?;
+        let (opposite, vertex_corner) = if adjacency {
+            (
+                read(StateBuffer::Opposite, 3 * t)?,
+                read(StateBuffer::VertexCorner, v)?,
+            )
+        } else {
+            (Vec::new(), Vec::new())
+        };
+        Ok(Snapshot {
+            positions: positions
+                .chunks_exact(3)
+                .map(|p| [p[0], p[1], p[2]])
+                .collect(),
+            deficits: deficits.iter().map(|&d| d as u8).collect(),
+            corners,
+            opposite,
+            vertex_corner,
+            fault,
+        })
+    }
+}
+
 /// Checks a base mesh against the capacities both hosts allocate.
 pub fn check_base(
     base: &BaseMesh<'_>,

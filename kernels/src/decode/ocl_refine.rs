@@ -5,7 +5,7 @@
 
 use super::adjacency::build_adjacency;
 pub use super::host::{BaseMesh, RefineError, RoundInput, Snapshot};
-use super::host::{check_base, check_round, position_limit, round_split_capacity};
+use super::host::{StateBuffer, check_base, check_round, position_limit, round_split_capacity};
 use super::layout::*;
 use super::schedule::{Entry, round_schedule, scan_words};
 use super::sources::opencl_program;
@@ -200,27 +200,16 @@ impl<'c> OclRefiner<'c> {
             write(&self.buffers[COUNTS], &reset)?;
         }
         self.vertex_count = v as u32;
-        let positions = read(&self.buffers[POSITIONS], 3 * v)?;
-        let deficits = read(&self.buffers[DEFICIT], v)?;
-        let corners = read(&self.buffers[CORNERS], 3 * t)?;
-        let (opposite, vertex_corner) = if adjacency {
-            (
-                read(&self.buffers[OPPOSITE], 3 * t)?,
-                read(&self.buffers[VERTEX_CORNER], v)?,
-            )
-        } else {
-            (Vec::new(), Vec::new())
-        };
-        Ok(Snapshot {
-            positions: positions
-                .chunks_exact(3)
-                .map(|p| [p[0], p[1], p[2]])
-                .collect(),
-            deficits: deficits.iter().map(|&d| d as u8).collect(),
-            corners,
-            opposite,
-            vertex_corner,
-            fault,
+        let buffers = &self.buffers;
+        Snapshot::read(v, t, adjacency, fault, |buffer, words| {
+            let index = match buffer {
+                StateBuffer::Positions => POSITIONS,
+                StateBuffer::Deficit => DEFICIT,
+                StateBuffer::Corners => CORNERS,
+                StateBuffer::Opposite => OPPOSITE,
+                StateBuffer::VertexCorner => VERTEX_CORNER,
+            };
+            read(&buffers[index], words)
         })
     }
 

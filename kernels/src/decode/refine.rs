@@ -13,7 +13,7 @@ use wgpu::util::DeviceExt;
 
 use super::adjacency::build_adjacency;
 pub use super::host::{BaseMesh, RefineError, RoundInput, Snapshot};
-use super::host::{check_base, check_round, position_limit, round_split_capacity};
+use super::host::{StateBuffer, check_base, check_round, position_limit, round_split_capacity};
 use super::layout::*;
 use super::schedule::{Entry, round_schedule, scan_words};
 use super::sources::DecodeModule;
@@ -316,27 +316,17 @@ impl<'c> Refiner<'c> {
             );
         }
         self.vertex_count = v as u32;
-        let positions: Vec<u32> = self.read_words(&self.buffers.positions, 3 * v)?;
-        let deficits: Vec<u32> = self.read_words(&self.buffers.deficit, v)?;
-        let corners = self.read_words(&self.buffers.corners, 3 * t)?;
-        let (opposite, vertex_corner) = if adjacency {
-            (
-                self.read_words(&self.buffers.opposite, 3 * t)?,
-                self.read_words(&self.buffers.vertex_corner, v)?,
-            )
-        } else {
-            (Vec::new(), Vec::new())
-        };
-        Ok(Snapshot {
-            positions: positions
-                .chunks_exact(3)
-                .map(|p| [p[0], p[1], p[2]])
-                .collect(),
-            deficits: deficits.iter().map(|&d| d as u8).collect(),
-            corners,
-            opposite,
-            vertex_corner,
-            fault,
+        let (v, t) = (v as usize, t as usize);
+        Snapshot::read(v, t, adjacency, fault, |buffer, words| {
+            let b = &self.buffers;
+            let source = match buffer {
+                StateBuffer::Positions => &b.positions,
+                StateBuffer::Deficit => &b.deficit,
+                StateBuffer::Corners => &b.corners,
+                StateBuffer::Opposite => &b.opposite,
+                StateBuffer::VertexCorner => &b.vertex_corner,
+            };
+            self.read_words(source, words as u64)
         })
     }
 
