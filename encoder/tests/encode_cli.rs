@@ -1,5 +1,6 @@
 //! `splitstream encode` and `decode` from the command line: the position
-//! mode chosen for a raster, and the raster's lattice kept exactly.
+//! mode chosen for a raster, the raster's lattice kept exactly, and one
+//! clear line for bad streams and arguments.
 
 mod cli;
 
@@ -94,4 +95,41 @@ fn a_raster_is_encoded_constrained_and_decodes_exactly() {
         "ignore",
     ]);
     assert!(succeeded(&out).contains("positions: optimal\n"));
+}
+
+/// A failed run's stderr: one line.
+fn one_line_error(out: &Output) -> String {
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    err
+}
+
+#[test]
+fn bad_streams_and_arguments_get_one_line_naming_the_file() {
+    let input = raster();
+    let stream = input.with_file_name("for-errors.sps");
+    let s = stream.to_str().unwrap();
+    succeeded(&splitstream(&["encode", input.to_str().unwrap(), "-o", s]));
+    let bytes = std::fs::read(&stream).unwrap();
+    // Cut inside level 0: every reader names the file and the problem.
+    let cut = input.with_file_name("cut.sps");
+    std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
+    let c = cut.to_str().unwrap();
+    for command in ["info", "verify"] {
+        let err = one_line_error(&splitstream(&[command, c]));
+        assert!(
+            err.contains("cut.sps: ") && err.contains("truncated"),
+            "{command}: {err}"
+        );
+    }
+    let garbage = temp("garbage.sps", "not a stream at all");
+    let err = one_line_error(&splitstream(&["info", garbage.to_str().unwrap()]));
+    assert!(err.contains("garbage.sps: not a splitstream file"), "{err}");
+    let out = input.with_file_name("out.ply");
+    let o = out.to_str().unwrap();
+    let err = one_line_error(&splitstream(&["decode", s, "-o", o, "--level", "99"]));
+    assert!(err.contains("--level 99"), "{err}");
+    let err = one_line_error(&splitstream(&["decode", s, "-o", "out.xyz"]));
+    assert!(err.contains("out.xyz"), "{err}");
 }

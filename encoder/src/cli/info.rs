@@ -51,11 +51,16 @@ pub fn field_sizes(
     };
     for k in 0..table.len() {
         let e = table.get(k);
-        let bytes = stream
-            .get(e.offset as usize..(e.offset + e.length as u64) as usize)
-            .ok_or("stream truncated")?;
-        let lh =
-            LevelHeader::parse(bytes, k == 0, header.max_chunk_len).map_err(|e| e.to_string())?;
+        let end = e.offset + e.length as u64;
+        let bytes = stream.get(e.offset as usize..end as usize).ok_or_else(|| {
+            format!(
+                "stream truncated: level {k} ends at byte {end}, the stream has {} bytes",
+                stream.len()
+            )
+        })?;
+        let lh = table
+            .level_header(k, bytes, header.max_chunk_len)
+            .map_err(|e| format!("level {k}: {e}"))?;
         sizes.framing += lh.payload_start as u64;
         for c in 0..lh.chunk_count {
             let chunk = lh.chunk(c).map_err(|e| e.to_string())?;
@@ -79,7 +84,8 @@ pub fn run(input: &Path, json: bool) -> CliResult {
     let fail = |e: splitstream_decoder_core::Error| format!("{}: {e}", input.display());
     let header = Header::parse(&stream).map_err(fail)?;
     let table = LevelTable::parse(&stream, &header).map_err(fail)?;
-    let sizes = field_sizes(&stream, &header, &table)?;
+    let sizes =
+        field_sizes(&stream, &header, &table).map_err(|e| format!("{}: {e}", input.display()))?;
     // Each level's plane policy (SPEC §5.1, §7.4).
     let planes: Vec<&str> = (0..table.len())
         .map(|k| {
