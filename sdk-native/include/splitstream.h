@@ -4,7 +4,9 @@
  *
  * Link with libsplitstream_sdk_native.a (plus -lpthread -ldl -lm) or the
  * shared library. Every function returning SsStatus reports failures
- * through ss_last_error_class() / ss_last_error_message().
+ * through ss_last_error_class() / ss_last_error_message() (per thread).
+ * A handle is not thread-safe: one thread at a time may use it, and it
+ * may move from thread to thread.
  */
 
 #ifndef SPLITSTREAM_H

@@ -1,8 +1,10 @@
 //! `Session`, the owning progressive decoder: the conformance vectors'
 //! round hashes, level by level and round by round, dropped half way,
-//! misused. Small enough to run under Miri, which checks the unsafe
-//! self-borrowing in src/ffi/session.rs:
-//! `cargo +nightly miri test -p splitstream-sdk-native --test session`.
+//! misused, moved to other threads mid-level. Small enough to run under
+//! Miri, which checks the unsafe self-borrowing in src/ffi/session.rs and
+//! its `Send` (about 3 minutes; the tests read the vector files):
+//! `MIRIFLAGS=-Zmiri-disable-isolation cargo +nightly miri test -p
+//! splitstream-sdk-native --test session`.
 
 use std::path::{Path, PathBuf};
 
@@ -169,4 +171,38 @@ fn the_level_for_a_screen_error_is_the_coarsest_within_it() {
             previous = k;
         }
     }
+}
+
+#[test]
+fn sessions_move_to_other_threads_mid_level() {
+    // Opened here, half decoded, finished on worker threads (one per
+    // vector, several at once): the same hashes as on one thread.
+    let vectors = valid_vectors(if cfg!(miri) { 2 } else { 16 });
+    let mut sessions = Vec::new();
+    for (name, stream, expected) in &vectors {
+        let mut s = Session::open(stream).unwrap();
+        let k = s.next_level().unwrap();
+        s.begin_level(k, level(&s, stream, k)).unwrap();
+        sessions.push((name, stream, expected, s));
+    }
+    std::thread::scope(|scope| {
+        let workers: Vec<_> = sessions
+            .into_iter()
+            .map(|(name, stream, expected, mut s)| {
+                scope.spawn(move || {
+                    while s.next_round().unwrap().is_some() {}
+                    while let Some(k) = s.next_level() {
+                        s.decode_level(k, level(&s, stream, k)).unwrap();
+                    }
+                    let last = expected.last().unwrap();
+                    assert_eq!(&format!("{:016x}", s.state_hash()), last, "{name}");
+                    // Back to the spawning thread, to be dropped there.
+                    s
+                })
+            })
+            .collect();
+        for w in workers {
+            drop(w.join().unwrap());
+        }
+    });
 }

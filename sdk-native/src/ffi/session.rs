@@ -28,7 +28,8 @@ use crate::view::{ScreenView, ViewError};
 /// A progressive decoding session: created from the stream head (header and
 /// level table), fed level by level, decoded level by level or round by
 /// round. All memory is allocated once, at [`Session::open`], from the
-/// sizes the header declares.
+/// sizes the header declares. A session is `Send`: decode it on a worker
+/// thread, or many sessions (tiles, objects) on as many cores.
 pub struct Session {
     /// `Box<LevelDecoder>` of the level being decoded round by round;
     /// borrows `*decoder` mutably and `*level_bytes`. Dropped before either.
@@ -293,6 +294,25 @@ impl Session {
         self.header.dequantize(q)
     }
 }
+
+// Every type a `Session` owns through its pointers is `Send`: checked here,
+// so that a change in decoder-core that made one of them `!Send` fails to
+// compile instead of making the `impl` below unsound.
+const _: () = {
+    const fn send<T: Send + ?Sized>() {}
+    send::<Decoder<'static, 'static>>();
+    send::<LevelDecoder<'static, 'static, 'static>>();
+    send::<OwnedWorkspace>();
+    send::<[u8]>();
+};
+
+// SAFETY: a `Session` is the only owner of every allocation its pointers
+// name (all from `Box::leak` in `open` and `begin_level`, freed in `Drop`
+// or `close_level`), and no reference into them outlives a call: what the
+// methods return borrows `self`. Moving a `Session` to another thread is
+// therefore moving those `Box`es, and every pointee is `Send` (checked
+// above). It is not `Sync`: one thread at a time uses it.
+unsafe impl Send for Session {}
 
 impl Drop for Session {
     fn drop(&mut self) {

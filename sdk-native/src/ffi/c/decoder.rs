@@ -48,7 +48,7 @@ unsafe fn byte_slice<'a>(data: *const u8, len: usize) -> Result<&'a [u8], SsStat
 /// `decoder` is null or a live handle from `ss_decoder_open`.
 unsafe fn session<'a>(decoder: *const SsDecoder) -> Option<&'a Session> {
     // SAFETY: the caller passes null or a live handle, not used mutably
-    // elsewhere meanwhile (handles are single-threaded).
+    // elsewhere meanwhile (one thread at a time uses a handle).
     unsafe { decoder.as_ref() }.map(|d| &d.session)
 }
 
