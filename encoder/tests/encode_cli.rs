@@ -133,3 +133,24 @@ fn bad_streams_and_arguments_get_one_line_naming_the_file() {
     let err = one_line_error(&splitstream(&["decode", s, "-o", "out.xyz"]));
     assert!(err.contains("out.xyz"), "{err}");
 }
+
+#[test]
+fn info_gives_the_memory_each_prefix_of_levels_needs() {
+    let input = raster();
+    let stream = input.with_file_name("for-info.sps");
+    let s = stream.to_str().unwrap();
+    succeeded(&splitstream(&["encode", input.to_str().unwrap(), "-o", s]));
+    let doc: serde_json::Value =
+        serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();
+    let memory: Vec<u64> = doc["levels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["workspace_bytes"].as_u64().unwrap())
+        .collect();
+    assert!(!memory.is_empty());
+    // Each level needs at least the memory of the ones before it, and all
+    // of them the header's workspace (SPEC §9).
+    assert!(memory.windows(2).all(|w| w[0] <= w[1]), "{memory:?}");
+    assert_eq!(memory.last().copied(), doc["workspace_bytes"].as_u64());
+}

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use splitstream_decoder_core::limits::VERSION_MAJOR;
 use splitstream_decoder_core::limits::substream::{self, NAMES};
-use splitstream_decoder_core::{Header, LevelHeader, LevelTable, PositionMode};
+use splitstream_decoder_core::{Header, LevelHeader, LevelTable, PositionMode, layout_for};
 
 use super::{CliResult, read_file};
 
@@ -110,6 +110,11 @@ pub fn run(input: &Path, json: bool) -> CliResult {
         PositionMode::Optimal => "optimal",
         PositionMode::Constrained => "constrained",
     };
+    // The workspace a decoder needs to decode levels 0 ..= k (SPEC §9): what
+    // a device with a fixed buffer can hold.
+    let memory: Vec<u64> = (0..table.len())
+        .map(|k| layout_for(&header, &table, k).total)
+        .collect();
     if json {
         let levels: Vec<_> = (0..table.len())
             .map(|k| {
@@ -119,6 +124,7 @@ pub fn run(input: &Path, json: bool) -> CliResult {
                     "vertices": e.vertex_count, "triangles": e.triangle_count,
                     "rounds": e.round_count, "geometric_error": e.geometric_error,
                     "plane_policy": planes[k as usize],
+                    "workspace_bytes": memory[k as usize],
                 })
             })
             .collect();
@@ -182,11 +188,13 @@ pub fn run(input: &Path, json: bool) -> CliResult {
         header.workspace_bytes as f64 / n,
         header.max_chunk_len
     );
-    println!("  level    offset     bytes   vertices  triangles rounds  plane     geometric error");
+    println!(
+        "  level    offset     bytes   vertices  triangles rounds  plane     decoder memory  geometric error"
+    );
     for k in 0..table.len() {
         let e = table.get(k);
         println!(
-            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:.6}",
+            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:>14}  {:.6}",
             k,
             e.offset,
             e.length,
@@ -194,6 +202,7 @@ pub fn run(input: &Path, json: bool) -> CliResult {
             e.triangle_count,
             e.round_count,
             planes[k as usize],
+            memory[k as usize],
             e.geometric_error
         );
     }

@@ -161,7 +161,8 @@ pub enum Command {
         #[arg(long)]
         level: Option<u16>,
     },
-    /// Header, level table, bits per field and per vertex, decoder memory.
+    /// Header, level table (with the decoder memory each prefix of levels
+    /// needs), bits per field and per vertex.
     Info {
         input: PathBuf,
         #[arg(long)]
