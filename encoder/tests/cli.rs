@@ -21,3 +21,11 @@ pub fn splitstream(args: &[&str]) -> Output {
         .output()
         .unwrap()
 }
+
+/// A failed run's stderr, checked to be one line.
+pub fn one_line_error(out: &Output) -> String {
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    err
+}

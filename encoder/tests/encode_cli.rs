@@ -7,7 +7,7 @@ mod cli;
 use std::path::PathBuf;
 use std::process::Output;
 
-use cli::splitstream;
+use cli::{one_line_error, splitstream};
 
 fn temp(name: &str, contents: &str) -> PathBuf {
     cli::temp("encode-cli", name, contents)
@@ -95,14 +95,6 @@ fn a_raster_is_encoded_constrained_and_decodes_exactly() {
         "ignore",
     ]);
     assert!(succeeded(&out).contains("positions: optimal\n"));
-}
-
-/// A failed run's stderr: one line.
-fn one_line_error(out: &Output) -> String {
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    err
 }
 
 #[test]

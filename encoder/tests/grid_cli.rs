@@ -4,9 +4,8 @@
 mod cli;
 
 use std::path::PathBuf;
-use std::process::Output;
 
-use cli::splitstream;
+use cli::{one_line_error, splitstream};
 
 fn temp(name: &str, contents: &str) -> PathBuf {
     cli::temp("grid-cli", name, contents)
@@ -22,13 +21,6 @@ fn asc(rows: usize, cols: usize, z: impl Fn(usize, usize) -> String) -> String {
         s.push('\n');
     }
     s
-}
-
-fn one_line_error(out: &Output) -> String {
-    assert!(!out.status.success());
-    let err = String::from_utf8_lossy(&out.stderr).to_string();
-    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
-    err
 }
 
 #[test]

@@ -52,6 +52,25 @@ unsafe fn session<'a>(decoder: *const SsDecoder) -> Option<&'a Session> {
     unsafe { decoder.as_ref() }.map(|d| &d.session)
 }
 
+/// The session behind `decoder` for a call that writes its result to
+/// `out`: the argument failure when either is null.
+///
+/// # Safety
+/// As [`session`].
+unsafe fn session_and_out<'a, T>(
+    decoder: *const SsDecoder,
+    out: *mut T,
+) -> Result<&'a Session, SsStatus> {
+    // SAFETY: per the contract.
+    let Some(s) = (unsafe { session(decoder) }) else {
+        return Err(fail_argument("null decoder"));
+    };
+    if out.is_null() {
+        return Err(fail_argument("null output pointer"));
+    }
+    Ok(s)
+}
+
 /// # Safety
 /// As [`session`], with no other reference to the handle alive.
 unsafe fn session_mut<'a>(decoder: *mut SsDecoder) -> Result<&'a mut Session, SsStatus> {
@@ -164,12 +183,10 @@ pub unsafe extern "C" fn ss_decoder_level_info(
     out: *mut SsLevelInfo,
 ) -> SsStatus {
     // SAFETY: per the contract.
-    let Some(s) = (unsafe { session(decoder) }) else {
-        return fail_argument("null decoder");
+    let s = match unsafe { session_and_out(decoder, out) } {
+        Ok(s) => s,
+        Err(status) => return status,
     };
-    if out.is_null() {
-        return fail_argument("null output pointer");
-    }
     let Some(e) = s.level_info(level) else {
         return fail_argument("level index beyond the level count");
     };
@@ -199,12 +216,10 @@ pub unsafe extern "C" fn ss_decoder_level_within_error(
     out: *mut u16,
 ) -> SsStatus {
     // SAFETY: per the contract.
-    let Some(s) = (unsafe { session(decoder) }) else {
-        return fail_argument("null decoder");
+    let s = match unsafe { session_and_out(decoder, out) } {
+        Ok(s) => s,
+        Err(status) => return status,
     };
-    if out.is_null() {
-        return fail_argument("null output pointer");
-    }
     // SAFETY: checked non-null; writable per the contract.
     unsafe { out.write(s.level_within_error(max_error)) };
     SsStatus::Ok
@@ -229,12 +244,10 @@ pub unsafe extern "C" fn ss_decoder_level_for_screen_error(
     out: *mut u16,
 ) -> SsStatus {
     // SAFETY: per the contract.
-    let Some(s) = (unsafe { session(decoder) }) else {
-        return fail_argument("null decoder");
+    let s = match unsafe { session_and_out(decoder, out) } {
+        Ok(s) => s,
+        Err(status) => return status,
     };
-    if out.is_null() {
-        return fail_argument("null output pointer");
-    }
     let level = ScreenView::perspective(viewport_height, fov_y)
         .and_then(|view| s.level_for_screen_error(&view, distance, max_pixels));
     match level {
