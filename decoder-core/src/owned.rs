@@ -4,7 +4,7 @@
 use alloc::boxed::Box;
 use alloc::vec::Vec;
 
-use crate::{Decoder, Error, Header, Inflater, LevelTable, workspace_len};
+use crate::{Decoder, Error, Header, Inflater, LevelTable};
 
 /// Largest workspace [`OwnedWorkspace::for_stream`] allocates per byte of
 /// stream.
@@ -37,10 +37,30 @@ impl OwnedWorkspace {
     /// allocations the system refuses. Callers with other needs size a
     /// workspace themselves (see [`crate::Layout`]).
     pub fn for_stream(head: &[u8]) -> Result<OwnedWorkspace, Error> {
+        OwnedWorkspace::within(head, u64::MAX)
+    }
+
+    /// Sized for the longest prefix of levels whose workspace (SPEC §9,
+    /// alignment included) is at most `max_bytes`: the decoder then decodes
+    /// those levels and stops cleanly ([`Decoder::levels_that_fit`]), the
+    /// way a device with a memory budget does. [`Error::WorkspaceTooSmall`]
+    /// when not even the base level fits; the limits of
+    /// [`OwnedWorkspace::for_stream`] apply too.
+    pub fn within(head: &[u8], max_bytes: u64) -> Result<OwnedWorkspace, Error> {
         let header = Header::parse(head)?;
         let table = LevelTable::parse(head, &header)?;
         crate::decoder::declared_layout(&header, &table)?;
-        let len = workspace_len(head)?;
+        let bytes = |last: u16| crate::layout_for(&header, &table, last).bytes_unaligned();
+        let Some(last) = (0..header.level_count)
+            .rev()
+            .find(|&k| bytes(k) <= max_bytes)
+        else {
+            return Err(Error::WorkspaceTooSmall {
+                needed: usize::try_from(bytes(0)).unwrap_or(usize::MAX),
+                available: usize::try_from(max_bytes).unwrap_or(usize::MAX),
+            });
+        };
+        let len = usize::try_from(bytes(last)).map_err(|_| Error::CapacityExceeded)?;
         let limit = table
             .stream_len()
             .saturating_mul(MAX_WORKSPACE_PER_STREAM_BYTE)
@@ -57,6 +77,16 @@ impl OwnedWorkspace {
             words,
             inflater: Box::new(Inflater::new()),
         })
+    }
+
+    /// Bytes of the workspace (the inflater not included).
+    pub fn len(&self) -> usize {
+        self.words.len() * 8
+    }
+
+    /// Whether the workspace is empty (never, for one made by this type).
+    pub fn is_empty(&self) -> bool {
+        self.words.is_empty()
     }
 
     /// A decoder over this memory.

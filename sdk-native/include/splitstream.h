@@ -122,6 +122,25 @@ SsStatus ss_head_len(const uint8_t *header, size_t header_len, size_t *out);
 // `head` points to `len` readable bytes; `out` is writable.
 SsStatus ss_decoder_open(const uint8_t *head, size_t len, SsDecoder **out);
 
+// As `ss_decoder_open`, with at most `max_bytes` of working memory: the
+// decoder holds the longest prefix of levels that fits (a device's memory
+// budget; `ss_decoder_levels_that_fit`) and decodes those.
+// `SS_STATUS_CAPACITY_EXCEEDED` when not even the base level fits.
+//
+// # Safety
+// `head` points to `len` readable bytes; `out` is writable.
+SsStatus ss_decoder_open_within(const uint8_t *head,
+                                size_t len,
+                                uint64_t max_bytes,
+                                SsDecoder **out);
+
+// Levels (base included) the decoder's working memory holds: all of them
+// unless opened with `ss_decoder_open_within`; 0 for a null handle.
+//
+// # Safety
+// `decoder` is null or a live handle.
+uint16_t ss_decoder_levels_that_fit(const SsDecoder *decoder);
+
 // Releases a decoder and all its memory; null is ignored.
 //
 // # Safety

@@ -206,3 +206,38 @@ fn sessions_move_to_other_threads_mid_level() {
         }
     });
 }
+
+#[test]
+fn a_budget_opens_the_levels_that_fit_and_decodes_them_exactly() {
+    use splitstream_decoder_core::{Error, Header, LevelTable, layout_for};
+    for (name, stream, _) in valid_vectors(if cfg!(miri) { 2 } else { 8 }) {
+        let header = Header::parse(&stream).unwrap();
+        let table = LevelTable::parse(&stream, &header).unwrap();
+        for k in 0..header.level_count {
+            // Exactly the memory of levels 0 ..= k (alignment included).
+            let layout = layout_for(&header, &table, k);
+            let mut s = Session::open_within(&stream, layout.bytes_unaligned()).unwrap();
+            assert_eq!(s.levels_that_fit(), k + 1, "{name}");
+            assert_eq!(s.workspace_bytes(), layout.total, "{name}");
+            while let Some(level) = s.next_level() {
+                s.decode_level(level, self::level(&s, &stream, level))
+                    .unwrap();
+            }
+            assert_eq!(s.levels_done(), k + 1, "{name}");
+            // The same state as a full session stopped after level k.
+            let mut full = Session::open(&stream).unwrap();
+            for level in 0..=k {
+                full.decode_level(level, self::level(&full, &stream, level))
+                    .unwrap();
+            }
+            assert_eq!(s.state_hash(), full.state_hash(), "{name} level {k}");
+        }
+        let base = layout_for(&header, &table, 0).bytes_unaligned();
+        let err = Session::open_within(&stream, base - 1).unwrap_err();
+        assert!(
+            matches!(err, Error::WorkspaceTooSmall { .. }),
+            "{name}: {err}"
+        );
+        assert_eq!(err.class(), "capacity-exceeded");
+    }
+}

@@ -45,6 +45,32 @@ impl StreamDecoder {
         })
     }
 
+    /// As the constructor, with at most `maxBytes` of working memory: the
+    /// decoder holds the longest prefix of levels that fits (`levelsThatFit`)
+    /// and decodes those, a phone's memory budget. Throws
+    /// `capacity-exceeded` when not even the base level fits.
+    #[wasm_bindgen(js_name = withinBudget)]
+    pub fn within_budget(head: &[u8], max_bytes: f64) -> Result<StreamDecoder, SdkError> {
+        if max_bytes.is_nan() || max_bytes < 0.0 {
+            return Err(SdkError::argument(format!(
+                "budget {max_bytes} is not a number of bytes"
+            )));
+        }
+        // Past 2^64 every budget is unlimited; `as` saturates.
+        Ok(StreamDecoder {
+            session: Session::open_within(head, max_bytes as u64)?,
+            out_f32: Vec::new(),
+            out_f64: Vec::new(),
+        })
+    }
+
+    /// Levels the working memory holds: all of them unless made with
+    /// `withinBudget`.
+    #[wasm_bindgen(getter, js_name = levelsThatFit)]
+    pub fn levels_that_fit(&self) -> u16 {
+        self.session.levels_that_fit()
+    }
+
     /// Levels in the stream, the base level 0 included.
     #[wasm_bindgen(getter, js_name = levelCount)]
     pub fn level_count(&self) -> u16 {

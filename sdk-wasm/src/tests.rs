@@ -165,6 +165,33 @@ fn the_level_for_a_screen_error_follows_the_distance() {
 }
 
 #[test]
+fn a_budget_holds_the_levels_that_fit() {
+    let stream = first_valid_multilevel();
+    let full = StreamDecoder::new(&stream).unwrap();
+    assert_eq!(full.levels_that_fit(), full.level_count());
+    // The base level's budget: one level.
+    let err = StreamDecoder::within_budget(&stream, 1.0).err().unwrap();
+    assert_eq!(err.class, "capacity-exceeded");
+    let err = StreamDecoder::within_budget(&stream, f64::NAN)
+        .err()
+        .unwrap();
+    assert_eq!(err.class, "invalid-argument");
+    let whole = StreamDecoder::within_budget(&stream, f64::INFINITY).unwrap();
+    assert_eq!(whole.levels_that_fit(), full.level_count());
+    let mut budget = full.workspace_bytes();
+    let smaller = loop {
+        budget = (budget * 0.75).floor();
+        match StreamDecoder::within_budget(&stream, budget) {
+            Ok(d) if d.levels_that_fit() < full.level_count() => break d,
+            Ok(_) => continue,
+            Err(e) => panic!("no budget between the base level and all: {e}"),
+        }
+    };
+    assert!(smaller.workspace_bytes() <= budget);
+    assert!(smaller.levels_that_fit() >= 1);
+}
+
+#[test]
 fn dropping_mid_level_frees_cleanly() {
     let stream = first_valid_multilevel();
     for rounds in 0..3 {

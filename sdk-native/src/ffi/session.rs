@@ -19,7 +19,7 @@ use core::ptr::NonNull;
 
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::{
-    Decoder, Error, Header, LevelDecoder, LevelInfo, MeshState, RoundInfo, head_len,
+    Decoder, Error, Header, LevelDecoder, LevelInfo, MeshState, RoundInfo, head_len, layout_for,
     level_within_error,
 };
 
@@ -44,6 +44,10 @@ pub struct Session {
     head: NonNull<[u8]>,
     header: Header,
     levels: Vec<LevelInfo>,
+    /// Levels the workspace holds (all, unless opened within a budget).
+    levels_that_fit: u16,
+    /// SPEC §9's workspace size for those levels.
+    workspace_bytes: u64,
     /// Levels done when the open level began (the decoder's own count is
     /// out of reach while a level borrows it).
     done_while_open: u16,
@@ -54,11 +58,20 @@ impl Session {
     /// stream or just its first [`Session::head_len`] bytes, which are
     /// copied) and allocates the workspace the whole stream needs.
     pub fn open(head: &[u8]) -> Result<Session, Error> {
+        Session::open_within(head, u64::MAX)
+    }
+
+    /// As [`Session::open`], with a workspace of at most `max_bytes`: sized
+    /// for the longest prefix of levels that fits (SPEC §9), which is all
+    /// the session decodes ([`Session::levels_that_fit`]); a device's
+    /// memory budget. `WorkspaceTooSmall` (class `capacity-exceeded`) when
+    /// not even the base level fits.
+    pub fn open_within(head: &[u8], max_bytes: u64) -> Result<Session, Error> {
         let header = Header::parse(head)?;
         let len = head_len(header.level_count);
         let head: Box<[u8]> = head.get(..len).ok_or(Error::Truncated)?.into();
         // Checks the level table and the declared size, refuses absurd ones.
-        let workspace = Box::new(OwnedWorkspace::for_stream(&head)?);
+        let workspace = Box::new(OwnedWorkspace::within(&head, max_bytes)?);
         let head = NonNull::from(Box::leak(head));
         let workspace = NonNull::from(Box::leak(workspace));
         // SAFETY: both pointers come from `Box::leak` just above, so they
@@ -81,6 +94,9 @@ impl Session {
         let levels = (0..header.level_count)
             .map(|k| decoder.level_table().get(k))
             .collect();
+        let levels_that_fit = decoder.levels_that_fit();
+        // SPEC §9's size for the levels that fit (the header's for all).
+        let workspace_bytes = layout_for(&header, decoder.level_table(), levels_that_fit - 1).total;
         let decoder = NonNull::from(Box::leak(Box::new(decoder)));
         Ok(Session {
             level: None,
@@ -90,6 +106,8 @@ impl Session {
             head,
             header,
             levels,
+            levels_that_fit,
+            workspace_bytes,
             done_while_open: 0,
         })
     }
@@ -153,9 +171,16 @@ impl Session {
         Ok(self.level_within_error(view.error_for_pixels(max_pixels, distance)?))
     }
 
-    /// Bytes of working memory the session holds (SPEC §9, with alignment).
+    /// Bytes of working memory the session holds (SPEC §9): the whole
+    /// stream's, or under [`Session::open_within`] the levels' that fit.
     pub fn workspace_bytes(&self) -> u64 {
-        self.header.workspace_bytes
+        self.workspace_bytes
+    }
+
+    /// Levels (base included) the session's workspace holds: all of them
+    /// unless opened with [`Session::open_within`].
+    pub fn levels_that_fit(&self) -> u16 {
+        self.levels_that_fit
     }
 
     /// The level to feed next; `None` when all are decoded, while a level

@@ -56,6 +56,17 @@ static int decode(const char *path) {
         free(stream);
         return fail();
     }
+    /* A memory budget: the levels that fit; one byte holds none. */
+    SsDecoder *tiny = NULL;
+    if (ss_decoder_open_within(stream, head < len ? head : len, 1, &tiny) != SS_STATUS_CAPACITY_EXCEEDED
+        || tiny != NULL) {
+        fprintf(stderr, "a 1-byte budget accepted\n");
+        return 3;
+    }
+    if (ss_decoder_levels_that_fit(d) != ss_decoder_level_count(d)) {
+        fprintf(stderr, "a full decoder holds fewer levels than the stream\n");
+        return 3;
+    }
     /* How many levels a viewer 500 units away needs (2 pixels, 1080 p,
        60 degrees); a field of view of 4 radians is no camera. */
     uint16_t needed = 0;

@@ -125,6 +125,24 @@ pub unsafe extern "C" fn ss_decoder_open(
     len: usize,
     out: *mut *mut SsDecoder,
 ) -> SsStatus {
+    // SAFETY: the same contract.
+    unsafe { ss_decoder_open_within(head, len, u64::MAX, out) }
+}
+
+/// As `ss_decoder_open`, with at most `max_bytes` of working memory: the
+/// decoder holds the longest prefix of levels that fits (a device's memory
+/// budget; `ss_decoder_levels_that_fit`) and decodes those.
+/// `SS_STATUS_CAPACITY_EXCEEDED` when not even the base level fits.
+///
+/// # Safety
+/// `head` points to `len` readable bytes; `out` is writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ss_decoder_open_within(
+    head: *const u8,
+    len: usize,
+    max_bytes: u64,
+    out: *mut *mut SsDecoder,
+) -> SsStatus {
     guard(|| {
         if out.is_null() {
             return fail_argument("null output pointer");
@@ -136,7 +154,7 @@ pub unsafe extern "C" fn ss_decoder_open(
             Ok(b) => b,
             Err(s) => return s,
         };
-        match Session::open(bytes) {
+        match Session::open_within(bytes, max_bytes) {
             Ok(session) => {
                 let handle = Box::into_raw(Box::new(SsDecoder { session }));
                 // SAFETY: as above.
@@ -146,6 +164,17 @@ pub unsafe extern "C" fn ss_decoder_open(
             Err(e) => fail_decoder(e),
         }
     })
+}
+
+/// Levels (base included) the decoder's working memory holds: all of them
+/// unless opened with `ss_decoder_open_within`; 0 for a null handle.
+///
+/// # Safety
+/// `decoder` is null or a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ss_decoder_levels_that_fit(decoder: *const SsDecoder) -> u16 {
+    // SAFETY: per the contract.
+    unsafe { session(decoder) }.map_or(0, Session::levels_that_fit)
 }
 
 /// Releases a decoder and all its memory; null is ignored.
