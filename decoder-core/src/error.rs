@@ -66,6 +66,8 @@ pub enum Error {
     Poisoned,
     /// API misuse: a vertex index beyond the current vertex count.
     NoSuchVertex,
+    /// API misuse: a level index beyond the level table (`count` levels).
+    NoSuchLevel { level: u16, count: u16 },
 }
 
 /// Which checksum failed (SPEC §3.3, §4.2, §5.1, §5.2).
@@ -101,7 +103,10 @@ impl Error {
             Error::ValenceOverflow | Error::SplitValenceOutOfRange => "valence-overflow",
             Error::NonManifold(_) => "non-manifold",
             Error::PositionOutOfRange => "position-out-of-range",
-            Error::LevelOutOfOrder { .. } | Error::Poisoned | Error::NoSuchVertex => "api-misuse",
+            Error::LevelOutOfOrder { .. }
+            | Error::Poisoned
+            | Error::NoSuchVertex
+            | Error::NoSuchLevel { .. } => "api-misuse",
         }
     }
 }
@@ -189,6 +194,12 @@ impl fmt::Display for Error {
                 "decoder already failed or a level was abandoned; start a new one"
             ),
             Error::NoSuchVertex => write!(f, "vertex index beyond the current vertex count"),
+            Error::NoSuchLevel { level, count } => {
+                write!(
+                    f,
+                    "level {level} does not exist: the stream has levels 0..{count}"
+                )
+            }
         }
     }
 }

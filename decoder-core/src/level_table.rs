@@ -152,6 +152,12 @@ impl<'h> LevelTable<'h> {
         bytes: &'l [u8],
         max_chunk_len: u32,
     ) -> Result<LevelHeader<'l>, Error> {
+        if k >= self.count {
+            return Err(Error::NoSuchLevel {
+                level: k,
+                count: self.count,
+            });
+        }
         let info = self.get(k);
         if bytes.len() as u64 != info.length as u64 {
             return Err(Error::Truncated);
@@ -255,6 +261,41 @@ mod tests {
         assert_eq!(level_within_error(levels(&errors), -1.0), Some(4));
         assert_eq!(level_within_error(levels(&errors), f32::NAN), Some(4));
         assert_eq!(level_within_error(levels(&[]), 1.0), None);
+    }
+
+    #[test]
+    fn a_level_header_is_checked_against_its_entry() {
+        use crate::handmade::tetra_stream;
+        use crate::writer::ChunkCodec;
+        let stream = tetra_stream(ChunkCodec::Deflate(6));
+        let header = Header::parse(&stream).unwrap();
+        let table = LevelTable::parse(&stream, &header).unwrap();
+        let bytes = |k: u16| {
+            let e = table.get(k);
+            &stream[e.offset as usize..(e.offset + e.length as u64) as usize]
+        };
+        for k in 0..table.len() {
+            let level = table
+                .level_header(k, bytes(k), header.max_chunk_len)
+                .unwrap();
+            assert_eq!(level.round_count, table.get(k).round_count);
+        }
+        // Not exactly the level's bytes, or a level that is not there.
+        let short = &bytes(0)[..bytes(0).len() - 1];
+        assert_eq!(
+            table.level_header(0, short, header.max_chunk_len).err(),
+            Some(Error::Truncated)
+        );
+        let beyond = table.len();
+        assert_eq!(
+            table
+                .level_header(beyond, bytes(0), header.max_chunk_len)
+                .err(),
+            Some(Error::NoSuchLevel {
+                level: beyond,
+                count: table.len()
+            })
+        );
     }
 
     #[test]
