@@ -50,7 +50,14 @@ impl OwnedWorkspace {
         let header = Header::parse(head)?;
         let table = LevelTable::parse(head, &header)?;
         crate::decoder::declared_layout(&header, &table)?;
-        let bytes = |last: u16| crate::layout_for(&header, &table, last).bytes_unaligned();
+        // The words below are 8-aligned, so a layout needs no slack for
+        // alignment: its total, in whole words.
+        let bytes = |last: u16| {
+            crate::layout_for(&header, &table, last)
+                .total
+                .div_ceil(8)
+                .saturating_mul(8)
+        };
         let Some(last) = (0..header.level_count)
             .rev()
             .find(|&k| bytes(k) <= max_bytes)

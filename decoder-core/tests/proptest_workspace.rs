@@ -2,13 +2,17 @@
 //! of every size from 0 up to the needed size, at every alignment, never
 //! panics; a workspace too small for the base level gives
 //! `WorkspaceTooSmall`, a larger one decodes the levels that fit, to the same
-//! states as a full decode.
+//! states as a full decode; an owned workspace within a budget holds exactly
+//! the levels whose layout fits the budget.
 
 #[path = "../fuzz/src/streams.rs"]
 mod streams;
 
 use proptest::prelude::*;
-use splitstream_decoder_core::{Decoder, Error, Inflater, workspace_len};
+use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_decoder_core::{
+    Decoder, Error, Header, Inflater, LevelTable, layout_for, workspace_len,
+};
 use streams::Choices;
 
 /// Decodes `stream` into `ws` and checks it against the full decode.
@@ -65,6 +69,42 @@ fn every_size(stream: &[u8]) {
     }
 }
 
+/// `OwnedWorkspace::within(stream, budget)` for every budget around each
+/// prefix's size (its layout in whole 8-byte words: the owned workspace is
+/// aligned): too small for the base level is `WorkspaceTooSmall`,
+/// otherwise a workspace of at most `budget` bytes whose decoder holds
+/// exactly the levels whose layout fits it.
+fn every_budget(stream: &[u8]) {
+    let header = Header::parse(stream).unwrap();
+    let table = LevelTable::parse(stream, &header).unwrap();
+    let sizes: Vec<u64> = (0..header.level_count)
+        .map(|k| layout_for(&header, &table, k).total.div_ceil(8) * 8)
+        .collect();
+    let budgets = sizes
+        .iter()
+        .flat_map(|&b| [b.saturating_sub(1), b, b + 1])
+        .chain([0, u64::MAX]);
+    for budget in budgets {
+        let fit = sizes.iter().filter(|&&b| b <= budget).count() as u16;
+        match OwnedWorkspace::within(stream, budget) {
+            Err(Error::WorkspaceTooSmall { .. }) => assert_eq!(fit, 0, "budget {budget}"),
+            Err(e) => panic!("budget {budget}: {e:?}"),
+            Ok(mut ws) => {
+                assert!(ws.len() as u64 <= budget, "budget {budget}");
+                let decoder = ws.decoder(stream).unwrap();
+                assert_eq!(decoder.levels_that_fit(), fit, "budget {budget}");
+            }
+        }
+    }
+}
+
+#[test]
+fn every_budget_of_the_seed_streams() {
+    for g in streams::seed_generated().iter().take(5) {
+        every_budget(&g.stream);
+    }
+}
+
 #[test]
 fn every_workspace_size_of_the_seed_streams() {
     for g in streams::seed_generated().iter().take(5) {
@@ -79,5 +119,6 @@ proptest! {
     fn every_workspace_size_of_generated_streams(choices in proptest::collection::vec(any::<u8>(), 0..1024)) {
         let g = streams::generate(&mut Choices::new(&choices), false);
         every_size(&g.stream);
+        every_budget(&g.stream);
     }
 }

@@ -214,9 +214,10 @@ fn a_budget_opens_the_levels_that_fit_and_decodes_them_exactly() {
         let header = Header::parse(&stream).unwrap();
         let table = LevelTable::parse(&stream, &header).unwrap();
         for k in 0..header.level_count {
-            // Exactly the memory of levels 0 ..= k (alignment included).
+            // Exactly the memory of levels 0 ..= k (the session's workspace
+            // is 8-aligned: no slack).
             let layout = layout_for(&header, &table, k);
-            let mut s = Session::open_within(&stream, layout.bytes_unaligned()).unwrap();
+            let mut s = Session::open_within(&stream, layout.total).unwrap();
             assert_eq!(s.levels_that_fit(), k + 1, "{name}");
             assert_eq!(s.workspace_bytes(), layout.total, "{name}");
             while let Some(level) = s.next_level() {
@@ -232,7 +233,7 @@ fn a_budget_opens_the_levels_that_fit_and_decodes_them_exactly() {
             }
             assert_eq!(s.state_hash(), full.state_hash(), "{name} level {k}");
         }
-        let base = layout_for(&header, &table, 0).bytes_unaligned();
+        let base = layout_for(&header, &table, 0).total;
         let err = Session::open_within(&stream, base - 1).unwrap_err();
         assert!(
             matches!(err, Error::WorkspaceTooSmall { .. }),
