@@ -175,15 +175,20 @@ fn run(
     while let Some(k) = decoder.next_level().filter(|&k| k < levels_visible) {
         let bytes = decoder.level_bytes(k, stream).map_err(|e| e.to_string())?;
         decoder.decode_level(k, bytes).map_err(|e| e.to_string())?;
-        let view = *view.get_or_insert_with(|| {
-            let v = View::fit(decoder.positions(), axes).expect("a base mesh has vertices");
-            // A pixel's length in model units: levels more exact than
-            // that change nothing on this display.
-            let step = header.scale[axes.0].max(header.scale[axes.1]);
-            pixel = (v.grid_units_per_pixel() * step) as f32;
-            levels_visible = decoder.level_table().level_within_error(pixel) + 1;
-            v
-        });
+        // Fitted on the base level, kept for the finer ones.
+        let view = match view {
+            Some(v) => v,
+            None => {
+                let v =
+                    View::fit(decoder.positions(), axes).ok_or("the base level has no vertex")?;
+                // A pixel's length in model units: levels more exact than
+                // that change nothing on this display.
+                let step = header.scale[axes.0].max(header.scale[axes.1]);
+                pixel = (v.grid_units_per_pixel() * step) as f32;
+                levels_visible = decoder.level_table().level_within_error(pixel) + 1;
+                *view.insert(v)
+            }
+        };
         display
             .clear(BinaryColor::Off)
             .expect("framebuffers do not fail");

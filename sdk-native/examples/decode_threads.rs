@@ -18,15 +18,23 @@ use std::time::Instant;
 use splitstream_sdk_native::Session;
 
 /// Opens and decodes `stream` whole; returns the splits decoded.
-fn decode(stream: &[u8]) -> u64 {
-    let mut s = Session::open(stream).expect("a valid stream");
+fn try_decode(stream: &[u8]) -> Result<u64, splitstream_decoder_core::Error> {
+    let mut s = Session::open(stream)?;
     while let Some(k) = s.next_level() {
-        let r = s.level_range(k).expect("a level of the table");
-        s.decode_level(k, &stream[r.start as usize..r.end as usize])
-            .expect("a valid stream");
+        let r = s.level_range(k).unwrap_or(0..0);
+        let bytes = stream
+            .get(r.start as usize..r.end as usize)
+            .ok_or(splitstream_decoder_core::Error::Truncated)?;
+        s.decode_level(k, bytes)?;
     }
     let base = s.level_info(0).map_or(0, |l| l.vertex_count) as u64;
-    s.positions().len() as u64 - base
+    Ok(s.positions().len() as u64 - base)
+}
+
+/// [`try_decode`] of a stream `main` has already decoded once without error
+/// (decoding is deterministic: the same bytes decode the same way).
+fn decode(stream: &[u8]) -> u64 {
+    try_decode(stream).expect("decoded once already")
 }
 
 /// Seconds to decode `copies` copies on `threads` threads, and the splits.
@@ -86,7 +94,8 @@ fn main() {
             std::process::exit(1);
         }
     };
-    if let Err(e) = Session::open(&stream) {
+    // A bad stream is reported here, once, before any timed decode.
+    if let Err(e) = try_decode(&stream) {
         eprintln!("decode_threads: {path}: {e}");
         std::process::exit(1);
     }
