@@ -64,7 +64,20 @@ if [[ ! -s "$real/jacksboro_fault_dem.npz" ]]; then
     mv "$tmp/mpl/jacksboro_fault_dem.npz" "$real/jacksboro_fault_dem.npz"
 fi
 
+# (d) glTF files written from (a) and (b) by glTF-Transform (npm
+# @gltf-transform/core), a writer the encoder's reader shares no code with;
+# gltf_samples.cjs says what each file holds.
+if [[ ! -s "$real/bunny.glb" || ! -s "$real/armadillo.gltf" || ! -s "$real/armadillo.bin" ]]; then
+    echo "fetching npm packages @gltf-transform/core and bunny" >&2
+    mkdir -p "$tmp/gltf"
+    (cd "$tmp/gltf" && npm install --silent --no-save --no-audit --no-fund \
+        @gltf-transform/core@4.5.1 bunny@1.0.1 >/dev/null)
+    NODE_PATH="$tmp/gltf/node_modules" node "$here/gltf_samples.cjs" \
+        "$tmp/gltf/node_modules/bunny" "$real/armadillo.off" "$real"
+fi
+
 echo "files in $real:"
-for f in bunny.ply armadillo.off bunny00.off refined_elephant.off jacksboro_fault_dem.npz; do
+for f in bunny.ply armadillo.off bunny00.off refined_elephant.off jacksboro_fault_dem.npz \
+    bunny.glb armadillo.gltf armadillo.bin; do
     printf '  %-26s %10s bytes\n' "$f" "$(wc -c < "$real/$f")"
 done

@@ -146,3 +146,34 @@ fn info_gives_the_memory_each_prefix_of_levels_needs() {
     assert!(memory.windows(2).all(|w| w[0] <= w[1]), "{memory:?}");
     assert_eq!(memory.last().copied(), doc["workspace_bytes"].as_u64());
 }
+
+#[test]
+fn a_decoded_glb_encodes_back_to_the_same_stream() {
+    // Geographic-sized coordinates: the GLB keeps them in the node's
+    // translation (f64 JSON) and positions relative to it (f32), so at 14
+    // bits the quantized positions come back exactly, and so does the
+    // stream. (The lattice is ignored: f32 positions are a hair off it.)
+    let input = raster();
+    let stream = input.with_file_name("glb-raster.sps");
+    let s = stream.to_str().unwrap();
+    let encode = |from: &str, to: &str| {
+        succeeded(&splitstream(&[
+            "encode",
+            from,
+            "-o",
+            to,
+            "--lattice",
+            "ignore",
+        ]))
+    };
+    encode(input.to_str().unwrap(), s);
+    let glb = input.with_file_name("glb-raster.glb");
+    succeeded(&splitstream(&["decode", s, "-o", glb.to_str().unwrap()]));
+    assert_eq!(&std::fs::read(&glb).unwrap()[..4], b"glTF");
+    let again = input.with_file_name("glb-raster-again.sps");
+    encode(glb.to_str().unwrap(), again.to_str().unwrap());
+    assert!(std::fs::read(&stream).unwrap() == std::fs::read(&again).unwrap());
+    // A wrong output extension names all three.
+    let err = one_line_error(&splitstream(&["decode", s, "-o", "out.gltf"]));
+    assert!(err.contains("must end in .ply, .obj or .glb"), "{err}");
+}

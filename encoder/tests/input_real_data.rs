@@ -84,3 +84,58 @@ fn matplotlib_jacksboro_dem() {
     );
     assert!(lo[2] >= 200.0 && hi[2] <= 1100.0, "{lo:?} {hi:?}");
 }
+
+/// Triangles as position triples, each rotated to start at its smallest
+/// position (keeping its orientation), sorted: a mesh's surface without its
+/// vertex numbering.
+fn surface(mesh: &Mesh) -> Vec<[[u64; 3]; 3]> {
+    let key = |v: u32| mesh.positions[v as usize].map(f64::to_bits);
+    let mut out: Vec<[[u64; 3]; 3]> = mesh
+        .triangles
+        .iter()
+        .map(|t| {
+            let mut k = [key(t[0]), key(t[1]), key(t[2])];
+            let first = (0..3).min_by_key(|&i| k[i]).unwrap();
+            k.rotate_left(first);
+            k
+        })
+        .collect();
+    out.sort_unstable();
+    out
+}
+
+#[test]
+fn gltf_transform_bunny_welds_into_the_ply_mesh() {
+    // glTF-Transform wrote a vertex per corner and no indices; welded by
+    // position it is bunny.ply's mesh (f32 positions in both).
+    let (Some(glb), Some(ply)) = (load("bunny.glb"), load("bunny.ply")) else {
+        return;
+    };
+    assert_eq!(glb.positions.len(), ply.positions.len());
+    assert_eq!(surface(&glb), surface(&ply));
+    check_mesh(&glb).unwrap();
+}
+
+#[test]
+fn gltf_transform_armadillo_keeps_its_node_transforms() {
+    // armadillo.gltf (external armadillo.bin) puts the OFF mesh under a
+    // node translated by (1000, -2000, 500) and a child turned a quarter
+    // about z and scaled by 2.
+    let (Some(gltf), Some(off)) = (load("armadillo.gltf"), load("armadillo.off")) else {
+        return;
+    };
+    assert_eq!(gltf.triangles, off.triangles);
+    assert_eq!(gltf.positions.len(), off.positions.len());
+    for (g, o) in gltf.positions.iter().zip(&off.positions) {
+        let o = o.map(|c| c as f32 as f64);
+        let expected = [
+            1000.0 - 2.0 * o[1],
+            -2000.0 + 2.0 * o[0],
+            500.0 + 2.0 * o[2],
+        ];
+        for k in 0..3 {
+            assert!((g[k] - expected[k]).abs() < 1e-9, "{g:?} {expected:?}");
+        }
+    }
+    check_mesh(&gltf).unwrap();
+}

@@ -21,6 +21,8 @@ fn real_meshes_roundtrip_exactly() {
         ("bunny00.off", Units::Linear),
         ("refined_elephant.off", Units::Linear),
         ("jacksboro_fault_dem.npz", Units::Geographic),
+        ("bunny.glb", Units::Linear),
+        ("armadillo.gltf", Units::Linear),
     ];
     for (file, units) in files {
         let path = dir.join(file);

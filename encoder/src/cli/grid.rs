@@ -115,13 +115,7 @@ pub fn run(args: Args) -> CliResult {
         return Err("an output file is needed: -o OUT.ply (or --bench TILE)".into());
     }
     if let Some(o) = &args.output {
-        let ext = o
-            .extension()
-            .map(|e| e.to_string_lossy().to_ascii_lowercase())
-            .unwrap_or_default();
-        if ext != "ply" && ext != "obj" {
-            return Err(format!("{}: output must end in .ply or .obj", o.display()));
-        }
+        super::output::mesh_extension(o)?;
     }
     let options = ReadOptions {
         npz_array: args.npz_array.clone(),

@@ -1,4 +1,5 @@
-//! Writing decoded meshes as binary little-endian PLY or OBJ.
+//! Writing decoded meshes as binary little-endian PLY, OBJ or glTF binary
+//! (GLB).
 
 use std::io::{BufWriter, Write};
 use std::path::Path;
@@ -11,9 +12,9 @@ pub fn mesh_extension(path: &Path) -> Result<String, String> {
         .map(|e| e.to_string_lossy().to_ascii_lowercase())
         .unwrap_or_default();
     match ext.as_str() {
-        "ply" | "obj" => Ok(ext),
+        "ply" | "obj" | "glb" => Ok(ext),
         _ => Err(format!(
-            "{}: output must end in .ply or .obj",
+            "{}: output must end in .ply, .obj or .glb",
             path.display()
         )),
     }
@@ -62,7 +63,87 @@ pub fn write_mesh(
                 writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1).map_err(io)?;
             }
         }
-        _ => return Err(format!("{name}: output must end in .ply or .obj")),
+        "glb" => w.write_all(&glb(positions, triangles)?).map_err(io)?,
+        _ => return Err(format!("{name}: output must end in .ply, .obj or .glb")),
     }
     w.flush().map_err(io)
+}
+
+/// A GLB holding one mesh: f32 positions relative to the bounding box's
+/// centre, and that centre as the node's translation. JSON numbers keep
+/// f64, so a large offset (geographic coordinates) survives in readers that
+/// compose transforms in double precision (three.js, Cesium, this crate's),
+/// where absolute f32 positions would lose it.
+fn glb(positions: &[[f64; 3]], triangles: &[[u32; 3]]) -> Result<Vec<u8>, String> {
+    let (lo, hi) = positions.iter().fold(
+        ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(lo, hi), p| {
+            (
+                std::array::from_fn(|k| lo[k].min(p[k])),
+                std::array::from_fn(|k| hi[k].max(p[k])),
+            )
+        },
+    );
+    let centre: [f64; 3] = if positions.is_empty() {
+        [0.0; 3]
+    } else {
+        std::array::from_fn(|k| (lo[k] + hi[k]) / 2.0)
+    };
+    let mut bin = Vec::with_capacity(12 * positions.len() + 12 * triangles.len());
+    let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in positions {
+        for k in 0..3 {
+            let v = (p[k] - centre[k]) as f32;
+            min[k] = min[k].min(v);
+            max[k] = max[k].max(v);
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    let position_bytes = bin.len();
+    for t in triangles {
+        for v in t {
+            bin.extend_from_slice(&v.to_le_bytes());
+        }
+    }
+    if positions.is_empty() {
+        (min, max) = ([0.0; 3], [0.0; 3]);
+    }
+    const ARRAY_BUFFER: u32 = 34962;
+    const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+    const FLOAT: u32 = 5126;
+    const UNSIGNED_INT: u32 = 5125;
+    let document = serde_json::json!({
+        "asset": { "version": "2.0", "generator": "splitstream" },
+        "scene": 0,
+        "scenes": [{ "nodes": [0] }],
+        "nodes": [{ "mesh": 0, "translation": centre }],
+        "meshes": [{ "primitives": [{ "attributes": { "POSITION": 0 }, "indices": 1 }] }],
+        "accessors": [
+            { "bufferView": 0, "componentType": FLOAT, "count": positions.len(),
+              "type": "VEC3", "min": min, "max": max },
+            { "bufferView": 1, "componentType": UNSIGNED_INT, "count": 3 * triangles.len(),
+              "type": "SCALAR" }
+        ],
+        "bufferViews": [
+            { "buffer": 0, "byteOffset": 0, "byteLength": position_bytes,
+              "target": ARRAY_BUFFER },
+            { "buffer": 0, "byteOffset": position_bytes,
+              "byteLength": bin.len() - position_bytes, "target": ELEMENT_ARRAY_BUFFER }
+        ],
+        "buffers": [{ "byteLength": bin.len() }]
+    });
+    let json = serde_json::to_vec(&document).map_err(|e| e.to_string())?;
+    if json.len() + bin.len() + 28 > u32::MAX as usize {
+        return Err("the mesh is too large for one GLB (4 GiB)".into());
+    }
+    let glb = gltf::binary::Glb {
+        header: gltf::binary::Header {
+            magic: *b"glTF",
+            version: 2,
+            length: 0, // computed by `to_vec`
+        },
+        json: json.into(),
+        bin: Some(bin.into()),
+    };
+    glb.to_vec().map_err(|e| e.to_string())
 }

@@ -8,8 +8,9 @@ use std::fmt;
 use std::io;
 
 /// Every extension `read_mesh` understands, for the unknown-extension message.
-pub const SUPPORTED_EXTENSIONS: &[&str] =
-    &["ply", "obj", "off", "tif", "tiff", "asc", "npy", "npz"];
+pub const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "ply", "obj", "off", "gltf", "glb", "tif", "tiff", "asc", "npy", "npz",
+];
 
 /// Why a file could not be turned into a [`crate::Mesh`].
 #[derive(Debug)]

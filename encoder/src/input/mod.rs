@@ -2,8 +2,8 @@
 //! checking that a mesh is something the encoder can stream, optionally
 //! repairing it, and generating synthetic terrain for benchmarks.
 //!
-//! One file per job: a reader per format (`ply`, `obj`, `off`, `esri`,
-//! `npy`, `geotiff`), `grid` for raster triangulation, `check` and `repair`
+//! One file per job: a reader per format (`ply`, `obj`, `off`, `gltf`,
+//! `esri`, `npy`, `geotiff`), `grid` for raster triangulation, `check` and `repair`
 //! for mesh validity, `terrain` for the synthetic DEM.
 
 mod check;
@@ -11,6 +11,7 @@ mod csr;
 mod error;
 mod esri;
 mod geotiff;
+mod gltf;
 mod grid;
 mod npy;
 mod obj;
@@ -59,7 +60,8 @@ impl Default for ReadOptions {
 }
 
 /// Reads a mesh or an elevation grid, choosing the format by extension
-/// (case-insensitive): `.ply`, `.obj`, `.off`, `.tif`/`.tiff` (GeoTIFF),
+/// (case-insensitive): `.ply`, `.obj`, `.off`, `.gltf`/`.glb` (glTF 2.0, the
+/// default scene, welded by position), `.tif`/`.tiff` (GeoTIFF),
 /// `.asc` (ESRI ASCII grid), `.npy`, `.npz`. Grids become meshes through
 /// [`grid_to_mesh`]. The mesh is not checked: call [`check_mesh`].
 pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<Mesh, InputError> {
@@ -72,6 +74,7 @@ pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<Mesh, InputError>
         "ply" => ply::read(path, &file)?,
         "obj" => obj::read(path, &file)?,
         "off" => off::read(path, &file)?,
+        "gltf" | "glb" => gltf::read(path, &file)?,
         "tif" | "tiff" => grid_to_mesh(&apply_spacing(geotiff::read(path, &file)?, options)),
         "asc" => grid_to_mesh(&apply_spacing(esri::read(path, &file)?, options)),
         "npy" => grid_to_mesh(&apply_spacing(npy::read_npy(path, &file)?, options)),
