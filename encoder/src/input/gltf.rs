@@ -512,7 +512,19 @@ impl<'a> Reader<'a> {
                 component,
                 components,
             )?,
-            None if accessor.sparse.is_some() => vec![0.0; count.saturating_mul(components)],
+            // Sparse values over zeros: nothing bounds the count but the
+            // memory, so ask for it rather than abort.
+            None if accessor.sparse.is_some() => {
+                let mut zeros = Vec::new();
+                count
+                    .checked_mul(components)
+                    .filter(|&n| zeros.try_reserve_exact(n).is_ok())
+                    .map(|n| zeros.resize(n, 0.0))
+                    .ok_or_else(|| {
+                        self.element(name.clone(), format!("count {count} is too large"))
+                    })?;
+                zeros
+            }
             None => return Err(self.element(name, "has neither bufferView nor sparse data")),
         };
         if let Some(sparse) = &accessor.sparse {
@@ -1041,6 +1053,14 @@ mod tests {
             (
                 square_indexed(json!({"buffers": [{"uri": "data:text/plain,abc"}]})),
                 "buffer 0: data URI is not base64",
+            ),
+            (
+                square_indexed(
+                    json!({"accessors": [{"bufferView": null, "count": 4_000_000_000_000_000u64,
+                    "sparse": {"count": 1, "indices": {"bufferView": 1, "componentType": 5123},
+                               "values": {"bufferView": 0}}}]}),
+                ),
+                "accessor 0: count 4000000000000000 is too large",
             ),
             (
                 square_indexed(json!({"buffers": [{"uri": "https://example.com/a.bin"}]})),
