@@ -4,14 +4,17 @@
 //
 //   npm install --prefix /tmp/draco draco3d@1.5.9
 //   NODE_PATH=/tmp/draco/node_modules node encoder/benches/draco_levels.mjs \
-//       STREAM.sps [--splitstream BIN] [--bits 14]
+//       STREAM.sps [--splitstream BIN] [--bits 14] [--metres]
 //
 // Every level k is decoded (`splitstream decode --level k`, binary PLY) and
 // encoded with Draco's edgebreaker at speed 0 (compression level 10) and
 // speed 5 (its default), positions quantized to --bits (Draco's one step for
 // all axes over the largest extent). A client showing levels 0..k from
 // Draco downloads each level's file whole; a splitstream client downloads
-// the stream's prefix up to level k.
+// the stream's prefix up to level k. `--metres`: x and y are longitude and
+// latitude in degrees (a stream encoded with --geographic), converted to
+// metres about the centre first, since Draco's one step for all axes would
+// otherwise be sized by the heights and flatten x and y.
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { createRequire } from 'node:module';
@@ -28,9 +31,11 @@ const option = (name, fallback) => {
 };
 const bin = option('--splitstream', 'target/release/splitstream');
 const bits = Number(option('--bits', '14'));
+const metresAt = args.indexOf('--metres');
+const metres = metresAt >= 0 && args.splice(metresAt, 1).length > 0;
 const stream = args[0];
 if (!stream) {
-  console.error('usage: draco_levels.mjs STREAM.sps [--splitstream BIN] [--bits 14]');
+  console.error('usage: draco_levels.mjs STREAM.sps [--splitstream BIN] [--bits 14] [--metres]');
   process.exit(2);
 }
 
@@ -42,8 +47,24 @@ function readPly(path) {
   const header = data.subarray(0, end).toString('ascii');
   const vertices = Number(/element vertex (\d+)/.exec(header)[1]);
   const faces = Number(/element face (\d+)/.exec(header)[1]);
-  const positions = new Float32Array(3 * vertices);
-  for (let i = 0; i < 3 * vertices; i++) positions[i] = data.readDoubleLE(end + 8 * i);
+  const f64 = new Float64Array(3 * vertices);
+  for (let i = 0; i < 3 * vertices; i++) f64[i] = data.readDoubleLE(end + 8 * i);
+  if (metres) {
+    // About the centre, on a sphere: metres per degree of longitude and
+    // latitude there.
+    const mid = (k) => {
+      let [lo, hi] = [Infinity, -Infinity];
+      for (let i = k; i < f64.length; i += 3) [lo, hi] = [Math.min(lo, f64[i]), Math.max(hi, f64[i])];
+      return (lo + hi) / 2;
+    };
+    const [x0, y0] = [mid(0), mid(1)];
+    const sx = 111320 * Math.cos((y0 * Math.PI) / 180);
+    for (let i = 0; i < f64.length; i += 3) {
+      f64[i] = (f64[i] - x0) * sx;
+      f64[i + 1] = (f64[i + 1] - y0) * 110540;
+    }
+  }
+  const positions = Float32Array.from(f64);
   const triangles = new Uint32Array(3 * faces);
   let at = end + 24 * vertices;
   for (let f = 0; f < faces; f++, at += 13) {
