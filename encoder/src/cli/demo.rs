@@ -3,7 +3,6 @@
 use std::time::Instant;
 
 use splitstream_decoder_core::owned::OwnedWorkspace;
-use splitstream_decoder_core::PositionMode;
 use splitstream_encoder::emit::{EncodeOptions, encode_auto_position};
 use splitstream_encoder::input::fractal_terrain;
 
@@ -45,16 +44,10 @@ pub fn run(side: usize, output: Option<&std::path::Path>) -> CliResult {
         encoded.simplify_seconds,
         encoded.emit_seconds,
     );
-    let exact = super::encode::lattice_axes(encoded.on_lattice);
-    let mode = match mode {
-        PositionMode::Optimal => "optimal",
-        PositionMode::Constrained => "constrained",
-    };
-    if exact.is_empty() {
-        println!("positions: {mode}");
-    } else {
-        println!("positions: {mode}; {exact} on the raster's lattice (exact)");
-    }
+    println!(
+        "{}",
+        super::encode::positions_line(mode, encoded.on_lattice)
+    );
     let fail = |e: splitstream_decoder_core::Error| format!("demo stream: {e}");
     let mut ws = OwnedWorkspace::for_stream(stream).map_err(fail)?;
     let mut decoder = ws.decoder(stream).map_err(fail)?;

@@ -196,21 +196,27 @@ pub fn run(a: Args) -> CliResult {
         encoded.level_vertex_counts.len(),
         encoded.rounds,
     );
-    let exact = lattice_axes(encoded.on_lattice);
-    let mode = match mode {
-        PositionMode::Optimal => "optimal",
-        PositionMode::Constrained => "constrained",
-    };
-    if exact.is_empty() {
-        println!("positions: {mode}");
-    } else {
-        println!("positions: {mode}; {exact} on the input's own lattice (exact)");
-    }
+    println!("{}", positions_line(mode, encoded.on_lattice));
     println!(
         "time: read+check {:.2} s, simplify {:.2} s, emit {:.2} s",
         read_seconds, encoded.simplify_seconds, encoded.emit_seconds
     );
     Ok(())
+}
+
+/// `positions: MODE[; AXES on the input's own lattice (exact)]`, the line
+/// `encode` and `demo` print about positions.
+pub fn positions_line(mode: PositionMode, on_lattice: [bool; 3]) -> String {
+    let mode = match mode {
+        PositionMode::Optimal => "optimal",
+        PositionMode::Constrained => "constrained",
+    };
+    let exact = lattice_axes(on_lattice);
+    if exact.is_empty() {
+        format!("positions: {mode}")
+    } else {
+        format!("positions: {mode}; {exact} on the input's own lattice (exact)")
+    }
 }
 
 /// The names of the axes on their lattice, as "x, y" ("" when none).

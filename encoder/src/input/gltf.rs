@@ -962,12 +962,9 @@ mod tests {
         assert_eq!(read_doc(&doc).unwrap().positions[3], [0., 2., 0.]);
     }
 
-    #[test]
-    fn glb_and_external_buffers() {
-        // The same square as GLB (buffer 0 = the binary chunk) and as JSON
-        // with an external, percent-encoded file name.
-        let mut bin = f32_bytes(&SQUARE);
-        bin.extend_from_slice(&[0, 1, 2, 0, 2, 3]);
+    /// The square as a GLB whose binary chunk `bin` holds its f32 positions
+    /// then its u8 indices; returns the JSON document too.
+    fn square_glb(bin: &[u8]) -> (Value, Vec<u8>) {
         let mut doc = square_indexed(json!({}));
         doc["bufferViews"] = json!([
             {"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 6}
@@ -981,10 +978,20 @@ mod tests {
                 length: 0,
             },
             json: doc.to_string().into_bytes().into(),
-            bin: Some(bin.clone().into()),
+            bin: Some(bin.to_vec().into()),
         }
         .to_vec()
         .unwrap();
+        (doc, glb)
+    }
+
+    #[test]
+    fn glb_and_external_buffers() {
+        // The same square as GLB (buffer 0 = the binary chunk) and as JSON
+        // with an external, percent-encoded file name.
+        let mut bin = f32_bytes(&SQUARE);
+        bin.extend_from_slice(&[0, 1, 2, 0, 2, 3]);
+        let (mut doc, glb) = square_glb(&bin);
         let f = TempFile::new("square.glb", &glb);
         let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
@@ -1108,23 +1115,7 @@ mod tests {
     fn truncated_and_mutated_glb_never_panic() {
         let mut bin = f32_bytes(&SQUARE);
         bin.extend_from_slice(&[0, 1, 2, 0, 2, 3, 0, 0]);
-        let mut doc = square_indexed(json!({}));
-        doc["bufferViews"] = json!([
-            {"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 6}
-        ]);
-        doc["accessors"][1]["componentType"] = json!(5121);
-        doc["buffers"] = json!([{"byteLength": 56}]);
-        let glb = gltf::binary::Glb {
-            header: gltf::binary::Header {
-                magic: *b"glTF",
-                version: 2,
-                length: 0,
-            },
-            json: doc.to_string().into_bytes().into(),
-            bin: Some(bin.into()),
-        }
-        .to_vec()
-        .unwrap();
+        let (_, glb) = square_glb(&bin);
         assert!(parse(&glb, None, "m.glb").is_ok());
         for cut in 0..glb.len() {
             let _ = parse(&glb[..cut], None, "m.glb");

@@ -7,27 +7,17 @@
 // and must end on the manifest's state hash with the mesh on screen; a
 // corrupt stream must show the decoder's error class.
 import assert from 'node:assert/strict';
-import { existsSync, readFileSync, readdirSync } from 'node:fs';
 import { createRequire } from 'node:module';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { join, resolve } from 'node:path';
 
 import { serve } from '../../examples/viewer/serve.mjs';
+import { newestVectors, root } from '../vectors.mjs';
 
-const here = dirname(fileURLToPath(import.meta.url));
-const root = resolve(here, '../../..');
 const pkgDir = resolve(process.argv[2] ?? '');
 const deps = resolve(process.env.SPLITSTREAM_BROWSER_DEPS ?? '');
 const { chromium } = createRequire(join(deps, 'package.json'))('playwright-core');
 
-const vectorsRoot = join(root, 'conformance/vectors');
-const version = (v) => v.split('.').map(Number);
-const newest = readdirSync(vectorsRoot)
-  .filter((d) => existsSync(join(vectorsRoot, d, 'manifest.json')))
-  .sort((a, b) => version(a)[0] - version(b)[0] || version(a)[1] - version(b)[1])
-  .pop();
-const dir = join(vectorsRoot, newest);
-const manifest = JSON.parse(readFileSync(join(dir, 'manifest.json'), 'utf8'));
+const { dir, manifest } = newestVectors();
 const vector = (name) => manifest.vectors.find((v) => v.name === name);
 
 const { server, url, log } = await serve({

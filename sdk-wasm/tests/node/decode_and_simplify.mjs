@@ -6,30 +6,18 @@
 // round) and checks the state hashes and error classes of manifest.json;
 // then simplifies grid tiles.
 import assert from 'node:assert/strict';
-import { readFileSync, readdirSync, existsSync } from 'node:fs';
+import { readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { join, resolve } from 'node:path';
 
-const here = dirname(fileURLToPath(import.meta.url));
-const root = resolve(here, '../../..');
+import { newestVectors } from '../vectors.mjs';
+
 const pkgDir = resolve(process.argv[2] ?? process.env.SPLITSTREAM_WASM_PKG ?? '');
 const require = createRequire(import.meta.url);
 const sdk = require(join(pkgDir, 'splitstream_sdk_wasm.js'));
 const { StreamDecoder, GridSimplifier } = sdk;
 
-// The newest vector set: conformance/vectors/<major.minor>/manifest.json.
-const vectorsRoot = join(root, 'conformance/vectors');
-const version = (v) => v.split('.').map(Number);
-const sets = readdirSync(vectorsRoot)
-  .filter((d) => existsSync(join(vectorsRoot, d, 'manifest.json')))
-  .sort((a, b) => {
-    const [x, y] = [version(a), version(b)];
-    return x[0] - y[0] || x[1] - y[1];
-  });
-assert.ok(sets.length > 0, 'no conformance vector set');
-const dir = join(vectorsRoot, sets[sets.length - 1]);
-const manifest = JSON.parse(readFileSync(join(dir, 'manifest.json'), 'utf8'));
+const { version: set, dir, manifest } = newestVectors();
 
 // Decodes like a browser; `rounds` says which levels go round by round.
 // Returns the hashes seen after the seed and each round (round levels only).
@@ -163,4 +151,4 @@ assert.ok(valid >= 5, 'too few valid vectors');
   console.log(`grid: ${st.cells} -> ${st.rectangles} facets, ${st.trianglesAfter} triangles, max error ${st.maxVerticalError.toFixed(3)} (${st.maxErrorRatio.toFixed(3)} T)`);
 }
 
-console.log(`sdk-wasm node test: ${valid} valid and ${invalid} invalid vectors of ${sets[sets.length - 1]} as the manifest says; grid tiles ok`);
+console.log(`sdk-wasm node test: ${valid} valid and ${invalid} invalid vectors of ${set} as the manifest says; grid tiles ok`);

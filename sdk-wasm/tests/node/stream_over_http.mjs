@@ -8,27 +8,18 @@
 // only the coarse levels fetches only those; a server that ignores ranges
 // costs one download; a corrupt stream throws the decoder's error class.
 import assert from 'node:assert/strict';
-import { readFileSync, readdirSync, existsSync } from 'node:fs';
+import { readFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
-import { dirname, join, resolve } from 'node:path';
-import { fileURLToPath } from 'node:url';
+import { join, resolve } from 'node:path';
 
 import { ProgressiveMesh } from '../../examples/viewer/stream.mjs';
 import { serve } from '../../examples/viewer/serve.mjs';
+import { newestVectors } from '../vectors.mjs';
 
-const here = dirname(fileURLToPath(import.meta.url));
-const root = resolve(here, '../../..');
 const pkgDir = resolve(process.argv[2] ?? process.env.SPLITSTREAM_WASM_PKG ?? '');
 const { StreamDecoder } = createRequire(import.meta.url)(join(pkgDir, 'splitstream_sdk_wasm.js'));
 
-const vectorsRoot = join(root, 'conformance/vectors');
-const version = (v) => v.split('.').map(Number);
-const newest = readdirSync(vectorsRoot)
-  .filter((d) => existsSync(join(vectorsRoot, d, 'manifest.json')))
-  .sort((a, b) => version(a)[0] - version(b)[0] || version(a)[1] - version(b)[1])
-  .pop();
-const dir = join(vectorsRoot, newest);
-const manifest = JSON.parse(readFileSync(join(dir, 'manifest.json'), 'utf8'));
+const { dir, manifest } = newestVectors();
 
 const { server, url, log } = await serve({ '/v/': dir });
 try {
