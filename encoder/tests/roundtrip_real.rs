@@ -23,6 +23,7 @@ fn real_meshes_roundtrip_exactly() {
         ("jacksboro_fault_dem.npz", Units::Geographic),
         ("bunny.glb", Units::Linear),
         ("armadillo.gltf", Units::Linear),
+        ("refined_elephant.stl", Units::Linear),
     ];
     for (file, units) in files {
         let path = dir.join(file);

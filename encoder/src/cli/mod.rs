@@ -150,8 +150,8 @@ pub enum Codec {
 
 #[derive(Subcommand)]
 pub enum Command {
-    /// Encode a mesh (.ply .obj .off .gltf .glb) or elevation grid (.tif .asc
-    /// .npy .npz).
+    /// Encode a mesh (.ply .obj .off .gltf .glb .stl) or elevation grid (.tif
+    /// .asc .npy .npz).
     Encode(encode::Args),
     /// Decode a stream to .ply, .obj or .glb, in decoded vertex order.
     Decode {

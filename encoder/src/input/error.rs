@@ -9,7 +9,7 @@ use std::io;
 
 /// Every extension `read_mesh` understands, for the unknown-extension message.
 pub const SUPPORTED_EXTENSIONS: &[&str] = &[
-    "ply", "obj", "off", "gltf", "glb", "tif", "tiff", "asc", "npy", "npz",
+    "ply", "obj", "off", "gltf", "glb", "stl", "tif", "tiff", "asc", "npy", "npz",
 ];
 
 /// Why a file could not be turned into a [`crate::Mesh`].

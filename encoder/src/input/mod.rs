@@ -3,7 +3,7 @@
 //! repairing it, and generating synthetic terrain for benchmarks.
 //!
 //! One file per job: a reader per format (`ply`, `obj`, `off`, `gltf`,
-//! `esri`, `npy`, `geotiff`), `grid` for raster triangulation, `check` and `repair`
+//! `stl`, `esri`, `npy`, `geotiff`), `grid` for raster triangulation, `check` and `repair`
 //! for mesh validity, `terrain` for the synthetic DEM.
 
 mod check;
@@ -20,6 +20,7 @@ mod ply;
 mod read_grid;
 mod repair;
 mod shapes;
+mod stl;
 mod terrain;
 
 use std::path::Path;
@@ -61,7 +62,8 @@ impl Default for ReadOptions {
 
 /// Reads a mesh or an elevation grid, choosing the format by extension
 /// (case-insensitive): `.ply`, `.obj`, `.off`, `.gltf`/`.glb` (glTF 2.0, the
-/// default scene, welded by position), `.tif`/`.tiff` (GeoTIFF),
+/// default scene, welded by position), `.stl` (binary or ascii, welded by
+/// position), `.tif`/`.tiff` (GeoTIFF),
 /// `.asc` (ESRI ASCII grid), `.npy`, `.npz`. Grids become meshes through
 /// [`grid_to_mesh`]. The mesh is not checked: call [`check_mesh`].
 pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<Mesh, InputError> {
@@ -75,6 +77,7 @@ pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<Mesh, InputError>
         "obj" => obj::read(path, &file)?,
         "off" => off::read(path, &file)?,
         "gltf" | "glb" => gltf::read(path, &file)?,
+        "stl" => stl::read(path, &file)?,
         "tif" | "tiff" => grid_to_mesh(&apply_spacing(geotiff::read(path, &file)?, options)),
         "asc" => grid_to_mesh(&apply_spacing(esri::read(path, &file)?, options)),
         "npy" => grid_to_mesh(&apply_spacing(npy::read_npy(path, &file)?, options)),
@@ -181,11 +184,11 @@ mod tests {
 
     #[test]
     fn unknown_extension_lists_supported_ones() {
-        let f = TempFile::new("mesh.stl", b"solid");
+        let f = TempFile::new("mesh.fbx", b"Kaydara FBX Binary");
         let err = read_mesh(&f.0, &ReadOptions::default()).unwrap_err();
         assert!(matches!(err, InputError::UnknownExtension { .. }));
         let msg = err.to_string();
-        assert!(msg.contains("'.stl'") && msg.contains(".npz"), "{msg}");
+        assert!(msg.contains("'.fbx'") && msg.contains(".npz"), "{msg}");
         let err = read_mesh(Path::new("noext"), &ReadOptions::default()).unwrap_err();
         assert!(err.to_string().contains("no file extension"));
     }
