@@ -17,7 +17,8 @@
 //! encoder streams positions only, so vertices at exactly the same world
 //! position are welded into one: input vertex ids (as `--permutation`
 //! reports them) number the distinct positions in the order they are first
-//! met (scene order, then primitive order, then accessor order).
+//! met (scene order, then primitive order, then accessor order). Vertices
+//! no triangle uses are left out.
 //!
 //! `gltf-json` parses the schema; the accessors are read here with every
 //! range checked, because the `gltf` crate's own readers assume a validated
@@ -227,6 +228,41 @@ fn local_transform(node: &Value, index: usize, file: &str) -> Result<Matrix, Inp
     Ok(m)
 }
 
+/// A primitive's triangles as corner indices, in the specification's
+/// order for each mode; strips and fans skip the triangles with a repeated
+/// index they use as joints, lists keep them for the checker.
+fn triangles(mode: Mode, corners: &[u32]) -> Vec<[u32; 3]> {
+    let joint = |t: &[u32; 3]| t[0] == t[1] || t[1] == t[2] || t[0] == t[2];
+    match mode {
+        Mode::Triangles => corners
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect(),
+        // {v_i, v_i+(1+i%2), v_i+(2-i%2)}
+        Mode::TriangleStrip => corners
+            .windows(3)
+            .enumerate()
+            .map(|(i, c)| {
+                if i % 2 == 0 {
+                    [c[0], c[1], c[2]]
+                } else {
+                    [c[0], c[2], c[1]]
+                }
+            })
+            .filter(|t| !joint(t))
+            .collect(),
+        // {v_i+1, v_i+2, v_0}
+        Mode::TriangleFan => corners
+            .get(1..)
+            .unwrap_or_default()
+            .windows(2)
+            .map(|c| [c[0], c[1], corners[0]])
+            .filter(|t| !joint(t))
+            .collect(),
+        _ => Vec::new(),
+    }
+}
+
 struct Reader<'a> {
     file: &'a str,
     root: &'a json::Root,
@@ -341,71 +377,49 @@ impl<'a> Reader<'a> {
                 .get(&Checked::Valid(Semantic::Positions))
                 .ok_or_else(|| self.element(name(), "no POSITION attribute"))?;
             let local = self.positions(position.value())?;
-            let ids = self.weld(&local, world)?;
             let corners = match primitive.indices {
                 Some(accessor) => self.indices(accessor.value(), local.len())?,
                 None => (0..local.len() as u32).collect(),
             };
-            self.push_triangles(mode, &corners, &ids, mirrored);
+            let triangles = triangles(mode, &corners);
+            let ids = self.weld(&local, &triangles, world)?;
+            self.mesh.triangles.extend(triangles.iter().map(|t| {
+                let t = t.map(|c| ids[c as usize]);
+                if mirrored { [t[0], t[2], t[1]] } else { t }
+            }));
         }
         Ok(())
     }
 
-    /// Maps each of a primitive's vertices to a welded id, adding new ones.
-    fn weld(&mut self, local: &[[f64; 3]], world: &Matrix) -> Result<Vec<u32>, InputError> {
-        let mut ids = Vec::with_capacity(local.len());
-        for &p in local {
+    /// Maps each vertex the triangles use to a welded id, adding new ones
+    /// in accessor order; vertices no triangle uses (a buffer shared by
+    /// primitives that each index part of it) are left out.
+    fn weld(
+        &mut self,
+        local: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        world: &Matrix,
+    ) -> Result<Vec<u32>, InputError> {
+        const UNUSED: u32 = u32::MAX;
+        let mut ids = vec![UNUSED; local.len()];
+        for &c in triangles.iter().flatten() {
+            ids[c as usize] = 0;
+        }
+        for (id, &p) in ids.iter_mut().zip(local) {
+            if *id == UNUSED {
+                continue;
+            }
             let q = transform_point(world, p);
             // +0.0 folds -0.0 into 0.0, so both weld.
             let key = q.map(|c| (c + 0.0).to_bits());
             let next = self.mesh.positions.len();
-            let id = *self.weld.entry(key).or_insert_with(|| {
+            *id = *self.weld.entry(key).or_insert_with(|| {
                 self.mesh.positions.push(q);
                 next as u32
             });
             check_vertex_count(self.file, self.mesh.positions.len() as u64)?;
-            ids.push(id);
         }
         Ok(ids)
-    }
-
-    /// Triangles of one primitive; strips and fans skip the degenerate
-    /// triangles they use as joints, lists keep them for the checker.
-    fn push_triangles(&mut self, mode: Mode, corners: &[u32], ids: &[u32], mirrored: bool) {
-        let v = |c: u32| ids[c as usize];
-        let mut push = |t: [u32; 3], joint_ok: bool| {
-            if joint_ok && (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) {
-                return;
-            }
-            self.mesh
-                .triangles
-                .push(if mirrored { [t[0], t[2], t[1]] } else { t });
-        };
-        match mode {
-            Mode::Triangles => {
-                for c in corners.chunks_exact(3) {
-                    push([v(c[0]), v(c[1]), v(c[2])], false);
-                }
-            }
-            Mode::TriangleStrip => {
-                for i in 0..corners.len().saturating_sub(2) {
-                    let c = &corners[i..i + 3];
-                    // The specification's {v_i, v_i+(1+i%2), v_i+(2-i%2)}.
-                    let t = if i % 2 == 0 {
-                        [v(c[0]), v(c[1]), v(c[2])]
-                    } else {
-                        [v(c[0]), v(c[2]), v(c[1])]
-                    };
-                    push(t, true);
-                }
-            }
-            Mode::TriangleFan => {
-                for i in 1..corners.len().saturating_sub(1) {
-                    push([v(corners[i]), v(corners[i + 1]), v(corners[0])], true);
-                }
-            }
-            _ => {}
-        }
     }
 
     /// A POSITION accessor's values: float, or integers (normalized or not)
@@ -819,6 +833,36 @@ mod tests {
             assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
             check_mesh(&m).unwrap();
         }
+    }
+
+    #[test]
+    fn vertices_no_triangle_uses_are_left_out() {
+        // Two primitives share one POSITION accessor of six vertices and
+        // index a triangle each; vertices 1 and 4 are used by neither.
+        let positions = [
+            0., 0., 0., 9., 9., 9., 1., 0., 0., 1., 1., 0., 8., 8., 8., 0., 1., 0.,
+        ];
+        let indices: Vec<u8> = vec![0, 2, 3, 0, 3, 5];
+        let mut doc = document(&f32_bytes(&positions), Some((&indices, 5121)), json!({}));
+        doc["bufferViews"][1]["byteLength"] = json!(3);
+        doc["bufferViews"].as_array_mut().unwrap().push(json!(
+            {"buffer": 0, "byteOffset": 72 + 3, "byteLength": 3}
+        ));
+        doc["accessors"][1]["count"] = json!(3);
+        doc["accessors"].as_array_mut().unwrap().push(json!(
+            {"bufferView": 2, "componentType": 5121, "count": 3, "type": "SCALAR"}
+        ));
+        doc["meshes"][0]["primitives"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({"attributes": {"POSITION": 0}, "indices": 2}));
+        let m = read_doc(&doc).unwrap();
+        assert_eq!(
+            m.positions,
+            vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]]
+        );
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        check_mesh(&m).unwrap();
     }
 
     #[test]
