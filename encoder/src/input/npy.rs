@@ -22,7 +22,72 @@ use npyz::{DType, NpyFile, Order, TypeChar};
 use super::grid::Grid;
 use super::{InputError, check_vertex_count};
 
+/// numpy's own bound on a header's length (`_MAX_HEADER_SIZE` since numpy
+/// 1.24, which refuses longer ones for the same reason as below).
+const MAX_HEADER_BYTES: u32 = 10_000;
+
+/// How deep a header may nest brackets: its dict holds the shape tuple,
+/// and a structured dtype's list of tuples at most.
+const MAX_HEADER_DEPTH: usize = 3;
+
+/// Refuses a header that npyz's literal parser would take exponential time
+/// on (py_literal backtracks: each level of nesting doubled the time, so a
+/// 40-byte file took hours; found by fuzzing) or that numpy would refuse.
+/// A header too short to say is left to npyz, which reports it.
+fn check_header<R: Read>(mut r: R) -> Result<(), String> {
+    let mut preamble = [0u8; 8];
+    if r.read_exact(&mut preamble).is_err() || &preamble[..6] != b"\x93NUMPY" {
+        return Ok(());
+    }
+    let len = match preamble[6] {
+        1 => {
+            let mut b = [0u8; 2];
+            if r.read_exact(&mut b).is_err() {
+                return Ok(());
+            }
+            u16::from_le_bytes(b) as u32
+        }
+        2 | 3 => {
+            let mut b = [0u8; 4];
+            if r.read_exact(&mut b).is_err() {
+                return Ok(());
+            }
+            u32::from_le_bytes(b)
+        }
+        _ => return Ok(()),
+    };
+    if len > MAX_HEADER_BYTES {
+        return Err(format!(
+            "header of {len} bytes (numpy reads at most {MAX_HEADER_BYTES})"
+        ));
+    }
+    let mut header = Vec::with_capacity(len as usize);
+    r.take(len as u64)
+        .read_to_end(&mut header)
+        .map_err(|e| e.to_string())?;
+    let (mut depth, mut deepest) = (0usize, 0usize);
+    for b in header {
+        match b {
+            b'(' | b'[' | b'{' => {
+                depth += 1;
+                deepest = deepest.max(depth);
+            }
+            b')' | b']' | b'}' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    if deepest > MAX_HEADER_DEPTH {
+        return Err(format!(
+            "header nests brackets {deepest} deep (at most {MAX_HEADER_DEPTH})"
+        ));
+    }
+    Ok(())
+}
+
 pub(super) fn read_npy(path: &Path, file: &str) -> Result<Grid, InputError> {
+    let invalid = |m: String| InputError::malformed(file, format!("invalid .npy: {m}"));
+    let f = File::open(path).map_err(|e| InputError::io(file, e))?;
+    check_header(BufReader::new(&f)).map_err(invalid)?;
     let f = File::open(path).map_err(|e| InputError::io(file, e))?;
     let npy = NpyFile::new(BufReader::new(f))
         .map_err(|e| InputError::malformed(file, format!("invalid .npy: {e}")))?;
@@ -139,7 +204,11 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
             .by_index(i)
             .map_err(|e| InputError::malformed(file, format!("invalid .npz: {e}")))?;
         if let Some(name) = npyz::npz::array_name_from_file_name(entry.name()) {
-            names.push(name.to_owned());
+            let name = name.to_owned();
+            check_header(entry).map_err(|m| {
+                InputError::malformed(file, format!("invalid .npz: array '{name}': {m}"))
+            })?;
+            names.push(name);
         }
     }
 
@@ -335,6 +404,42 @@ mod tests {
                 "{msg}"
             );
         }
+    }
+
+    /// Found by fuzzing (`encoder/fuzz`, `read_input`): npyz parses the
+    /// header with py_literal, whose parser backtracks, so each level of
+    /// nesting doubled the time: 20 open brackets took 5.6 s, 30 would take
+    /// hours. Such headers are refused before npyz sees them.
+    #[test]
+    fn deeply_nested_header_is_refused_at_once() {
+        let deep = |depth: usize, tail: &str| {
+            let header = format!("{{'descr': {}{tail}\n", "[".repeat(depth));
+            let mut bytes = b"\x93NUMPY\x01\x00".to_vec();
+            bytes.extend((header.len() as u16).to_le_bytes());
+            bytes.extend(header.as_bytes());
+            bytes
+        };
+        for bytes in [deep(30, ""), deep(4, "]]]]")] {
+            let f = TempFile::new("deep.npy", &bytes);
+            let t = std::time::Instant::now();
+            let msg = read_npy(&f.0, "deep.npy").unwrap_err().to_string();
+            assert!(t.elapsed().as_secs() < 1);
+            assert!(
+                msg.starts_with("deep.npy: invalid .npy: header nests brackets"),
+                "{msg}"
+            );
+            // The same inside an archive.
+            let f = TempFile::new("deep.npz", &npz(&[("elevation.npy", bytes)]));
+            let msg = read_npz(&f.0, "deep.npz", None).unwrap_err().to_string();
+            assert!(msg.contains("header nests brackets"), "{msg}");
+        }
+        // A header longer than numpy itself reads.
+        let mut bytes = b"\x93NUMPY\x02\x00".to_vec();
+        bytes.extend(20_000u32.to_le_bytes());
+        bytes.extend(vec![b' '; 20_000]);
+        let f = TempFile::new("long.npy", &bytes);
+        let msg = read_npy(&f.0, "long.npy").unwrap_err().to_string();
+        assert!(msg.contains("header of 20000 bytes"), "{msg}");
     }
 
     fn npz(entries: &[(&str, Vec<u8>)]) -> Vec<u8> {
