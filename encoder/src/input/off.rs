@@ -79,7 +79,9 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
     let nf = parse_count(file, counts_line, counts.next(), "face count")?;
     check_vertex_count(file, nv as u64)?;
 
-    let mut positions = Vec::with_capacity(nv.min(1 << 24));
+    // At most one vertex per 6 bytes ("0 0 0\n") and one face per 8: the
+    // counts in the header reserve no more than the text can hold.
+    let mut positions = Vec::with_capacity(nv.min(text.len() / 6));
     let mut last_line = counts_line;
     for i in 0..nv {
         let (n, l) = lines.next().ok_or_else(|| {
@@ -108,7 +110,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
         positions.push(p);
     }
 
-    let mut triangles = Vec::with_capacity(nf.min(1 << 24));
+    let mut triangles = Vec::with_capacity(nf.min(text.len() / 8));
     let mut scratch = Vec::new();
     for i in 0..nf {
         let (n, l) = lines.next().ok_or_else(|| {
@@ -121,7 +123,9 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
         last_line = n;
         let mut tokens = l.split_whitespace();
         let count = parse_count(file, n, tokens.next(), "face vertex count")?;
-        let mut indices = Vec::with_capacity(count);
+        // The line holds at most one index per two bytes: a count beyond
+        // that fails below, without reserving memory for it first.
+        let mut indices = Vec::with_capacity(count.min(l.len() / 2));
         for _ in 0..count {
             let token = tokens.next().ok_or_else(|| {
                 InputError::line(
@@ -162,6 +166,18 @@ mod tests {
         assert_eq!(m.positions.len(), 5);
         assert_eq!(m.positions[4], [2.0, 0.5, 0.0]);
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3], [1, 4, 2]]);
+    }
+
+    /// Found by fuzzing (`encoder/fuzz`, `read_input`): a face line that
+    /// claims 888,888,888 vertices reserved 7 GB before reading them.
+    #[test]
+    fn huge_polygon_count_fails_without_reserving_it() {
+        let text = "OFF\n4 1 0\n0 0 0\n1 0 0\n888.0 0 0\n1 0 0\n888888888 3888888 3 2\n";
+        let msg = parse(text, "big.off").unwrap_err().to_string();
+        assert!(
+            msg.contains("face 0: expected 888888888 vertex indices, found 3"),
+            "{msg}"
+        );
     }
 
     #[test]
