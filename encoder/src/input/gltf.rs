@@ -31,6 +31,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use base64::Engine;
+use glam::{DMat4, DQuat, DVec3};
 use gltf::json::accessor::{ComponentType, Type};
 use gltf::json::mesh::{Mode, Semantic};
 use gltf::json::validation::Checked;
@@ -137,37 +138,6 @@ fn compressed(file: &str, extension: &str) -> InputError {
     )
 }
 
-/// A column-major 4 × 4 affine transform, as glTF stores matrices.
-type Matrix = [f64; 16];
-
-const IDENTITY: Matrix = [
-    1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
-];
-
-fn multiply(a: &Matrix, b: &Matrix) -> Matrix {
-    let mut m = [0.0; 16];
-    for col in 0..4 {
-        for row in 0..4 {
-            m[col * 4 + row] = (0..4).map(|k| a[k * 4 + row] * b[col * 4 + k]).sum();
-        }
-    }
-    m
-}
-
-fn transform_point(m: &Matrix, p: [f64; 3]) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for (row, o) in out.iter_mut().enumerate() {
-        *o = m[row] * p[0] + m[4 + row] * p[1] + m[8 + row] * p[2] + m[12 + row];
-    }
-    out
-}
-
-/// The determinant of the upper-left 3 × 3 block: negative for a mirror.
-fn determinant(m: &Matrix) -> f64 {
-    m[0] * (m[5] * m[10] - m[9] * m[6]) - m[4] * (m[1] * m[10] - m[9] * m[2])
-        + m[8] * (m[1] * m[6] - m[5] * m[2])
-}
-
 /// Numbers from a JSON array of exactly `N` numbers.
 fn numbers<const N: usize>(value: Option<&Value>) -> Option<[f64; N]> {
     let items = value?.as_array()?;
@@ -181,18 +151,20 @@ fn numbers<const N: usize>(value: Option<&Value>) -> Option<[f64; N]> {
     Some(out)
 }
 
-/// A node's local transform: `matrix`, or translation · rotation · scale.
-fn local_transform(node: &Value, index: usize, file: &str) -> Result<Matrix, InputError> {
+/// A node's local transform: `matrix` (column-major, as glTF stores it),
+/// or translation · rotation · scale.
+fn local_transform(node: &Value, index: usize, file: &str) -> Result<DMat4, InputError> {
     let bad =
         |what: &str| InputError::element(file, format!("node {index}"), format!("invalid {what}"));
     if let Some(matrix) = node.get("matrix") {
-        return numbers::<16>(Some(matrix)).ok_or_else(|| bad("matrix"));
+        let m = numbers::<16>(Some(matrix)).ok_or_else(|| bad("matrix"))?;
+        return Ok(DMat4::from_cols_array(&m));
     }
     let t = match node.get("translation") {
         Some(v) => numbers::<3>(Some(v)).ok_or_else(|| bad("translation"))?,
         None => [0.0; 3],
     };
-    let [x, y, z, w] = match node.get("rotation") {
+    let q = match node.get("rotation") {
         Some(v) => numbers::<4>(Some(v)).ok_or_else(|| bad("rotation"))?,
         None => [0.0, 0.0, 0.0, 1.0],
     };
@@ -200,32 +172,11 @@ fn local_transform(node: &Value, index: usize, file: &str) -> Result<Matrix, Inp
         Some(v) => numbers::<3>(Some(v)).ok_or_else(|| bad("scale"))?,
         None => [1.0; 3],
     };
-    // Rotation columns of the unit quaternion (x, y, z, w), each scaled.
-    let r = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y + z * w),
-            2.0 * (x * z - y * w),
-        ],
-        [
-            2.0 * (x * y - z * w),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z + x * w),
-        ],
-        [
-            2.0 * (x * z + y * w),
-            2.0 * (y * z - x * w),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
-    let mut m = IDENTITY;
-    for col in 0..3 {
-        for row in 0..3 {
-            m[col * 4 + row] = r[col][row] * s[col];
-        }
-    }
-    m[12..15].copy_from_slice(&t);
-    Ok(m)
+    Ok(DMat4::from_scale_rotation_translation(
+        DVec3::from_array(s),
+        DQuat::from_array(q),
+        DVec3::from_array(t),
+    ))
 }
 
 /// A primitive's triangles as corner indices, in the specification's
@@ -290,10 +241,12 @@ impl<'a> Reader<'a> {
     }
 
     /// Every mesh to place, with its world transform, in scene order.
-    fn instances(&self) -> Result<Vec<(usize, Matrix)>, InputError> {
+    fn instances(&self) -> Result<Vec<(usize, DMat4)>, InputError> {
         let root = self.root;
         if root.scenes.is_empty() {
-            return Ok((0..root.meshes.len()).map(|m| (m, IDENTITY)).collect());
+            return Ok((0..root.meshes.len())
+                .map(|m| (m, DMat4::IDENTITY))
+                .collect());
         }
         let scene_index = root.scene.map_or(0, |s| s.value());
         let scene = root.scenes.get(scene_index).ok_or_else(|| {
@@ -309,11 +262,11 @@ impl<'a> Reader<'a> {
         let mut visited = vec![false; root.nodes.len()];
         let mut out = Vec::new();
         // Depth-first, children in order, so ids follow the document.
-        let mut stack: Vec<(usize, Matrix)> = scene
+        let mut stack: Vec<(usize, DMat4)> = scene
             .nodes
             .iter()
             .rev()
-            .map(|n| (n.value(), IDENTITY))
+            .map(|n| (n.value(), DMat4::IDENTITY))
             .collect();
         while let Some((index, parent)) = stack.pop() {
             let node = root.nodes.get(index).ok_or_else(|| {
@@ -329,7 +282,7 @@ impl<'a> Reader<'a> {
                 ));
             }
             let raw = raw_nodes.and_then(|n| n.get(index)).unwrap_or(&Value::Null);
-            let world = multiply(&parent, &local_transform(raw, index, self.file)?);
+            let world = parent * local_transform(raw, index, self.file)?;
             if let Some(mesh) = node.mesh {
                 out.push((mesh.value(), world));
             }
@@ -340,7 +293,7 @@ impl<'a> Reader<'a> {
         Ok(out)
     }
 
-    fn add_mesh(&mut self, mesh_index: usize, world: &Matrix) -> Result<(), InputError> {
+    fn add_mesh(&mut self, mesh_index: usize, world: &DMat4) -> Result<(), InputError> {
         let root = self.root;
         let mesh = root.meshes.get(mesh_index).ok_or_else(|| {
             InputError::malformed(
@@ -351,7 +304,8 @@ impl<'a> Reader<'a> {
                 ),
             )
         })?;
-        let mirrored = determinant(world) < 0.0;
+        // Negative for a mirror (an affine matrix: its 3 × 3 part's sign).
+        let mirrored = world.determinant() < 0.0;
         for (p, primitive) in mesh.primitives.iter().enumerate() {
             let name = || format!("mesh {mesh_index} primitive {p}");
             let draco = self
@@ -398,7 +352,7 @@ impl<'a> Reader<'a> {
         &mut self,
         local: &[[f64; 3]],
         triangles: &[[u32; 3]],
-        world: &Matrix,
+        world: &DMat4,
     ) -> Result<Vec<u32>, InputError> {
         const UNUSED: u32 = u32::MAX;
         let mut ids = vec![UNUSED; local.len()];
@@ -409,7 +363,7 @@ impl<'a> Reader<'a> {
             if *id == UNUSED {
                 continue;
             }
-            let q = transform_point(world, p);
+            let q = world.transform_point3(DVec3::from_array(p)).to_array();
             // +0.0 folds -0.0 into 0.0, so both weld.
             let key = q.map(|c| (c + 0.0).to_bits());
             let next = self.mesh.positions.len();
