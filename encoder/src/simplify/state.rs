@@ -15,9 +15,12 @@ use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
 
 /// Share of refused checks above which a step checks its players' requests
-/// before they pair up (`validate`): about 0.3 % on the meshes and terrains,
-/// 20 % on a DEM read in degrees and metres.
-const VALIDATE_ABOVE: f64 = 0.02;
+/// before they pair up (`validate`): about 0.3 % on the meshes, 2–3 % on a
+/// terrain whose x and y stay on the raster's lattice, 10–20 % on a DEM read
+/// in degrees and metres (the Jacksboro DEM without `--geographic`). At
+/// 2 % the lattice terrain validated every step, 25 % of its simplification
+/// time for the same collapses (encoder/BENCHMARKS.md, Speed).
+const VALIDATE_ABOVE: f64 = 0.05;
 
 /// Split valence stored for vertices that were never produced by a collapse.
 pub const LEAF: u8 = 0xFF;
