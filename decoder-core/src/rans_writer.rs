@@ -8,6 +8,10 @@ use alloc::vec::Vec;
 use crate::limits::rans::{PROB_BITS, RAW_BITS_STEP, STATE_LOW, TOKENS};
 use crate::rans::{normalise, token_of};
 
+/// The most raw-bit steps of one value: 31 extra bits in steps of
+/// `RAW_BITS_STEP`.
+const RAW_STEPS_MAX: usize = 31usize.div_ceil(RAW_BITS_STEP as usize);
+
 /// A value and the context it is coded in.
 pub type Symbol = (u8, u32);
 
@@ -128,15 +132,19 @@ pub fn encode_chunk(symbols: &[Symbol], contexts: usize, lanes: usize) -> Vec<u8
         for &&(ctx, value) in mine.iter().rev() {
             let (token, extra, low) = token_of(value);
             // Raw bits: the decoder reads the low step first, so the
-            // encoder pushes the high steps first.
-            let mut steps = Vec::new();
+            // encoder pushes the high steps first. At most 31 extra bits:
+            // two steps (a fixed array; a Vec here allocated once per value
+            // with raw bits).
+            let mut steps = [(0u32, 0u32); RAW_STEPS_MAX];
+            let mut count = 0;
             let mut done = 0;
             while done < extra {
                 let step = (extra - done).min(RAW_BITS_STEP);
-                steps.push((step, (low >> done) & ((1 << step) - 1)));
+                steps[count] = (step, (low >> done) & ((1 << step) - 1));
+                count += 1;
                 done += step;
             }
-            for &(step, bits) in steps.iter().rev() {
+            for &(step, bits) in steps[..count].iter().rev() {
                 let x_max = (STATE_LOW >> step) << 8;
                 while x >= x_max {
                     bytes.push(x as u8);
