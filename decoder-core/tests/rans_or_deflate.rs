@@ -52,7 +52,7 @@ fn skewed_values_stay_rans() {
     let mut next = pseudo_random();
     let mut sub = SubstreamWriter::default();
     for _ in 0..100_000 {
-        let v = if next() % 8 == 0 {
+        let v = if next().is_multiple_of(8) {
             (next() % 40) as i32 - 20
         } else {
             0
@@ -73,7 +73,7 @@ fn the_choice_is_the_smaller_codec() {
     for modulus in [2u64, 5, 17, 300, 70_000] {
         let mut sub = SubstreamWriter::default();
         for i in 0..30_000u64 {
-            let v = if i % 3 == 0 {
+            let v = if i.is_multiple_of(3) {
                 next() % modulus
             } else {
                 i % modulus
