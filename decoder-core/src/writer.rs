@@ -410,8 +410,9 @@ pub fn frame_level_with(
 /// smaller kept; the level-10 trial is skipped when a level-1 deflate is at
 /// least this ratio (8/5) of the rANS size. On the real meshes, the DEM and
 /// the 1M terrain, level 10 was never below 0.62 of level 1 (so it could
-/// not have won past 1.6), and 60 % of the bytes skip the trial, which ran
-/// after the last level's replay and bounded the encoder's emission.
+/// not have won past 1.6), and half of the bytes skip the trial, which ran
+/// after the last level's replay and bounded the encoder's emission
+/// (encoder/BENCHMARKS.md, Speed).
 const DEFLATE_QUICK_RATIO: (usize, usize) = (8, 5);
 
 /// The chunks of substream `id` as `frame_level` codes them.

@@ -1,7 +1,7 @@
 //! Under the rANS codec a substream's chunks are rANS-coded or deflated at
 //! level 10, whichever is smaller (`writer`); a level-1 deflate first rules
-//! level 10 out where it cannot win. Both outcomes stay reachable, and the
-//! choice is never larger than either codec alone.
+//! level 10 out where it is far behind. Both outcomes stay reachable, and
+//! on these inputs the choice is the smaller codec.
 
 use splitstream_decoder_core::limits::substream;
 use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, SubstreamWriter, coded_len};
