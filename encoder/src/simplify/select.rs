@@ -68,7 +68,9 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
                 best = (cand, e);
             }
         }
-        best.0
+        // The error is already known: a fourth evaluation of the quadric
+        // would give the same bits.
+        return Some(best);
     } else {
         let (t, _) = collapse_target(&q, s.geometry(p), s.geometry(c), false);
         let top = ((1u64 << s.bits) - 1) as f64;
