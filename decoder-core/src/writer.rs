@@ -408,12 +408,12 @@ pub fn frame_level_with(
 
 /// Under the rANS codec a substream is deflated at level 10 too, and the
 /// smaller kept; the level-10 trial is skipped when a level-1 deflate is at
-/// least this ratio (8/5) of the rANS size. On the real meshes, the DEM and
-/// the 1M terrain, level 10 was never below 0.62 of level 1 (so it could
-/// not have won past 1.6), and half of the bytes skip the trial, which ran
-/// after the last level's replay and bounded the encoder's emission
-/// (encoder/BENCHMARKS.md, Speed).
-const DEFLATE_QUICK_RATIO: (usize, usize) = (8, 5);
+/// least this ratio (5/3) of the rANS size. On the real meshes, the DEM and
+/// the terrains, level 10 was never more than 1.62 times smaller than
+/// level 1 (two measurements, encoder/BENCHMARKS.md, Speed), so it could
+/// not have won past 5/3; about half of the bytes skip the trial, which ran
+/// after the last level's replay and bounded the encoder's emission.
+const DEFLATE_QUICK_RATIO: (usize, usize) = (5, 3);
 
 /// The chunks of substream `id` as `frame_level` codes them.
 fn substream_chunks(
