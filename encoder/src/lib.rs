@@ -6,6 +6,7 @@ pub mod emit;
 pub mod input;
 pub mod mesh;
 pub mod metrics;
+mod prefetch;
 pub mod quadric;
 pub mod quantize;
 pub mod simplify;

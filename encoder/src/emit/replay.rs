@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use super::levels::LevelPlan;
 use super::policies::{SplitResiduals, choose_policy, code_policies};
 use crate::corner_table::Fan;
+use crate::prefetch::prefetch;
 use crate::quantize::QuantizedMesh;
 use crate::simplify::{Collapse, Simplification};
 
@@ -100,6 +101,12 @@ impl Memory {
 /// Feeds one round from the collapses of one simplification step.
 struct StepSource<'a> {
     collapses: &'a [Collapse],
+    /// The decoder ids of each collapse's wings (`wing_a`, `wing_b`),
+    /// looked up before the round: the wings do not split in it, so their
+    /// ids hold for the whole round, and the look-ups, independent of one
+    /// another there, overlap their cache misses instead of each waiting
+    /// inside its record.
+    wings: &'a [[u32; 2]],
     /// For each decoder id, the index of its vertex's collapse in this step
     /// (or NONE): the decoder asks by its own ids, one look-up instead of
     /// two through `dec2enc` for every candidate.
@@ -142,8 +149,16 @@ impl RecordSource for StepSource<'_> {
         // Exactly the flags flag() will give: the candidates that collapse
         // in this step. (`current` is indexed by decoder id, as in flag();
         // indexing it by encoder id warmed the fans of unrelated vertices.)
+        // The records of the batch's collapses are asked for while their
+        // fans are walked: a collapse lies wherever the simplifier put it,
+        // so reading it in `record` was a cache miss on the replay's path.
         upcoming.iter().enumerate().fold(0, |bits, (i, &v)| {
-            bits | ((self.current[v as usize] != NONE) as u64) << i
+            let index = self.current[v as usize];
+            if index != NONE {
+                prefetch(self.collapses, index as usize);
+                prefetch(self.wings, index as usize);
+            }
+            bits | ((index != NONE) as u64) << i
         })
     }
 
@@ -152,8 +167,7 @@ impl RecordSource for StepSource<'_> {
         let col = self.collapses[index];
         let id = col.p;
         self.pending = Some(index);
-        let dec = |enc: u32, map: &[u32]| if enc == NONE { NONE } else { map[enc as usize] };
-        let (a, b) = (dec(col.wing_a, self.enc2dec), dec(col.wing_b, self.enc2dec));
+        let [a, b] = self.wings[index];
         let find = |x: u32| ring.vertices().iter().position(|&y| y == x);
         let (Some(ia), Some(ib)) = (find(a), find(b)) else {
             return Err(self.fail(format!("wings of the collapse of {id} not in the ring")));
@@ -397,6 +411,7 @@ pub fn replay(
     let seed = SeedPayload::new(&base_positions, &base_triangles, &base_deficits);
     let mut current = vec![NONE; n];
     let mut flagged = Vec::new();
+    let mut wings = Vec::new();
     let mut ring = Ring::default();
     // A level's residuals are coded under the six plane policies on one
     // thread while the level replays; choosing the policy and framing the
@@ -418,13 +433,23 @@ pub fn replay(
                 let collapses = &s.steps[k];
                 residuals.reserve_exact(collapses.len());
                 flagged.clear();
+                wings.clear();
+                let dec = |enc: u32| {
+                    if enc == NONE {
+                        NONE
+                    } else {
+                        enc2dec[enc as usize]
+                    }
+                };
                 for (i, col) in collapses.iter().enumerate() {
                     let r = enc2dec[col.p as usize];
                     current[r as usize] = i as u32;
                     flagged.push(r);
+                    wings.push([dec(col.wing_a), dec(col.wing_b)]);
                 }
                 let mut source = StepSource {
                     collapses,
+                    wings: &wings,
                     current: &mut current,
                     enc2dec: &mut enc2dec,
                     dec2enc: &mut dec2enc,
@@ -557,6 +582,7 @@ mod tests {
         let mut residuals = Vec::new();
         let mut source = StepSource {
             collapses: &[],
+            wings: &[],
             current: &mut current,
             enc2dec: &mut enc2dec,
             dec2enc: &mut dec2enc,

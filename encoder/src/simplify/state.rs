@@ -11,6 +11,7 @@ use super::select::{
     pair_key, pick_edge,
 };
 use crate::corner_table::{CornerAccess, CornerTable, Fan, NONE, collapse_in, next, prev};
+use crate::prefetch::prefetch;
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
 
@@ -1037,29 +1038,6 @@ fn take_offers(
         }
     }
     offered
-}
-
-/// Asks the cache for element `i` of `items` (all of its cache lines), where
-/// the target has a prefetch instruction; a hint, never a fault.
-#[inline(always)]
-pub(super) fn prefetch<T>(items: &[T], i: usize) {
-    #[cfg(target_arch = "x86_64")]
-    if let Some(x) = items.get(i) {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let first = (x as *const T).cast::<i8>();
-        let last = first.wrapping_add(std::mem::size_of::<T>() - 1);
-        // SAFETY: SSE is part of the x86-64 baseline, and a prefetch reads
-        // nothing the program sees and never faults.
-        unsafe {
-            _mm_prefetch::<_MM_HINT_T0>(first);
-            if std::mem::size_of::<T>() > 64 {
-                _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(64));
-            }
-            _mm_prefetch::<_MM_HINT_T0>(last);
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (items, i);
 }
 
 /// Prefetches, while the vertex at `i` of `list` is processed, what the
