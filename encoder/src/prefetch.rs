@@ -6,11 +6,21 @@
 /// the target has a prefetch instruction; a hint, never a fault.
 #[inline(always)]
 pub fn prefetch<T>(items: &[T], i: usize) {
-    #[cfg(target_arch = "x86_64")]
     if let Some(x) = items.get(i) {
+        prefetch_at(x as *const T);
+    }
+}
+
+/// Asks the cache for the `T` at `at` (all of its cache lines). A prefetch
+/// reads nothing the program sees and never faults, so any address will
+/// do; callers pass addresses inside their arrays.
+#[inline(always)]
+pub fn prefetch_at<T>(at: *const T) {
+    #[cfg(target_arch = "x86_64")]
+    {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        let first = (x as *const T).cast::<i8>();
-        let last = first.wrapping_add(std::mem::size_of::<T>() - 1);
+        let first = at.cast::<i8>();
+        let last = first.wrapping_add(std::mem::size_of::<T>().max(1) - 1);
         // SAFETY: SSE is part of the x86-64 baseline, and a prefetch reads
         // nothing the program sees and never faults.
         unsafe {
@@ -22,5 +32,5 @@ pub fn prefetch<T>(items: &[T], i: usize) {
         }
     }
     #[cfg(not(target_arch = "x86_64"))]
-    let _ = (items, i);
+    let _ = at;
 }

@@ -11,7 +11,7 @@ use super::select::{
     pair_key, pick_edge,
 };
 use crate::corner_table::{CornerAccess, CornerTable, Fan, NONE, collapse_in, next, prev};
-use crate::prefetch::prefetch;
+use crate::prefetch::{prefetch, prefetch_at};
 use crate::quadric::{Quadric, vertex_quadrics};
 use crate::quantize::QuantizedMesh;
 
@@ -1810,23 +1810,9 @@ impl<T: Copy> Raw<T> {
 
     /// [`prefetch`] of element `i` (reads nothing the program sees).
     fn prefetch(self, i: usize) {
-        #[cfg(target_arch = "x86_64")]
         if i < self.len {
-            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-            let first = self.ptr.wrapping_add(i).cast::<i8>().cast_const();
-            let last = first.wrapping_add(std::mem::size_of::<T>() - 1);
-            // SAFETY: SSE is part of the x86-64 baseline, and a prefetch
-            // never faults.
-            unsafe {
-                _mm_prefetch::<_MM_HINT_T0>(first);
-                if std::mem::size_of::<T>() > 64 {
-                    _mm_prefetch::<_MM_HINT_T0>(first.wrapping_add(64));
-                }
-                _mm_prefetch::<_MM_HINT_T0>(last);
-            }
+            prefetch_at(self.ptr.wrapping_add(i).cast_const());
         }
-        #[cfg(not(target_arch = "x86_64"))]
-        let _ = i;
     }
 
     /// # Safety
