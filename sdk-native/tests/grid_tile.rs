@@ -373,6 +373,24 @@ fn garbage_input_gives_typed_errors() {
         simplify_tile(&base, &p),
         Err(GridTileError::NeighbourMismatch { .. })
     ));
+    for (origin, spacing) in [
+        ([f64::NAN, 0.0], [1.0, 1.0]),
+        ([0.0, f64::INFINITY], [1.0, 1.0]),
+        // A finite origin whose far corner, two spacings on, is not.
+        ([f64::MAX, 0.0], [1e300, 1.0]),
+    ] {
+        assert!(matches!(
+            simplify_tile(
+                &Tile {
+                    origin,
+                    spacing,
+                    ..base
+                },
+                &params(700.0)
+            ),
+            Err(GridTileError::BadOrigin { .. })
+        ));
+    }
     // Errors print one line.
     let msg = GridTileError::NonFiniteHeight { row: 1, col: 2 }.to_string();
     assert!(!msg.contains('\n'));
@@ -449,4 +467,54 @@ fn coarser_neighbour_side_keeps_only_its_samples_and_threshold() {
     // T on the interior is the tile's own; on that side the coarse one.
     assert_eq!(stats.threshold, threshold(3000.0, d));
     assert!(threshold(3000.0, 4.0 * d) > 3.0 * stats.threshold);
+}
+
+/// Fuzz finding (`sdk-native/fuzz`, target `grid_tile`, 2026-12-03): heights
+/// of 3.2e16 with a threshold of 0.24 simplified "successfully" with a
+/// sample 6.4 thresholds off, because f64 rounding at that magnitude (one
+/// ulp is 4.0) is more than the threshold. Such a tile is now refused.
+#[test]
+fn heights_too_large_for_the_threshold_are_refused() {
+    let mut heights = vec![0.0; 25 * 25];
+    heights[0] = 32300.0 * 1e12;
+    heights[1] = 126.0 * 1e12;
+    let tile = Tile {
+        rows: 25,
+        cols: 25,
+        heights: &heights,
+        spacing: [6.0, 6.0],
+        origin: [0.0, 0.0],
+    };
+    let mut p = params(500.0);
+    p.neighbour_res[Side::West as usize] = Some(36.0);
+    let err = simplify_tile(&tile, &p).unwrap_err();
+    assert_eq!(
+        err,
+        GridTileError::BelowPrecision {
+            threshold: 0.24,
+            max_abs_height: 3.23e16
+        }
+    );
+    assert!(!err.to_string().contains('\n'));
+    // A viewing height so low that T is below any height's rounding.
+    let flat = vec![1.0; 25 * 25];
+    let flat_tile = Tile {
+        heights: &flat,
+        ..tile
+    };
+    assert!(matches!(
+        simplify_tile(&flat_tile, &params(1e-300)),
+        Err(GridTileError::BelowPrecision { .. })
+    ));
+    // Everest in metres, a threshold of 0.24 m: far inside the limit.
+    let everest: Vec<f64> = (0..25 * 25).map(|i| 8848.0 - (i % 25) as f64).collect();
+    let (_, stats) = simplify_tile(
+        &Tile {
+            heights: &everest,
+            ..tile
+        },
+        &params(500.0),
+    )
+    .unwrap();
+    assert!(stats.max_error_ratio <= 1.0 + 1e-6);
 }

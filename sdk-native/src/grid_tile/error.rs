@@ -17,6 +17,9 @@ pub enum GridTileError {
     NonFiniteHeight { row: usize, col: usize },
     /// A spacing is zero, negative zero or not finite.
     BadSpacing { dx: f64, dy: f64 },
+    /// The origin is not finite, or the tile's far corner (origin plus
+    /// the extent) is not: the vertices would come out NaN or infinite.
+    BadOrigin { x: f64, y: f64 },
     /// The viewing height is not finite and positive.
     BadViewingHeight(f64),
     /// A neighbour resolution is not finite and positive.
@@ -29,6 +32,13 @@ pub enum GridTileError {
         spacing: f64,
         cells: usize,
     },
+    /// A threshold is too small for the heights in f64: the error check
+    /// tolerates rounding of `ROUNDING` times the height (see
+    /// `measure.rs`), which must stay under a millionth of every
+    /// threshold, so that the samples end within T up to that millionth.
+    /// Terrain in metres seen from metres up is far from it: a threshold
+    /// of 0.24 allows heights up to 240 km.
+    BelowPrecision { threshold: f64, max_abs_height: f64 },
     /// The neighbour tile count of a side is zero or does not divide the
     /// cells of that side.
     NeighbourTilesMismatch {
@@ -59,6 +69,10 @@ impl fmt::Display for GridTileError {
             GridTileError::BadSpacing { dx, dy } => {
                 write!(f, "spacing ({dx}, {dy}) must be finite and non-zero")
             }
+            GridTileError::BadOrigin { x, y } => write!(
+                f,
+                "origin ({x}, {y}) and the tile's far corner must be finite"
+            ),
             GridTileError::BadViewingHeight(h) => {
                 write!(f, "viewing height {h} must be finite and positive")
             }
@@ -75,6 +89,15 @@ impl fmt::Display for GridTileError {
                 f,
                 "{side:?} neighbour resolution {resolution} is not a whole multiple of the \
                  spacing {spacing} dividing the {cells} cells of that side (per neighbour tile)"
+            ),
+            GridTileError::BelowPrecision {
+                threshold,
+                max_abs_height,
+            } => write!(
+                f,
+                "threshold {threshold} is too small for heights up to {max_abs_height}: \
+                 f64 rounding would take more than a millionth of it (lower the heights' \
+                 offset or raise the viewing height)"
             ),
             GridTileError::NeighbourTilesMismatch { side, tiles, cells } => write!(
                 f,

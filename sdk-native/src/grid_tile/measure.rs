@@ -2,6 +2,16 @@
 //! between its reference height and the simplified surface above or below
 //! it, absolute and relative to the sample's threshold T.
 
+/// The rounding the check tolerates, relative to `1 + |h|`: plane
+/// evaluation rounds to a few ulps of the heights (2^-52 each), and this
+/// leaves a wide margin. The simplifier refuses thresholds under a
+/// millionth of it ([`super::GridTileError::BelowPrecision`]), so a sample
+/// accepted ends within T plus a millionth of T.
+pub const ROUNDING: f64 = 1e-12;
+
+/// The share of a threshold that [`ROUNDING`] may take.
+pub const ROUNDING_SHARE: f64 = 1e-6;
+
 /// What [`check`] found.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Check {
@@ -51,7 +61,7 @@ pub fn check(
             out.max_error = out.max_error.max(e);
             out.max_ratio = out.max_ratio.max(e / t);
             // Plane evaluation rounds: tolerate a few ulps of the heights.
-            if e > t + 1e-12 * (1.0 + h.abs()) {
+            if e > t + ROUNDING * (1.0 + h.abs()) {
                 over.push(i as u32);
             }
         });

@@ -15,7 +15,9 @@
 //!
 //! Error bound: every sample of the tile ends within its T of the surface
 //! drawn (T of the side, from the coarser resolution, on a side next to a
-//! coarser tile). The merges alone do not ensure it: a rectangle fanned
+//! coarser tile), give or take a millionth of T of f64 rounding: a
+//! threshold too small for that, against the heights' magnitude, is
+//! refused ([`GridTileError::BelowPrecision`]). The merges alone do not ensure it: a rectangle fanned
 //! through vertices on its sides, or re-triangulated where a border corner
 //! is removed, can drift up to about 2 T (5 T next to borders). So after
 //! triangulating, the simplifier measures every sample and splits the
@@ -158,7 +160,9 @@ pub struct Stats {
     /// height (see the module docs: the tile's own except for samples a
     /// coarser neighbour lacks).
     pub max_vertical_error: f64,
-    /// Max over the samples of |h - surface| / T(sample): at most 1.
+    /// Max over the samples of |h - surface| / T(sample): at most 1, give
+    /// or take a millionth of rounding (`BelowPrecision` refuses tiles
+    /// where rounding could take more).
     pub max_error_ratio: f64,
     /// T of interior samples.
     pub threshold: f64,
@@ -257,6 +261,7 @@ impl Simplifier {
         self.out.triangles.clear();
         check(tile)?;
         let th = threshold::Thresholds::new(tile, params)?;
+        check_precision(tile, &th)?;
         let (rows, cols) = (tile.rows, tile.cols);
         let n = rows * cols;
 
@@ -360,6 +365,20 @@ pub fn simplify_tile(tile: &Tile, params: &Params) -> Result<(Simplified, Stats)
     Ok((out.clone(), stats))
 }
 
+/// Refuses thresholds that f64 cannot honour for these heights (see
+/// [`GridTileError::BelowPrecision`]).
+fn check_precision(tile: &Tile, th: &threshold::Thresholds) -> Result<(), GridTileError> {
+    let max_abs_height = tile.heights.iter().fold(0.0f64, |m, h| m.max(h.abs()));
+    let threshold = th.smallest();
+    if measure::ROUNDING * (1.0 + max_abs_height) > measure::ROUNDING_SHARE * threshold {
+        return Err(GridTileError::BelowPrecision {
+            threshold,
+            max_abs_height,
+        });
+    }
+    Ok(())
+}
+
 fn check(tile: &Tile) -> Result<(), GridTileError> {
     let (rows, cols) = (tile.rows, tile.cols);
     if rows < 2 || cols < 2 {
@@ -381,6 +400,11 @@ fn check(tile: &Tile) -> Result<(), GridTileError> {
     let [dx, dy] = tile.spacing;
     if !(dx.is_finite() && dy.is_finite() && dx != 0.0 && dy != 0.0) {
         return Err(GridTileError::BadSpacing { dx, dy });
+    }
+    let [x, y] = tile.origin;
+    let far = [x + (cols - 1) as f64 * dx, y + (rows - 1) as f64 * dy];
+    if !(x.is_finite() && y.is_finite() && far.iter().all(|c| c.is_finite())) {
+        return Err(GridTileError::BadOrigin { x, y });
     }
     if let Some(i) = tile.heights.iter().position(|h| !h.is_finite()) {
         return Err(GridTileError::NonFiniteHeight {

@@ -104,6 +104,15 @@ impl Thresholds {
         })
     }
 
+    /// The smallest T of any sample (the sides' are never below the
+    /// interior's, but a tile may be all border).
+    pub fn smallest(&self) -> f64 {
+        self.sides
+            .iter()
+            .map(|s| s.threshold)
+            .fold(self.interior, f64::min)
+    }
+
     /// T(V) for the sample at `(col, row)` of a `rows x cols` tile. Tile
     /// corners sit on two sides and take the larger threshold (they are
     /// never removed anyway).
