@@ -33,11 +33,10 @@ pub enum GridTileError {
         cells: usize,
     },
     /// A threshold is too small for the heights in f64: the error check
-    /// tolerates rounding of `ROUNDING` times the height (see
-    /// `measure.rs`), which must stay under a millionth of every
-    /// threshold, so that the samples end within T up to that millionth.
-    /// Terrain in metres seen from metres up is far from it: a threshold
-    /// of 0.24 allows heights up to 240 km.
+    /// tolerates rounding of 1e-12 times `1 + |h|` (`measure::ROUNDING`),
+    /// which must stay under a thousandth of every threshold, so that the
+    /// samples end within T up to that thousandth. Terrain in metres is
+    /// far from it: a threshold of 2 mm allows heights up to 2,000 km.
     BelowPrecision { threshold: f64, max_abs_height: f64 },
     /// The neighbour tile count of a side is zero or does not divide the
     /// cells of that side.
@@ -95,9 +94,9 @@ impl fmt::Display for GridTileError {
                 max_abs_height,
             } => write!(
                 f,
-                "threshold {threshold} is too small for heights up to {max_abs_height}: \
-                 f64 rounding would take more than a millionth of it (lower the heights' \
-                 offset or raise the viewing height)"
+                "threshold {threshold} (min(H / 800, resolution / 25)) is too small for \
+                 heights up to {max_abs_height}: f64 rounding would take more than a \
+                 thousandth of it (are the heights and the spacing in the same units?)"
             ),
             GridTileError::NeighbourTilesMismatch { side, tiles, cells } => write!(
                 f,

@@ -15,7 +15,7 @@
 //!
 //! Error bound: every sample of the tile ends within its T of the surface
 //! drawn (T of the side, from the coarser resolution, on a side next to a
-//! coarser tile), give or take a millionth of T of f64 rounding: a
+//! coarser tile), give or take a thousandth of T of f64 rounding: a
 //! threshold too small for that, against the heights' magnitude, is
 //! refused ([`GridTileError::BelowPrecision`]). The merges alone do not ensure it: a rectangle fanned
 //! through vertices on its sides, or re-triangulated where a border corner
@@ -161,7 +161,7 @@ pub struct Stats {
     /// coarser neighbour lacks).
     pub max_vertical_error: f64,
     /// Max over the samples of |h - surface| / T(sample): at most 1, give
-    /// or take a millionth of rounding (`BelowPrecision` refuses tiles
+    /// or take a thousandth of rounding (`BelowPrecision` refuses tiles
     /// where rounding could take more).
     pub max_error_ratio: f64,
     /// T of interior samples.
