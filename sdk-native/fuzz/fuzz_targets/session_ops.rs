@@ -1,0 +1,197 @@
+//! `Session` (a self-referential owner built on `unsafe`) driven by
+//! arbitrary sequences of calls over the conformance suite's valid streams:
+//! levels begun, decoded whole or round by round, in order or not, with
+//! their bytes right, cut short or with a byte changed; the mesh read
+//! between any two calls; the session dropped half way through a level.
+//! cargo-fuzz builds with AddressSanitizer, so a use after free or a stray
+//! read of the session's pointers is a finding, as is a panic. While the
+//! calls are right, the session must end where decoder-core's own decode
+//! of the stream ends (the same state hash).
+#![no_main]
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use libfuzzer_sys::fuzz_target;
+use splitstream_decoder_core::owned::decode_all;
+use splitstream_sdk_native::{ScreenView, Session};
+
+/// A valid stream and the state hash of its complete decode.
+struct Stream {
+    bytes: Vec<u8>,
+    final_hash: u64,
+}
+
+/// The valid vectors of the newest format version in the conformance
+/// suite, read once.
+fn streams() -> &'static [Stream] {
+    static STREAMS: OnceLock<Vec<Stream>> = OnceLock::new();
+    STREAMS.get_or_init(|| {
+        let root = PathBuf::from(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../conformance/vectors"
+        ));
+        let newest = std::fs::read_dir(&root)
+            .expect("conformance/vectors")
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_dir())
+            .max()
+            .expect("a version folder");
+        let mut paths: Vec<PathBuf> = std::fs::read_dir(newest.join("valid"))
+            .expect("valid vectors")
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.extension().is_some_and(|x| x == "sps"))
+            .collect();
+        paths.sort();
+        paths
+            .into_iter()
+            .filter_map(|p| {
+                let bytes = std::fs::read(&p).ok()?;
+                let decoded = decode_all(&bytes, true).ok()?;
+                let final_hash = *decoded.round_hashes.last()?;
+                Some(Stream { bytes, final_hash })
+            })
+            .collect()
+    })
+}
+
+/// The input, read a byte at a time; zeros once it runs out.
+struct Bytes<'a>(&'a [u8]);
+
+impl Bytes<'_> {
+    fn u8(&mut self) -> u8 {
+        match self.0.split_first() {
+            Some((&b, rest)) => {
+                self.0 = rest;
+                b
+            }
+            None => 0,
+        }
+    }
+
+    fn u16(&mut self) -> u16 {
+        u16::from_le_bytes([self.u8(), self.u8()])
+    }
+
+    fn done(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
+/// Reads the whole mesh the session shows, as a viewer would between two
+/// calls, and checks that it is a mesh.
+fn look(session: &Session) {
+    let positions = session.positions();
+    let count = positions.len();
+    for t in session.triangles() {
+        assert!(
+            t.iter().all(|&v| (v as usize) < count),
+            "triangle {t:?} of {count} vertices"
+        );
+    }
+    assert_eq!(session.deficits().len(), count);
+    if let Some(p) = positions.first() {
+        let _ = session.dequantize(*p);
+    }
+    let _ = session.state_hash();
+}
+
+fuzz_target!(|data: &[u8]| {
+    let streams = streams();
+    let mut b = Bytes(data);
+    let Some(stream) = streams.get(b.u8() as usize % streams.len().max(1)) else {
+        return;
+    };
+    let bytes = &stream.bytes[..];
+    let open = |b: &mut Bytes| match b.u8() % 4 {
+        0 => Session::open_within(bytes, (b.u16() as u64) << (b.u8() % 12)),
+        1 => Session::open(&bytes[..bytes.len().min(b.u16() as usize)]),
+        _ => Session::open(bytes),
+    };
+    let Ok(mut session) = open(&mut b) else {
+        return;
+    };
+    // Whether every call so far was a right one, in order.
+    let mut faithful = session.levels_that_fit() == session.level_count();
+    while !b.done() {
+        match b.u8() % 8 {
+            // Begin or decode the next level (or another one), with its
+            // bytes right, cut short, or with one byte changed.
+            op @ (0 | 1 | 2) => {
+                let next = session.next_level();
+                let k = match b.u8() % 8 {
+                    0 => b.u16() % (session.level_count() + 2),
+                    _ => next.unwrap_or(0),
+                };
+                let Some(range) = session.level_range(k) else {
+                    let _ = session.begin_level(k, &[]);
+                    faithful = false;
+                    continue;
+                };
+                let mut level = bytes[range.start as usize..range.end as usize].to_vec();
+                match b.u8() % 8 {
+                    0 if !level.is_empty() => {
+                        let at = b.u16() as usize % level.len();
+                        level[at] ^= b.u8() | 1;
+                        faithful = false;
+                    }
+                    1 => {
+                        level.truncate(b.u16() as usize % (level.len() + 1));
+                        faithful = false;
+                    }
+                    _ => {}
+                }
+                faithful &= Some(k) == next;
+                let result = if op == 0 {
+                    session.decode_level(k, &level)
+                } else {
+                    session.begin_level(k, &level)
+                };
+                faithful &= result.is_ok();
+            }
+            // One round, or the rest of the open level.
+            3 => {
+                faithful &= session.next_round().is_ok();
+            }
+            4 => while let Ok(Some(_)) = session.next_round() {},
+            // Read everything, as a viewer drawing a frame.
+            5 => look(&session),
+            // The questions a viewer asks.
+            6 => {
+                let _ = session.level_within_error(f32::from_bits(b.u16() as u32 * 65_537));
+                if let Ok(view) = ScreenView::perspective(1080.0, 0.8) {
+                    let _ = session.level_for_screen_error(&view, b.u16() as f32, 1.0);
+                }
+                let _ = (
+                    session.open_level(),
+                    session.levels_done(),
+                    session.next_level(),
+                );
+                let _ = (session.workspace_bytes(), session.level_info(b.u16() % 8));
+            }
+            // Drop it, wherever it is, and start again.
+            _ => {
+                drop(session);
+                let Ok(again) = open(&mut b) else {
+                    return;
+                };
+                session = again;
+                faithful = session.levels_that_fit() == session.level_count();
+            }
+        }
+    }
+    look(&session);
+    // Right calls all the way: finish, and compare with decoder-core.
+    if faithful {
+        while session.open_level().is_some() {
+            session.next_round().expect("a right stream decodes");
+        }
+        while let Some(k) = session.next_level() {
+            let range = session.level_range(k).expect("a level of the table");
+            session
+                .decode_level(k, &bytes[range.start as usize..range.end as usize])
+                .expect("a right stream decodes");
+        }
+        assert_eq!(session.state_hash(), stream.final_hash);
+    }
+});
