@@ -15,6 +15,7 @@ use std::sync::OnceLock;
 use libfuzzer_sys::fuzz_target;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_sdk_native::{ScreenView, Session};
+use splitstream_sdk_native_fuzz::Bytes;
 
 /// A valid stream and the state hash of its complete decode.
 struct Stream {
@@ -53,29 +54,6 @@ fn streams() -> &'static [Stream] {
             })
             .collect()
     })
-}
-
-/// The input, read a byte at a time; zeros once it runs out.
-struct Bytes<'a>(&'a [u8]);
-
-impl Bytes<'_> {
-    fn u8(&mut self) -> u8 {
-        match self.0.split_first() {
-            Some((&b, rest)) => {
-                self.0 = rest;
-                b
-            }
-            None => 0,
-        }
-    }
-
-    fn u16(&mut self) -> u16 {
-        u16::from_le_bytes([self.u8(), self.u8()])
-    }
-
-    fn done(&self) -> bool {
-        self.0.is_empty()
-    }
 }
 
 /// Reads the whole mesh the session shows, as a viewer would between two
