@@ -259,9 +259,9 @@ impl Simplifier {
         self.out.rectangles.clear();
         self.out.positions.clear();
         self.out.triangles.clear();
-        check(tile)?;
+        let max_abs_height = check(tile)?;
         let th = threshold::Thresholds::new(tile, params)?;
-        check_precision(tile, &th)?;
+        check_precision(max_abs_height, &th)?;
         let (rows, cols) = (tile.rows, tile.cols);
         let n = rows * cols;
 
@@ -365,10 +365,9 @@ pub fn simplify_tile(tile: &Tile, params: &Params) -> Result<(Simplified, Stats)
     Ok((out.clone(), stats))
 }
 
-/// Refuses thresholds that f64 cannot honour for these heights (see
-/// [`GridTileError::BelowPrecision`]).
-fn check_precision(tile: &Tile, th: &threshold::Thresholds) -> Result<(), GridTileError> {
-    let max_abs_height = tile.heights.iter().fold(0.0f64, |m, h| m.max(h.abs()));
+/// Refuses thresholds that f64 cannot honour for heights up to
+/// `max_abs_height` (see [`GridTileError::BelowPrecision`]).
+fn check_precision(max_abs_height: f64, th: &threshold::Thresholds) -> Result<(), GridTileError> {
     let threshold = th.smallest();
     if measure::ROUNDING * (1.0 + max_abs_height) > measure::ROUNDING_SHARE * threshold {
         return Err(GridTileError::BelowPrecision {
@@ -379,7 +378,9 @@ fn check_precision(tile: &Tile, th: &threshold::Thresholds) -> Result<(), GridTi
     Ok(())
 }
 
-fn check(tile: &Tile) -> Result<(), GridTileError> {
+/// Checks the tile's sizes, spacing, origin and heights; returns the
+/// largest |height|, found in the same pass as the non-finite ones.
+fn check(tile: &Tile) -> Result<f64, GridTileError> {
     let (rows, cols) = (tile.rows, tile.cols);
     if rows < 2 || cols < 2 {
         return Err(GridTileError::TooSmall { rows, cols });
@@ -406,11 +407,15 @@ fn check(tile: &Tile) -> Result<(), GridTileError> {
     if !(x.is_finite() && y.is_finite() && far.iter().all(|c| c.is_finite())) {
         return Err(GridTileError::BadOrigin { x, y });
     }
-    if let Some(i) = tile.heights.iter().position(|h| !h.is_finite()) {
-        return Err(GridTileError::NonFiniteHeight {
-            row: i / cols,
-            col: i % cols,
-        });
+    let mut max_abs_height = 0.0f64;
+    for (i, h) in tile.heights.iter().enumerate() {
+        if !h.is_finite() {
+            return Err(GridTileError::NonFiniteHeight {
+                row: i / cols,
+                col: i % cols,
+            });
+        }
+        max_abs_height = max_abs_height.max(h.abs());
     }
-    Ok(())
+    Ok(max_abs_height)
 }
