@@ -1,9 +1,10 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.1 decoder, in Python, written from
+"""A second splitstream 3.2 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
-plane policy `height` was added with the SPEC section that defines it.) It speaks the conformance protocol (a stream
+plane policy `height` and 3.2's wing policies were added with the SPEC
+sections that define them.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -462,7 +463,9 @@ class Decoder:
             raise Fail("checksum-mismatch")
         if lvl[8] > 5:
             raise Fail("malformed")
-        if lvl[9] or lvl[10] or lvl[11]:
+        if lvl[9] > 2:  # wing policy (3.2)
+            raise Fail("malformed")
+        if lvl[10] or lvl[11]:
             raise Fail("malformed")
         if li == 0 and (SV == 0 or ST == 0):
             raise Fail("malformed")
@@ -518,6 +521,7 @@ class Decoder:
             subs[sid] = Sub(sid, lst, self.lane_count)
         self.subs = subs
         self.policy = lvl[8]
+        self.wing_policy = lvl[9]
         self.T_l = entry["T"]
         if li == 0:
             self.read_base(SV, ST)
@@ -688,10 +692,13 @@ class Decoder:
         ctx = min(max(m, 2), 9) - 2
         op = subs[2].byte(ctx)
         dp = subs[3].byte(ctx)
-        if dp == 0 or op + dp >= m:
-            raise Fail("ring-offset-out-of-range")
-        o = E[op]
-        d = E[op + dp] - o
+        if self.wing_policy == 0:
+            if dp == 0 or op + dp >= m:
+                raise Fail("ring-offset-out-of-range")
+            o = E[op]
+            d = E[op + dp] - o
+        else:
+            o, d = self.near_wings(ring, E, op, dp)
         valP = d + 2
         valC = k - d + 2
         dP = self.deficit_of(subs[4].byte(0), valP)
@@ -818,6 +825,39 @@ class Decoder:
             if (det > 0 and s >= 0 and t >= 0) or (det < 0 and s <= 0 and t <= 0):
                 return rnd(s * a[2] + t * b[2], det)
         return None
+
+    def near_wings(self, ring, E, u, v):
+        # SPEC 7.4 (3.2): the wings in the near order.
+        k = len(ring)
+        real = [self.pos[x] for x in ring if x != GHOST]
+        n = len(real)
+        centre = [sum(p[a] for p in real) // max(n, 1) for a in range(3)]
+        axes = 3 if self.wing_policy == 1 else 2
+        cap = (1 << 47) - 1
+
+        def K(i):
+            if ring[i] == GHOST:
+                key = cap
+            else:
+                p = self.pos[ring[i]]
+                key = min(sum((p[a] - centre[a]) ** 2 for a in range(axes)), cap)
+            return key * 256 + i
+
+        order = sorted(K(i) for i in E)
+        if u >= len(order):
+            raise Fail("ring-offset-out-of-range")
+        first = order[u]
+        f = first & 0xFF
+
+        def balance(j):
+            return abs(2 * ((j - f) % k) - k)
+
+        rest = sorted((balance(x & 0xFF) << 55) | x for x in order if x > first)
+        if v >= len(rest):
+            raise Fail("ring-offset-out-of-range")
+        s = rest[v] & 0xFF
+        a, b = min(f, s), max(f, s)
+        return a, b - a
 
     @staticmethod
     def deficit_of(sym, val):

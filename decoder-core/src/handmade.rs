@@ -17,6 +17,7 @@ use crate::header::PositionMode;
 use crate::limits::LEAF;
 use crate::owned::decode_all;
 use crate::predict::PlanePolicy;
+use crate::wing_order::WingPolicy;
 use crate::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
 };
@@ -171,6 +172,7 @@ pub fn level_with(
     LevelPayload {
         round_splits: rounds,
         plane,
+        wings: WingPolicy::Ranks,
         substreams: s,
         vertex_count: v,
         triangle_count: t,

@@ -1,12 +1,14 @@
-//! A level's own header: rounds, the plane policy, split counts and the
+//! A level's own header: rounds, the plane and wing policies, split counts and the
 //! chunk directory (SPEC §5.1, §5.2).
 
 use crate::bytes::{crc32, u8_at, u16_at, u32_at};
 use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
 use crate::predict::PlanePolicy;
+use crate::wing_order::WingPolicy;
 use crate::{ChecksumScope, Error};
 
-/// Offset of the plane policy byte (SPEC §5.1), followed by 3 reserved bytes.
+/// Offset of the plane policy byte (SPEC §5.1), followed by the wing policy
+/// byte (3.2) and 2 reserved bytes.
 const PLANE_AT: usize = 8;
 /// Offset of level 0's seed counts (SPEC §5.1).
 const SEED_AT: usize = 12;
@@ -33,7 +35,11 @@ pub struct LevelHeader<'l> {
     /// §5.1, §7.4); the raw byte is checked by [`LevelHeader::parse`].
     pub plane_policy: PlanePolicy,
     plane_byte: u8,
-    reserved: [u8; 3],
+    /// How this level codes the wings (SPEC §5.1, §7.4; format 3.2); the
+    /// raw byte is checked by [`LevelHeader::parse`].
+    pub wing_policy: WingPolicy,
+    wing_byte: u8,
+    reserved: [u8; 2],
     /// Level 0 only: vertex and triangle counts of the seed mesh its rounds
     /// start from (SPEC §5.1, §6.3); `(0, 0)` for other levels.
     pub seed_vertices: u32,
@@ -61,11 +67,8 @@ impl<'l> LevelHeader<'l> {
             (0, 0)
         };
         let plane_byte = u8_at(level, PLANE_AT)?;
-        let reserved = [
-            u8_at(level, PLANE_AT + 1)?,
-            u8_at(level, PLANE_AT + 2)?,
-            u8_at(level, PLANE_AT + 3)?,
-        ];
+        let wing_byte = u8_at(level, PLANE_AT + 1)?;
+        let reserved = [u8_at(level, PLANE_AT + 2)?, u8_at(level, PLANE_AT + 3)?];
         let splits_len = (round_count as usize)
             .checked_mul(4)
             .ok_or(Error::Truncated)?;
@@ -85,6 +88,8 @@ impl<'l> LevelHeader<'l> {
             round_count,
             plane_policy: PlanePolicy::from_byte(plane_byte).unwrap_or(PlanePolicy::Off),
             plane_byte,
+            wing_policy: WingPolicy::from_byte(wing_byte).unwrap_or(WingPolicy::Ranks),
+            wing_byte,
             reserved,
             seed_vertices,
             seed_triangles,
@@ -101,7 +106,10 @@ impl<'l> LevelHeader<'l> {
         if PlanePolicy::from_byte(self.plane_byte).is_none() {
             return Err(Error::InvalidLevelHeader("unknown plane policy"));
         }
-        if self.reserved != [0; 3] {
+        if WingPolicy::from_byte(self.wing_byte).is_none() {
+            return Err(Error::InvalidLevelHeader("unknown wing policy"));
+        }
+        if self.reserved != [0; 2] {
             return Err(Error::InvalidLevelHeader(
                 "reserved level header bytes not zero",
             ));

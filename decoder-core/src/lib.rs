@@ -50,6 +50,7 @@ mod split;
 mod state;
 pub mod substream;
 pub mod symbols;
+pub mod wing_order;
 #[cfg(feature = "alloc")]
 pub mod writer;
 
@@ -73,6 +74,7 @@ pub use round::{FANS_AHEAD_FROM_VERTICES, RecordSource, RoundStats};
 pub use split::{SplitOutcome, SplitRecord};
 pub use state::{MeshState, StateMemory, next, prev};
 pub use symbols::WingCandidates;
+pub use wing_order::WingPolicy;
 
 /// Bytes of workspace (with alignment slack) needed to decode all of
 /// `stream`, from its header and level table alone (SPEC §9).

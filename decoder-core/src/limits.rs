@@ -6,9 +6,12 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 
 /// Format version this crate reads and writes (SPEC §1).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 1;
-/// The minor version written when a stream uses no 3.1 feature (every
-/// reserved field zero), so that 3.0 decoders read it (SPEC §1).
+pub const VERSION_MINOR: u8 = 2;
+/// The minor version written when a stream uses the plane policy `height`
+/// and no 3.2 feature, so that 3.1 decoders read it (SPEC §1).
+pub const VERSION_MINOR_HEIGHT: u8 = 1;
+/// The minor version written when a stream uses no 3.1 or 3.2 feature
+/// (every reserved field zero), so that 3.0 decoders read it (SPEC §1).
 pub const VERSION_MINOR_BASELINE: u8 = 0;
 
 /// Size of the fixed header in bytes (SPEC §3).

@@ -3,6 +3,7 @@
 use crate::Error;
 use crate::context::{self, SINGLE};
 use crate::header::PositionMode;
+use crate::limits::MAX_SPLIT_VALENCE;
 use crate::limits::substream::{self, SLOTS};
 use crate::predict::{
     Plane, PlanePolicy, SplitFan, Target, arc_means, constrained_positions, predict,
@@ -13,6 +14,7 @@ use crate::split::SplitRecord;
 use crate::state::MeshState;
 use crate::substream::Substreams;
 use crate::symbols::deficit_of;
+use crate::wing_order::{NearKeys, WingPolicy, near_keys, near_wings};
 
 /// Substream slot of a refinement substream id (ids 1..=7 use slots 0..=6).
 const fn slot(id: u8) -> usize {
@@ -34,6 +36,10 @@ pub struct StreamSource<'s, 'l, 'b> {
     pub mode: PositionMode,
     /// The level's plane policy (SPEC §5.1).
     pub plane: PlanePolicy,
+    /// The level's wing policy (SPEC §5.1, 3.2).
+    pub wings: WingPolicy,
+    /// The current ring's near keys, under a near wing policy.
+    keys: NearKeys,
 }
 
 impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
@@ -41,7 +47,14 @@ impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
     /// position mode `mode`, with the plane policy of the level's header.
     pub fn new(subs: &'s mut Substreams<'l, 'b>, mode: PositionMode) -> Self {
         let plane = subs.level_header().plane_policy;
-        StreamSource { subs, mode, plane }
+        let wings = subs.level_header().wing_policy;
+        StreamSource {
+            subs,
+            mode,
+            plane,
+            wings,
+            keys: [0; MAX_SPLIT_VALENCE],
+        }
     }
 }
 
@@ -70,7 +83,8 @@ impl RecordSource for StreamSource<'_, '_, '_> {
         bits & all_ones(known as usize) | !all_ones(known as usize) & all_ones(upcoming.len())
     }
 
-    /// SPEC §7.4, fields in order: wing ranks, split valences of P and C,
+    /// SPEC §7.4, fields in order: wing ranks (in ring order, or in the near
+    /// order of the level's wing policy), split valences of P and C,
     /// then (constrained) the placement code and one residual vector, or
     /// (optimal) two residual vectors.
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
@@ -80,7 +94,13 @@ impl RecordSource for StreamSource<'_, '_, '_> {
         let wing_context = context::wing(eligible.count());
         let o_rank = s.byte(slot(substream::WING_OFFSET), wing_context)?;
         let d_rank = s.byte(slot(substream::WING_DISTANCE), wing_context)?;
-        let (o, d) = eligible.wings(o_rank, d_rank)?;
+        let (o, d) = match self.wings {
+            WingPolicy::Ranks => eligible.wings(o_rank, d_rank)?,
+            near => {
+                let m = near_keys(state.positions(), ring, &eligible, near, &mut self.keys);
+                near_wings(&self.keys[..m], k, o_rank, d_rank)?
+            }
+        };
         let (valence_p, valence_c) = (d + 2, k - d + 2);
         let deficit_p = deficit_of(s.byte(slot(substream::DEFICIT_P), SINGLE)?, valence_p)?;
         let deficit_c = deficit_of(

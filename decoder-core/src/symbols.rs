@@ -24,10 +24,27 @@ pub struct WingCandidates {
 }
 
 impl WingCandidates {
+    /// The entries of a ring of at most 64 entries whose bits `mask` sets
+    /// (unit tests).
+    #[cfg(test)]
+    pub(crate) fn from_first_mask(mask: u64) -> WingCandidates {
+        WingCandidates {
+            mask: [mask, 0, 0, 0],
+            count: mask.count_ones() as usize,
+        }
+    }
+
     /// `m`: the number of ring entries that may be wings.
     #[inline]
     pub fn count(&self) -> usize {
         self.count
+    }
+
+    /// Bits `64 w .. 64 w + 64` of the set: bit `i` says whether ring
+    /// position `64 w + i` may be a wing (0 past the fourth word).
+    #[inline]
+    pub fn word(&self, w: usize) -> u64 {
+        self.mask.get(w).copied().unwrap_or(0)
     }
 
     /// Whether ring position `i` may be a wing.

@@ -10,10 +10,12 @@ use crate::header::{Header, PositionMode};
 use crate::layout::Layout;
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
-    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, VERSION_MINOR_BASELINE, codec, substream,
+    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, VERSION_MINOR_BASELINE, VERSION_MINOR_HEIGHT,
+    codec, substream,
 };
 use crate::predict::PlanePolicy;
 use crate::rans_writer::{Symbol, encode_chunk};
+use crate::wing_order::WingPolicy;
 
 /// A growing substream: bytes, bits (least significant first) or varints
 /// for the byte codecs (SPEC §5.4), and the same values with their contexts
@@ -150,6 +152,8 @@ pub struct LevelPayload {
     pub round_splits: Vec<u32>,
     /// The level's plane policy (SPEC §5.1, §7.4).
     pub plane: PlanePolicy,
+    /// The level's wing policy (SPEC §5.1, §7.4; 3.2).
+    pub wings: WingPolicy,
     /// Substreams in id order: ids 1..=7 for rounds (index 0 is id 1), or
     /// ids 8..=10 for a base level given to [`write_stream`].
     pub substreams: Vec<SubstreamWriter>,
@@ -225,6 +229,7 @@ impl SeedPayload {
         LevelPayload {
             round_splits: Vec::new(),
             plane: PlanePolicy::Off,
+            wings: WingPolicy::Ranks,
             vertex_count: self.vertices,
             triangle_count: self.triangles,
             substreams: self.substreams,
@@ -299,15 +304,18 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.1 only where a 3.1 feature (the plane policy `height`) is
-    // used; every other stream stays readable by 3.0 decoders.
-    let uses_3_1 = levels.iter().any(|l| l.plane == PlanePolicy::Height);
+    // SPEC §1: 3.2 only where a 3.2 feature (a wing policy other than
+    // `ranks`) is used, 3.1 where a 3.1 feature (the plane policy `height`)
+    // is; every other stream stays readable by 3.0 decoders.
+    let version_minor = if levels.iter().any(|l| l.wings != WingPolicy::Ranks) {
+        VERSION_MINOR
+    } else if levels.iter().any(|l| l.plane == PlanePolicy::Height) {
+        VERSION_MINOR_HEIGHT
+    } else {
+        VERSION_MINOR_BASELINE
+    };
     let header = Header {
-        version_minor: if uses_3_1 {
-            VERSION_MINOR
-        } else {
-            VERSION_MINOR_BASELINE
-        },
+        version_minor,
         position_mode: params.position_mode,
         bits: params.bits,
         lane_count: params.codec.lane_count(),
@@ -389,7 +397,7 @@ pub fn frame_level_with(
     let mut out = Vec::new();
     out.extend_from_slice(&(level.round_splits.len() as u32).to_le_bytes());
     out.extend_from_slice(&(directory.len() as u32).to_le_bytes());
-    out.extend_from_slice(&[level.plane.to_byte(), 0, 0, 0]);
+    out.extend_from_slice(&[level.plane.to_byte(), level.wings.to_byte(), 0, 0]);
     if let Some(seed) = seed {
         out.extend_from_slice(&seed.vertices.to_le_bytes());
         out.extend_from_slice(&seed.triangles.to_le_bytes());

@@ -2,11 +2,11 @@
 //! reverse order, as a thread pool might finish them), the framed level is
 //! byte for byte `frame_level`'s.
 
-use splitstream_decoder_core::PlanePolicy;
 use splitstream_decoder_core::writer::{
     Chunk, ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level,
     frame_level_with,
 };
+use splitstream_decoder_core::{PlanePolicy, WingPolicy};
 
 fn params(codec: ChunkCodec) -> StreamParams {
     StreamParams {
@@ -41,6 +41,7 @@ fn level() -> LevelPayload {
     LevelPayload {
         round_splits: vec![150, 250],
         plane: PlanePolicy::Dominant,
+        wings: WingPolicy::Ranks,
         substreams,
         vertex_count: 420,
         triangle_count: 836,

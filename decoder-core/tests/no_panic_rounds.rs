@@ -8,12 +8,12 @@
 
 use std::time::Instant;
 
-use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
+use splitstream_decoder_core::{PositionMode, WingPolicy};
 
 /// A `w` x `w` grid whose centre vertex splits once per round, `rounds` times.
 fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
@@ -47,6 +47,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
     let base = LevelPayload {
         round_splits: vec![],
         plane: Default::default(),
+        wings: WingPolicy::Ranks,
         substreams: subs,
         vertex_count: nv,
         triangle_count: nt,
@@ -72,6 +73,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
     let level = LevelPayload {
         round_splits: vec![1; rounds as usize],
         plane: Default::default(),
+        wings: WingPolicy::Ranks,
         substreams: s,
         vertex_count: nv + rounds,
         triangle_count: nt + 2 * rounds,

@@ -23,7 +23,7 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{PlanePolicy, PositionMode};
+use splitstream_decoder_core::{PlanePolicy, PositionMode, WingPolicy};
 use streams::{Choices, bases};
 
 fn base_euler(base: &str) -> i64 {
@@ -86,6 +86,7 @@ proptest! {
         let level = LevelPayload {
             round_splits: rounds,
             plane: PlanePolicy::from_byte(plane).unwrap(),
+            wings: WingPolicy::Ranks,
             substreams: subs
                 .iter()
                 .map(|s| {

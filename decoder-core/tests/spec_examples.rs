@@ -5,7 +5,7 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{Fnv1a, PlanePolicy, PositionMode, crc32};
+use splitstream_decoder_core::{Fnv1a, PlanePolicy, PositionMode, WingPolicy, crc32};
 
 fn params() -> StreamParams {
     StreamParams {
@@ -39,6 +39,7 @@ fn tetra_stream() -> Vec<u8> {
     let base = LevelPayload {
         round_splits: vec![],
         plane: PlanePolicy::Off,
+        wings: WingPolicy::Ranks,
         substreams: b,
         vertex_count: 4,
         triangle_count: 4,
@@ -60,6 +61,7 @@ fn tetra_stream() -> Vec<u8> {
     let l1 = LevelPayload {
         round_splits: vec![1],
         plane: PlanePolicy::Dominant,
+        wings: WingPolicy::Ranks,
         substreams: s,
         vertex_count: 5,
         triangle_count: 6,
@@ -507,6 +509,7 @@ fn section_5_4_varints() {
         let base = LevelPayload {
             round_splits: vec![],
             plane: PlanePolicy::Off,
+            wings: WingPolicy::Ranks,
             substreams: b,
             vertex_count: 3,
             triangle_count: 1,

@@ -6,7 +6,7 @@ mod roundtrip_check;
 
 use roundtrip_check::assert_roundtrip;
 
-use splitstream_decoder_core::{PlanePolicy, PositionMode};
+use splitstream_decoder_core::{PlanePolicy, PositionMode, WingPolicy};
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::quantize::{Lattice, Quantization, Units};
 
@@ -88,8 +88,8 @@ fn every_plane_policy_roundtrips_at_31_bits() {
 }
 
 /// Format 3.1's plane policy `height` on terrain, in both position modes,
-/// at 14 and 31 bits; a stream that uses it says minor version 1, one that
-/// does not stays 3.0 (SPEC §1).
+/// at 14 and 31 bits; a stream that uses it (and no 3.2 wing policy) says
+/// minor version 1, one that uses neither stays 3.0 (SPEC §1).
 #[test]
 fn height_policy_roundtrips_and_sets_the_minor_version() {
     let terrain = common::bumpy_grid(21, 17, 3);
@@ -99,6 +99,7 @@ fn height_policy_roundtrips_and_sets_the_minor_version() {
                 let options = EncodeOptions {
                     bits,
                     plane: Some(plane),
+                    wings: Some(WingPolicy::Ranks),
                     position_mode: mode,
                     ..EncodeOptions::default()
                 };
@@ -107,6 +108,54 @@ fn height_policy_roundtrips_and_sets_the_minor_version() {
                 assert_eq!(encoded.stream[9], minor, "{mode:?} {bits} {plane:?}");
             }
         }
+    }
+}
+
+/// Format 3.2's wing policies, forced in every level, on a closed mesh and
+/// on terrain with a boundary (the ghost is eligible), in both position
+/// modes, at 14 and 31 bits; `near` and `near-xy` set minor version 2,
+/// `ranks` leaves it at 0 (SPEC §1, §7.4).
+#[test]
+fn every_wing_policy_roundtrips_and_sets_the_minor_version() {
+    let meshes = [common::icosphere(2), common::bumpy_grid(21, 17, 3)];
+    for mesh in &meshes {
+        for mode in [PositionMode::Constrained, PositionMode::Optimal] {
+            for bits in [14, 31] {
+                for (wings, minor) in [
+                    (WingPolicy::Ranks, 0),
+                    (WingPolicy::Near, 2),
+                    (WingPolicy::NearXy, 2),
+                ] {
+                    let options = EncodeOptions {
+                        bits,
+                        plane: Some(PlanePolicy::Dominant),
+                        wings: Some(wings),
+                        position_mode: mode,
+                        ..EncodeOptions::default()
+                    };
+                    assert_roundtrip(mesh, &options);
+                    let encoded = encode(mesh, &options, |_| {}).expect("encode");
+                    assert_eq!(encoded.stream[9], minor, "{mode:?} {bits} {wings:?}");
+                }
+            }
+        }
+    }
+}
+
+/// The default picks the wing policy per level by size: not larger than
+/// `ranks` everywhere (on a tie `ranks` is kept). The choice ranks the two
+/// wing substreams as rANS codes them, and the framing may still pick
+/// deflate for a chunk, so a few bytes of slack are allowed.
+#[test]
+fn the_chosen_wing_policy_is_never_larger_than_ranks() {
+    for mesh in [common::icosphere(3), common::bumpy_grid(31, 23, 2)] {
+        let auto = encode(&mesh, &EncodeOptions::default(), |_| {}).expect("encode");
+        let ranks = EncodeOptions {
+            wings: Some(WingPolicy::Ranks),
+            ..EncodeOptions::default()
+        };
+        let ranks = encode(&mesh, &ranks, |_| {}).expect("encode");
+        assert!(auto.stream.len() <= ranks.stream.len() + 64);
     }
 }
 

@@ -13,7 +13,7 @@ use splitstream_decoder_core::limits::{LEAF, codec};
 use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
 use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
 use splitstream_decoder_core::{
-    Fnv1a, Header, LevelHeader, LevelTable, PlanePolicy, PositionMode, head_len,
+    Fnv1a, Header, LevelHeader, LevelTable, PlanePolicy, PositionMode, WingPolicy, head_len,
 };
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
@@ -570,6 +570,34 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             );
         }
     }
+    // Every wing policy byte (SPEC §5.1, §7.4; near and near-xy are 3.2),
+    // forced for every level, in both position modes.
+    for policy in WingPolicy::ALL {
+        for (mode, what) in [
+            (PositionMode::Constrained, "constrained"),
+            (PositionMode::Optimal, "optimal"),
+        ] {
+            for (mesh, name) in [(&sphere2, "icosphere"), (&small_holed, "grid-hole")] {
+                s.valid(
+                    &format!("wings-{}-{name}-{what}", policy.name()),
+                    &format!(
+                        "{name} ({what} positions, rANS) with wing policy `{}` (byte {}) in every level.",
+                        policy.name(),
+                        policy.to_byte()
+                    ),
+                    &["encoded", "wing-policy"],
+                    encoded(
+                        mesh,
+                        EncodeOptions {
+                            position_mode: mode,
+                            wings: Some(policy),
+                            ..opts()
+                        },
+                    ),
+                );
+            }
+        }
+    }
     // 31 bits per axis: the arithmetic of SPEC §7.4 at its widest (the
     // seed's rounds span the whole grid).
     for (mode, what) in [
@@ -948,11 +976,18 @@ fn invalid_vectors(s: &mut Specs) {
         with_level_header_byte(&subject, 0, plane_policy_at(&subject, 0), 255),
     );
     s.invalid(
+        "wing-policy-reserved",
+        "malformed",
+        "Level 1's wing policy byte (level header byte 9) set to 3, the first value 3.2 reserves (level header CRC recomputed).",
+        &["reserved", "wing-policy"],
+        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 1, 3),
+    );
+    s.invalid(
         "reserved-level-header",
         "malformed",
-        "Level 1's reserved level header byte 9 (after the plane policy) not zero (level header CRC recomputed).",
+        "Level 1's reserved level header byte 10 (after the wing policy) not zero (level header CRC recomputed).",
         &["reserved", "plane-policy"],
-        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 1, 1),
+        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 2, 1),
     );
     s.invalid(
         "unknown-codec",
@@ -997,6 +1032,43 @@ fn invalid_vectors(s: &mut Specs) {
             reframe(&p)
         },
     );
+    // The near order's ranks (3.2) out of range: the first wing's rank u
+    // beyond the m eligible entries, the second's v beyond those after it.
+    let near = unframe(&encoded(
+        &meshes::icosphere(2),
+        EncodeOptions {
+            codec: ChunkCodec::Stored,
+            wings: Some(WingPolicy::Near),
+            ..opts()
+        },
+    ));
+    for (slot, name, what) in [
+        (
+            1,
+            "near-wing-first-rank",
+            "first wing's near rank u = 255 (u >= m)",
+        ),
+        (
+            2,
+            "near-wing-second-rank",
+            "second wing's near rank v = 255 (beyond the entries after the first)",
+        ),
+    ] {
+        s.invalid(
+            name,
+            "ring-offset-out-of-range",
+            &format!(
+                "Level 1 (wing policy `near`, 3.2): its first split record's {what} (SPEC §7.4)."
+            ),
+            &["records", "ring-offset", "wing-policy"],
+            {
+                let mut p = near.clone();
+                assert_eq!(p.levels[1].wings, WingPolicy::Near);
+                p.levels[1].substreams[slot][0] = 255;
+                reframe(&p)
+            },
+        );
+    }
     s.invalid(
         "flag-count-declared-less",
         "count-mismatch",

@@ -10,7 +10,7 @@ use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream_seeded,
 };
 use splitstream_decoder_core::{
-    Header, Inflater, LevelHeader, LevelTable, PlanePolicy, crc32, head_len,
+    Header, Inflater, LevelHeader, LevelTable, PlanePolicy, WingPolicy, crc32, head_len,
 };
 
 /// One level's content, substreams as raw bytes.
@@ -22,6 +22,8 @@ pub struct Level {
     pub round_splits: Vec<u32>,
     /// The level's plane policy (SPEC §5.1).
     pub plane: PlanePolicy,
+    /// The level's wing policy (SPEC §5.1, 3.2).
+    pub wings: WingPolicy,
     /// The rounds' substreams, ids 1..=7.
     pub substreams: Vec<Vec<u8>>,
     pub vertex_count: u32,
@@ -76,6 +78,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
             seed,
             round_splits: (0..lh.round_count).map(|r| lh.split_count(r)).collect(),
             plane: lh.plane_policy,
+            wings: lh.wing_policy,
             substreams,
             vertex_count: info.vertex_count,
             triangle_count: info.triangle_count,
@@ -120,6 +123,7 @@ pub fn reframe(u: &Unframed) -> Vec<u8> {
         .map(|l| LevelPayload {
             round_splits: l.round_splits.clone(),
             plane: l.plane,
+            wings: l.wings,
             substreams: writers(&l.substreams),
             vertex_count: l.vertex_count,
             triangle_count: l.triangle_count,

@@ -14,7 +14,8 @@
 //! flagged neighbour); the replay then stops at the error and the stream
 //! ends with that round, so the decoder must report the very same error.
 //!
-//! Each level gets a plane policy from the choices (SPEC §5.1); with 31
+//! Each level gets a plane policy and a wing policy from the choices (SPEC
+//! §5.1); with 31
 //! bits per axis the base meshes are scaled up to the top of the grid, so
 //! that the predictions' wide arithmetic (SPEC §7.4) is exercised.
 
@@ -29,8 +30,8 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Decoder, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane, PlanePolicy,
-    PositionMode, RecordSource, Ring, SplitFan, SplitRecord, Target, arc_means,
-    constrained_positions, context, predict, workspace_len,
+    PositionMode, RecordSource, Ring, SplitFan, SplitRecord, Target, WingPolicy, arc_means,
+    constrained_positions, context, predict, wing_order, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -188,6 +189,7 @@ struct GenSource<'g, 'c> {
     subs: &'g mut [SubstreamWriter],
     mode: PositionMode,
     plane: PlanePolicy,
+    wings: WingPolicy,
     bits: u8,
     allow_invalid: bool,
 }
@@ -266,17 +268,28 @@ impl RecordSource for GenSource<'_, '_> {
         let wing_context = context::wing(eligible.count());
         // The wings as ranks among the entries that may be wings (SPEC
         // §7.4); raw ranks name whatever pair they name, or none.
+        // Under a near wing policy (3.2) the ranks count in the near order.
+        let mut keys: wing_order::NearKeys = [0; 255];
+        let m = wing_order::near_keys(state.positions(), ring, &eligible, self.wings, &mut keys);
+        let keys = &keys[..m];
         let (o_rank, d_rank) = if self.allow_invalid && c.byte() == 0xFF {
             (c.byte(), c.byte())
         } else if pairs.is_empty() {
             (0, 0)
         } else {
             let (o, d) = pairs[c.below(pairs.len())];
-            eligible.ranks(o, d).expect("pairs are eligible")
+            match self.wings {
+                WingPolicy::Ranks => eligible.ranks(o, d),
+                _ => wing_order::near_ranks(keys, k, o, d),
+            }
+            .expect("pairs are eligible")
         };
         self.subs[1].byte_in(wing_context, o_rank);
         self.subs[2].byte_in(wing_context, d_rank);
-        let (o, d) = eligible.wings(o_rank, d_rank)?;
+        let (o, d) = match self.wings {
+            WingPolicy::Ranks => eligible.wings(o_rank, d_rank)?,
+            _ => wing_order::near_wings(keys, k, o_rank, d_rank)?,
+        };
         let (valence_p, valence_c) = (d + 2, k - d + 2);
         let (deficit_p, deficit_c) = (
             pick_deficit(c.byte(), valence_p),
@@ -472,6 +485,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         let mut round_splits = Vec::new();
         let level_start_v = state.vertex_count();
         let plane = PlanePolicy::ALL[choices.below(PlanePolicy::ALL.len())];
+        let wings = WingPolicy::ALL[choices.below(WingPolicy::ALL.len())];
         let rounds = 3 - choices.below(3);
         for _ in 0..rounds {
             let n = state.vertex_count();
@@ -536,6 +550,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                 subs: &mut subs,
                 mode: position_mode,
                 plane,
+                wings,
                 bits,
                 allow_invalid,
             };
@@ -547,6 +562,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                     levels.push(LevelPayload {
                         round_splits,
                         plane,
+                        wings,
                         substreams: subs,
                         vertex_count: n + declared,
                         triangle_count: state.triangle_count() + remaining,
@@ -564,6 +580,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         levels.push(LevelPayload {
             round_splits,
             plane,
+            wings,
             substreams: subs,
             vertex_count: state.vertex_count(),
             triangle_count: state.triangle_count(),
@@ -747,7 +764,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
         .iter()
         .map(|l| l.substreams.iter().map(|s| s.as_bytes().to_vec()).collect())
         .collect();
-    let mut meta: Vec<(Vec<u32>, u32, u32, PlanePolicy)> = g
+    let mut meta: Vec<(Vec<u32>, u32, u32, PlanePolicy, WingPolicy)> = g
         .levels
         .iter()
         .map(|l| {
@@ -756,6 +773,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 l.vertex_count,
                 l.triangle_count,
                 l.plane,
+                l.wings,
             )
         })
         .collect();
@@ -806,7 +824,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 }
             }
             6 => {
-                let (splits, _, _, _) = &mut meta[l];
+                let (splits, _, _, _, _) = &mut meta[l];
                 let r = ops.below(splits.len());
                 let delta = (ops.byte() as i8 % 3) as i32;
                 if let Some(x) = splits.get_mut(r) {
@@ -814,14 +832,14 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 }
             }
             7 => {
-                let (_, v, t, _) = &mut meta[l];
+                let (_, v, t, _, _) = &mut meta[l];
                 let dv = (ops.byte() as i8 % 3) as i64;
                 let dt = (ops.byte() as i8 % 3) as i64;
                 *v = (*v as i64 + dv).clamp(0, u32::MAX as i64) as u32;
                 *t = (*t as i64 + dt).clamp(0, u32::MAX as i64) as u32;
             }
             8 => {
-                let (splits, _, _, _) = &mut meta[l];
+                let (splits, _, _, _, _) = &mut meta[l];
                 if ops.byte() & 1 == 0 {
                     splits.pop();
                 } else {
@@ -855,8 +873,13 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 bytes.extend(core::iter::repeat_n(v, n as usize));
             }
             11 => {
-                // Another plane policy for the level (SPEC §5.1, §7.4).
-                meta[l].3 = PlanePolicy::ALL[ops.below(PlanePolicy::ALL.len())];
+                // Another plane or wing policy for the level (SPEC §5.1,
+                // §7.4).
+                if ops.byte() & 1 == 0 {
+                    meta[l].3 = PlanePolicy::ALL[ops.below(PlanePolicy::ALL.len())];
+                } else {
+                    meta[l].4 = WingPolicy::ALL[ops.below(WingPolicy::ALL.len())];
+                }
             }
             _ => {
                 // Drop the last level (never the base).
@@ -871,9 +894,10 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
         .into_iter()
         .zip(meta)
         .map(
-            |(s, (round_splits, vertex_count, triangle_count, plane))| LevelPayload {
+            |(s, (round_splits, vertex_count, triangle_count, plane, wings))| LevelPayload {
                 round_splits,
                 plane,
+                wings,
                 substreams: s
                     .into_iter()
                     .map(|b| {

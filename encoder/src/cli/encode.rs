@@ -11,7 +11,9 @@ use splitstream_encoder::emit::{EncodeOptions, SEED_VERTICES, encode, encode_aut
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::{Quantization, Units};
 
-use super::{BackendArg, CliResult, Codec, LatticeArg, PlaneArg, Position, QuantizationArg};
+use super::{
+    BackendArg, CliResult, Codec, LatticeArg, PlaneArg, Position, QuantizationArg, WingsArg,
+};
 
 /// `splitstream encode`'s arguments.
 #[derive(clap::Args)]
@@ -80,6 +82,11 @@ pub struct Args {
     /// format 3.1) (SPEC §7.4); `auto` picks the cheapest per level.
     #[arg(long, value_enum, default_value_t = PlaneArg::Auto)]
     pub plane: PlaneArg,
+    /// How each level names its splits' wings: `ranks` in ring order, or
+    /// `near`/`near-xy`, in the order of their distance to the ring's
+    /// centre (format 3.2) (SPEC §7.4); `auto` picks the cheapest per level.
+    #[arg(long, value_enum, default_value_t = WingsArg::Auto)]
+    pub wings: WingsArg,
     /// Where the simplification's data-parallel passes run (GPU backends:
     /// quadrics, best edges and selection on the device, collapses on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
@@ -139,6 +146,7 @@ pub fn run(a: Args) -> CliResult {
         lattice: a.lattice.lattice(),
         backend: a.backend.into(),
         plane: a.plane.policy(),
+        wings: a.wings.policy(),
     };
     let degrees_unconverted = !a.geographic && looks_geographic(&mesh);
     if degrees_unconverted {

@@ -86,14 +86,16 @@ pub fn run(input: &Path, json: bool) -> CliResult {
     let table = LevelTable::parse(&stream, &header).map_err(fail)?;
     let sizes =
         field_sizes(&stream, &header, &table).map_err(|e| format!("{}: {e}", input.display()))?;
-    // Each level's plane policy (SPEC §5.1, §7.4).
-    let planes: Vec<&str> = (0..table.len())
+    // Each level's plane and wing policies (SPEC §5.1, §7.4).
+    let policies: Vec<(&str, &str)> = (0..table.len())
         .map(|k| {
             let e = table.get(k);
             stream
                 .get(e.offset as usize..(e.offset + e.length as u64) as usize)
                 .and_then(|b| LevelHeader::parse(b, k == 0, header.max_chunk_len).ok())
-                .map_or("?", |lh| lh.plane_policy.name())
+                .map_or(("?", "?"), |lh| {
+                    (lh.plane_policy.name(), lh.wing_policy.name())
+                })
         })
         .collect();
     let n = header.vertex_capacity as f64;
@@ -123,7 +125,8 @@ pub fn run(input: &Path, json: bool) -> CliResult {
                     "level": k, "offset": e.offset, "length": e.length,
                     "vertices": e.vertex_count, "triangles": e.triangle_count,
                     "rounds": e.round_count, "geometric_error": e.geometric_error,
-                    "plane_policy": planes[k as usize],
+                    "plane_policy": policies[k as usize].0,
+                    "wing_policy": policies[k as usize].1,
                     "workspace_bytes": memory[k as usize],
                 })
             })
@@ -189,19 +192,20 @@ pub fn run(input: &Path, json: bool) -> CliResult {
         header.max_chunk_len
     );
     println!(
-        "  level    offset     bytes   vertices  triangles rounds  plane     decoder memory  geometric error"
+        "  level    offset     bytes   vertices  triangles rounds  plane     wings    decoder memory  geometric error"
     );
     for k in 0..table.len() {
         let e = table.get(k);
         println!(
-            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:>14}  {:.6}",
+            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:>14}  {:.6}",
             k,
             e.offset,
             e.length,
             e.vertex_count,
             e.triangle_count,
             e.round_count,
-            planes[k as usize],
+            policies[k as usize].0,
+            policies[k as usize].1,
             memory[k as usize],
             e.geometric_error
         );

@@ -117,6 +117,32 @@ impl PlaneArg {
     }
 }
 
+/// How each level names the wings of its splits (SPEC §7.4, format 3.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum WingsArg {
+    /// Per level, the policy whose wing ranks take fewest bytes.
+    #[default]
+    Auto,
+    /// Ranks in ring order (readable by every 3.x decoder).
+    Ranks,
+    /// Ranks in the near order: by distance to the ring's centre (3.2).
+    Near,
+    /// The near order over x and y only (terrain; 3.2).
+    NearXy,
+}
+
+impl WingsArg {
+    pub fn policy(self) -> Option<splitstream_decoder_core::WingPolicy> {
+        use splitstream_decoder_core::WingPolicy;
+        match self {
+            WingsArg::Auto => None,
+            WingsArg::Ranks => Some(WingPolicy::Ranks),
+            WingsArg::Near => Some(WingPolicy::Near),
+            WingsArg::NearXy => Some(WingPolicy::NearXy),
+        }
+    }
+}
+
 /// Where the simplifier's data-parallel passes run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {

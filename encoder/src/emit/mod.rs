@@ -5,9 +5,10 @@
 mod levels;
 mod policies;
 mod replay;
+mod wings;
 
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
-use splitstream_decoder_core::{PlanePolicy, PositionMode};
+use splitstream_decoder_core::{PlanePolicy, PositionMode, WingPolicy};
 
 use crate::mesh::Mesh;
 use crate::quantize::{Lattice, Quantization, QuantizedMesh, Units, quantize_with};
@@ -51,6 +52,9 @@ pub struct EncodeOptions {
     /// The plane policy of every level (SPEC §7.4); `None`: per level, the
     /// one whose residuals take fewest bytes.
     pub plane: Option<PlanePolicy>,
+    /// The wing policy of every level (SPEC §7.4, format 3.2); `None`: per
+    /// level, the one whose wing ranks take fewest bytes.
+    pub wings: Option<WingPolicy>,
 }
 
 impl Default for EncodeOptions {
@@ -70,6 +74,7 @@ impl Default for EncodeOptions {
             lattice: None,
             backend: Backend::Cpu,
             plane: None,
+            wings: None,
         }
     }
 }
@@ -219,8 +224,15 @@ pub fn encode_quantized(
         codec: options.codec,
         chunk_limit: options.chunk_limit,
     };
-    let replayed = replay(mesh, &simplification, &plan, &params, options.plane)
-        .map_err(EncodeError::Replay)?;
+    let replayed = replay(
+        mesh,
+        &simplification,
+        &plan,
+        &params,
+        options.plane,
+        options.wings,
+    )
+    .map_err(EncodeError::Replay)?;
     let level_vertex_counts = replayed
         .levels
         .iter()

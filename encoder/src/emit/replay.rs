@@ -9,8 +9,8 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     CornerRefs, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource, Ring, SplitFan,
-    SplitOutcome, SplitRecord, StateMemory, Target, add_residual, arc_means, constrained_positions,
-    context, predict, residual,
+    SplitOutcome, SplitRecord, StateMemory, Target, WingPolicy, add_residual, arc_means,
+    constrained_positions, context, predict, residual,
 };
 
 use std::sync::mpsc;
@@ -19,6 +19,7 @@ use rayon::prelude::*;
 
 use super::levels::LevelPlan;
 use super::policies::{SplitResiduals, choose_policy, code_policies};
+use super::wings::WingCoding;
 use crate::corner_table::Fan;
 use crate::prefetch::prefetch;
 use crate::quantize::QuantizedMesh;
@@ -114,6 +115,8 @@ struct StepSource<'a> {
     enc2dec: &'a mut [u32],
     dec2enc: &'a mut Vec<u32>,
     subs: &'a mut [SubstreamWriter],
+    /// The level's wings under every wing policy that may be chosen.
+    wing_coding: &'a mut WingCoding,
     /// The round's residual vectors, coded under every plane policy on
     /// another thread (`policies`).
     residuals: &'a mut Vec<SplitResiduals>,
@@ -216,17 +219,14 @@ impl RecordSource for StepSource<'_> {
         if parent != col.position_r {
             return Err(self.fail(format!("position of {id} differs from its collapse")));
         }
-        // SPEC §7.4: the wings as ranks among the entries that may be wings.
-        let eligible = state.wing_candidates(ring);
-        let Some((o_rank, d_rank)) = eligible.ranks(o, d) else {
+        // SPEC §7.4: the wings as ranks among the entries that may be
+        // wings, in ring order or in the near order of a wing policy.
+        if !self.wing_coding.write(state, ring, o, d) {
             return Err(self.fail(format!(
                 "a wing of the collapse of {id} was a candidate at the start of its round"
             )));
-        };
-        let wing_context = context::wing(eligible.count());
+        }
         let s = &mut *self.subs;
-        s[slot(substream::WING_OFFSET)].byte_in(wing_context, o_rank);
-        s[slot(substream::WING_DISTANCE)].byte_in(wing_context, d_rank);
         s[slot(substream::DEFICIT_P)].byte_in(context::SINGLE, split_valence_symbol(dp, valence_p));
         s[slot(substream::DEFICIT_C)].byte_in(
             context::deficit_c(dp, valence_c),
@@ -349,14 +349,16 @@ fn height_residual(
 type FramedLevel = (LevelPayload, (Vec<u8>, u32));
 
 /// Replays `s` level by level as planned, returning the level payloads,
-/// each with the plane policy `plane`, or by default the one whose
-/// residuals cost least under `params`.
+/// each with the plane policy `plane` and the wing policy `wing_policy`, or
+/// by default the ones whose residuals and wing ranks cost least under
+/// `params`.
 pub fn replay(
     mesh: &QuantizedMesh,
     s: &Simplification,
     plan: &LevelPlan,
     params: &StreamParams,
     plane: Option<PlanePolicy>,
+    wing_policy: Option<WingPolicy>,
 ) -> Result<Replayed, ReplayError> {
     let mode = params.position_mode;
     let n = mesh.positions.len();
@@ -422,6 +424,7 @@ pub fn replay(
         let mut choosing = Vec::with_capacity(plan.rounds.len());
         for (l, steps) in plan.rounds.iter().enumerate() {
             let mut subs = vec![SubstreamWriter::default(); 7];
+            let mut wing_coding = WingCoding::new(wing_policy);
             // The level's residuals go round by round to a thread that
             // codes them under every plane policy.
             let (batches, coded_batches) = mpsc::channel();
@@ -454,6 +457,7 @@ pub fn replay(
                     enc2dec: &mut enc2dec,
                     dec2enc: &mut dec2enc,
                     subs: &mut subs,
+                    wing_coding: &mut wing_coding,
                     residuals: &mut residuals,
                     mode,
                     heights: plane.is_none_or(|p| p == PlanePolicy::Height),
@@ -485,9 +489,11 @@ pub fn replay(
                     .map_err(level_error)?;
                 let plane = choose_policy(&mut subs, residuals, params, plane)
                     .map_err(|why| level_error(why.to_string()))?;
+                let wings = wing_coding.choose(&mut subs, params);
                 let level = LevelPayload {
                     round_splits,
                     plane,
+                    wings,
                     substreams: subs,
                     vertex_count,
                     triangle_count,
@@ -579,6 +585,7 @@ mod tests {
             current[d] = i as u32;
         }
         let mut subs = vec![SubstreamWriter::default(); 7];
+        let mut wing_coding = WingCoding::new(None);
         let mut residuals = Vec::new();
         let mut source = StepSource {
             collapses: &[],
@@ -587,6 +594,7 @@ mod tests {
             enc2dec: &mut enc2dec,
             dec2enc: &mut dec2enc,
             subs: &mut subs,
+            wing_coding: &mut wing_coding,
             residuals: &mut residuals,
             mode: PositionMode::Optimal,
             heights: true,

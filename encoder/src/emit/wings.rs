@@ -1,0 +1,86 @@
+//! The wing policy of a level (SPEC §5.1, §7.4, format 3.2): the replay
+//! writes each split's wings under every policy that may be chosen, and the
+//! level keeps the policy whose two wing substreams code smallest.
+
+use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, substream};
+use splitstream_decoder_core::wing_order::{NearKeys, near_keys, near_ranks};
+use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, SubstreamWriter, coded_len};
+use splitstream_decoder_core::{MeshState, Ring, WingCandidates, WingPolicy, context};
+
+/// One level's wing ranks under every wing policy that may be chosen.
+#[derive(Clone)]
+pub struct WingCoding {
+    /// Per policy of [`WingPolicy::ALL`]: the wing-offset and wing-distance
+    /// values, or `None` when the policy is not a choice.
+    coded: [Option<[SubstreamWriter; 2]>; 3],
+    keys: NearKeys,
+}
+
+impl WingCoding {
+    /// Every policy, or only `forced`.
+    pub fn new(forced: Option<WingPolicy>) -> WingCoding {
+        let used = |p: WingPolicy| forced.is_none_or(|f| f == p);
+        WingCoding {
+            coded: WingPolicy::ALL.map(|p| used(p).then(Default::default)),
+            keys: [0; MAX_SPLIT_VALENCE],
+        }
+    }
+
+    /// Records the wings at ring positions `o` and `o + d` of the split of
+    /// `ring`, under each policy; `false` when they are not both eligible.
+    pub fn write(&mut self, state: &MeshState<'_>, ring: &Ring, o: usize, d: usize) -> bool {
+        let eligible: WingCandidates = state.wing_candidates(ring);
+        let ctx = context::wing(eligible.count());
+        for (policy, coded) in WingPolicy::ALL.iter().zip(&mut self.coded) {
+            let Some([offset, distance]) = coded else {
+                continue;
+            };
+            let ranks = match policy {
+                WingPolicy::Ranks => eligible.ranks(o, d),
+                near => {
+                    let m = near_keys(state.positions(), ring, &eligible, *near, &mut self.keys);
+                    near_ranks(&self.keys[..m], ring.len(), o, d)
+                }
+            };
+            let Some((first, second)) = ranks else {
+                return false;
+            };
+            offset.byte_in(ctx, first);
+            distance.byte_in(ctx, second);
+        }
+        true
+    }
+
+    /// Puts the cheapest policy's wing substreams into `subs` (ids 1..=7 at
+    /// 0..=6) and returns it; ties go to the earlier policy, so `ranks`
+    /// (readable by 3.0 and 3.1 decoders) wins when nothing is gained.
+    pub fn choose(self, subs: &mut [SubstreamWriter], params: &StreamParams) -> WingPolicy {
+        // Ranked as the rANS codec would code them, deflate fallback aside
+        // (as the plane policies are, `policies::choose_policy`).
+        let ranking = match params.codec {
+            ChunkCodec::Rans { lanes } => StreamParams {
+                codec: ChunkCodec::RansAlways { lanes },
+                ..*params
+            },
+            _ => *params,
+        };
+        let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
+        let (policy, [offset, distance]) = WingPolicy::ALL
+            .into_iter()
+            .zip(self.coded)
+            .filter_map(|(p, c)| c.map(|c| (p, c)))
+            .min_by_key(|(p, [offset, distance])| {
+                let cost = if single {
+                    0
+                } else {
+                    coded_len(offset, substream::WING_OFFSET, &ranking)
+                        + coded_len(distance, substream::WING_DISTANCE, &ranking)
+                };
+                (cost, p.to_byte())
+            })
+            .expect("at least one wing policy is a choice");
+        subs[(substream::WING_OFFSET - substream::FLAGS) as usize] = offset;
+        subs[(substream::WING_DISTANCE - substream::FLAGS) as usize] = distance;
+        policy
+    }
+}
