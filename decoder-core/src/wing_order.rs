@@ -68,19 +68,16 @@ pub const KEY_CAP: u64 = (1 << 47) - 1;
 /// Room for the order keys of one ring's eligible entries ([`near_keys`]).
 pub type NearKeys = [u64; MAX_SPLIT_VALENCE];
 
-/// Writes the near order key `K(i) = near_key(i) × 256 + i` of every
-/// eligible ring entry `i`, in ring order, into `keys`, and returns how many
-/// (SPEC §7.4). `near_key(i)` is the squared distance, over the policy's
-/// axes, from `r_i` to the floor mean of the ring's real entries, capped at
-/// [`KEY_CAP`]; the ghost's is the cap. Keys are distinct, since `i` is in
-/// them.
-pub fn near_keys(
+/// Calls `f(i, d)` for every eligible ring entry `i`, in ring order, with
+/// `d` its distance to the floor mean of the ring's real entries per axis
+/// (SPEC §7.4), or `None` for the ghost.
+#[inline(always)]
+fn centre_distances(
     positions: &[[u32; 3]],
     ring: &Ring,
     eligible: &WingCandidates,
-    policy: WingPolicy,
-    keys: &mut NearKeys,
-) -> usize {
+    mut f: impl FnMut(usize, Option<[u64; 3]>),
+) {
     let vertices = ring.vertices();
     let (mut sum, mut n) = ([0u64; 3], 0u64);
     for &v in vertices {
@@ -95,29 +92,71 @@ pub fn near_keys(
     }
     let n = n.max(1);
     let centre = [sum[0] / n, sum[1] / n, sum[2] / n];
-    let z_mask = if policy.axes() == 3 { u64::MAX } else { 0 };
-    let mut m = 0;
     for w in 0..vertices.len().div_ceil(64) {
         let mut bits = eligible.word(w);
         while bits != 0 {
             let i = 64 * w + bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let key = match vertices.get(i).and_then(|&v| positions.get(v as usize)) {
-                Some(p) => {
-                    // Each square is below 2^62: three fit in 64 bits.
-                    let dx = (p[0] as u64).abs_diff(centre[0]);
-                    let dy = (p[1] as u64).abs_diff(centre[1]);
-                    let dz = (p[2] as u64).abs_diff(centre[2]) & z_mask;
-                    (dx * dx + dy * dy + dz * dz).min(KEY_CAP)
-                }
-                None => KEY_CAP,
-            };
-            if let Some(slot) = keys.get_mut(m) {
-                *slot = (key << 8) | i as u64;
-                m += 1;
-            }
+            let d = vertices
+                .get(i)
+                .and_then(|&v| positions.get(v as usize))
+                .map(|p| core::array::from_fn(|a| (p[a] as u64).abs_diff(centre[a])));
+            f(i, d);
         }
     }
+}
+
+/// The order key of entry `i` from its squared distance (SPEC §7.4).
+#[inline(always)]
+fn order_key(i: usize, squared: Option<u64>) -> u64 {
+    (squared.map_or(KEY_CAP, |q| q.min(KEY_CAP)) << 8) | i as u64
+}
+
+/// Writes the near order key `K(i) = near_key(i) × 256 + i` of every
+/// eligible ring entry `i`, in ring order, into `keys`, and returns how many
+/// (SPEC §7.4). `near_key(i)` is the squared distance, over the policy's
+/// axes, from `r_i` to the floor mean of the ring's real entries, capped at
+/// [`KEY_CAP`]; the ghost's is the cap. Keys are distinct, since `i` is in
+/// them. (A coordinate difference is below 2^31, so each square is below
+/// 2^62 and three of them fit in 64 bits.)
+pub fn near_keys(
+    positions: &[[u32; 3]],
+    ring: &Ring,
+    eligible: &WingCandidates,
+    policy: WingPolicy,
+    keys: &mut NearKeys,
+) -> usize {
+    let z_mask = if policy.axes() == 3 { u64::MAX } else { 0 };
+    let mut m = 0;
+    centre_distances(positions, ring, eligible, |i, d| {
+        let squared = d.map(|[dx, dy, dz]| dx * dx + dy * dy + (dz & z_mask) * (dz & z_mask));
+        if let Some(slot) = keys.get_mut(m) {
+            *slot = order_key(i, squared);
+            m += 1;
+        }
+    });
+    m
+}
+
+/// [`near_keys`] under `near` and under `near-xy` at once (an encoder
+/// weighing both): one pass over the ring.
+pub fn near_keys_both(
+    positions: &[[u32; 3]],
+    ring: &Ring,
+    eligible: &WingCandidates,
+    near: &mut NearKeys,
+    near_xy: &mut NearKeys,
+) -> usize {
+    let mut m = 0;
+    centre_distances(positions, ring, eligible, |i, d| {
+        let xy = d.map(|[dx, dy, _]| dx * dx + dy * dy);
+        let xyz = d.map(|[dx, dy, dz]| dx * dx + dy * dy + dz * dz);
+        if let (Some(a), Some(b)) = (near.get_mut(m), near_xy.get_mut(m)) {
+            *a = order_key(i, xyz);
+            *b = order_key(i, xy);
+            m += 1;
+        }
+    });
     m
 }
 
@@ -249,6 +288,29 @@ mod tests {
             Err(Error::RingOffsetOutOfRange)
         );
         assert_eq!(near_wings(&[], 0, 0, 0), Err(Error::RingOffsetOutOfRange));
+    }
+
+    #[test]
+    fn both_key_sets_at_once_are_each_policys() {
+        let positions = [
+            [7, 100, 3],
+            [50, 9, 1000],
+            [20, 30, 40],
+            [0, 0, 0],
+            [99, 1, 5],
+        ];
+        let ring = Ring::of_vertices(&[0, 1, crate::limits::NONE, 2, 4, 3]);
+        let eligible = WingCandidates::from_first_mask(0b110111);
+        let (mut a, mut b) = ([0; MAX_SPLIT_VALENCE], [0; MAX_SPLIT_VALENCE]);
+        let m = near_keys_both(&positions, &ring, &eligible, &mut a, &mut b);
+        for (policy, both) in [(WingPolicy::Near, &a), (WingPolicy::NearXy, &b)] {
+            let mut one = [0; MAX_SPLIT_VALENCE];
+            assert_eq!(near_keys(&positions, &ring, &eligible, policy, &mut one), m);
+            assert_eq!(one[..m], both[..m]);
+        }
+        assert_eq!(m, 5);
+        // The ghost (ring position 2) has the capped key.
+        assert_eq!(a[2], (KEY_CAP << 8) | 2);
     }
 
     #[test]

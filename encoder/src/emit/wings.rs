@@ -3,7 +3,7 @@
 //! level keeps the policy whose two wing substreams code smallest.
 
 use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, substream};
-use splitstream_decoder_core::wing_order::{NearKeys, near_keys, near_ranks};
+use splitstream_decoder_core::wing_order::{NearKeys, near_keys, near_keys_both, near_ranks};
 use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, SubstreamWriter, coded_len};
 use splitstream_decoder_core::{MeshState, Ring, WingCandidates, WingPolicy, context};
 
@@ -13,7 +13,8 @@ pub struct WingCoding {
     /// Per policy of [`WingPolicy::ALL`]: the wing-offset and wing-distance
     /// values, or `None` when the policy is not a choice.
     coded: [Option<[SubstreamWriter; 2]>; 3],
-    keys: NearKeys,
+    /// The current ring's keys under `near` and `near-xy`.
+    keys: [NearKeys; 2],
 }
 
 impl WingCoding {
@@ -22,7 +23,7 @@ impl WingCoding {
         let used = |p: WingPolicy| forced.is_none_or(|f| f == p);
         WingCoding {
             coded: WingPolicy::ALL.map(|p| used(p).then(Default::default)),
-            keys: [0; MAX_SPLIT_VALENCE],
+            keys: [[0; MAX_SPLIT_VALENCE]; 2],
         }
     }
 
@@ -31,16 +32,31 @@ impl WingCoding {
     pub fn write(&mut self, state: &MeshState<'_>, ring: &Ring, o: usize, d: usize) -> bool {
         let eligible: WingCandidates = state.wing_candidates(ring);
         let ctx = context::wing(eligible.count());
-        for (policy, coded) in WingPolicy::ALL.iter().zip(&mut self.coded) {
+        let k = ring.len();
+        // The near keys of both near policies in one pass over the ring
+        // (this runs on the replay's thread, the emission's critical path).
+        let [near, near_xy] = &mut self.keys;
+        let m = match (&self.coded[1], &self.coded[2]) {
+            (Some(_), Some(_)) => near_keys_both(state.positions(), ring, &eligible, near, near_xy),
+            (Some(_), None) => {
+                near_keys(state.positions(), ring, &eligible, WingPolicy::Near, near)
+            }
+            (None, Some(_)) => near_keys(
+                state.positions(),
+                ring,
+                &eligible,
+                WingPolicy::NearXy,
+                near_xy,
+            ),
+            (None, None) => 0,
+        };
+        for (index, coded) in self.coded.iter_mut().enumerate() {
             let Some([offset, distance]) = coded else {
                 continue;
             };
-            let ranks = match policy {
-                WingPolicy::Ranks => eligible.ranks(o, d),
-                near => {
-                    let m = near_keys(state.positions(), ring, &eligible, *near, &mut self.keys);
-                    near_ranks(&self.keys[..m], ring.len(), o, d)
-                }
+            let ranks = match index {
+                0 => eligible.ranks(o, d),
+                near => near_ranks(&self.keys[near - 1][..m], k, o, d),
             };
             let Some((first, second)) = ranks else {
                 return false;
