@@ -26,6 +26,8 @@ MAX_TRIANGLES = 0x55555554
 STATE_LOW = 1 << 23
 RANS_SLOT_BYTES = 1856
 NCTX = {1: 1, 2: 8, 3: 8, 4: 1, 5: 5, 6: 3, 7: 5, 8: 3, 9: 1, 10: 1}
+# Under the deficit contexts `valence` (3.3) deficit-p has 5, deficit-c 6.
+NCTX_VALENCE = {**NCTX, 4: 5, 5: 6}
 
 
 class Fail(Exception):
@@ -221,8 +223,9 @@ def decode_value(L, tab):
 
 # ---------------------------------------------------------------- substreams
 class Sub:
-    def __init__(self, sid, chunks, lane_count):
+    def __init__(self, sid, chunks, lane_count, nctx):
         self.sid = sid
+        self.nctx = nctx  # rANS tables per chunk (§5.3, §5.5.5)
         self.chunks = chunks  # list of (codec, raw_len, crc, payload)
         self.rans = bool(chunks) and chunks[0][0] == 2
         self.idx = 0
@@ -254,7 +257,7 @@ class Sub:
                 raise Fail("malformed")
             self.buf = out
         else:
-            self.tables, self.lanes = parse_rans(payload, NCTX[self.sid], raw_len, self.lane_count)
+            self.tables, self.lanes = parse_rans(payload, self.nctx, raw_len, self.lane_count)
         self.len = raw_len
         self.pos = 0
 
@@ -465,7 +468,9 @@ class Decoder:
             raise Fail("malformed")
         if lvl[9] > 2:  # wing policy (3.2)
             raise Fail("malformed")
-        if lvl[10] or lvl[11]:
+        if lvl[10] > 1:  # deficit contexts (3.3)
+            raise Fail("malformed")
+        if lvl[11]:
             raise Fail("malformed")
         if li == 0 and (SV == 0 or ST == 0):
             raise Fail("malformed")
@@ -518,10 +523,12 @@ class Decoder:
         subs = {}
         for sid in range(1, 11):
             lst = [(c, rl, crc, bytes(lvl[off:off + sl])) for (c, rl, crc, off, sl) in chunks.get(sid, [])]
-            subs[sid] = Sub(sid, lst, self.lane_count)
+            nctx = (NCTX_VALENCE if lvl[10] == 1 else NCTX)[sid]
+            subs[sid] = Sub(sid, lst, self.lane_count, nctx)
         self.subs = subs
         self.policy = lvl[8]
         self.wing_policy = lvl[9]
+        self.deficit_contexts = lvl[10]
         self.T_l = entry["T"]
         if li == 0:
             self.read_base(SV, ST)
@@ -701,8 +708,15 @@ class Decoder:
             o, d = self.near_wings(ring, E, op, dp)
         valP = d + 2
         valC = k - d + 2
-        dP = self.deficit_of(subs[4].byte(0), valP)
-        cctx = 4 if dP == LEAF else min(max(valC, 3), 6) - 3
+        if self.deficit_contexts == 0:  # plain
+            pctx = 0
+        else:  # valence (3.3)
+            pctx = min(max(valP, 4), 8) - 4
+        dP = self.deficit_of(subs[4].byte(pctx), valP)
+        if self.deficit_contexts == 0:
+            cctx = 4 if dP == LEAF else min(max(valC, 3), 6) - 3
+        else:
+            cctx = 0 if dP == LEAF else min(max(valC, 4), 8) - 3
         dC = self.deficit_of(subs[5].byte(cctx), valC)
         # arc means
         pos = self.pos

@@ -2,8 +2,64 @@
 //! value is coded with, from what the decoder already knows. Encoders call
 //! the same functions, so both sides agree by construction.
 
-use crate::limits::LEAF;
+use crate::limits::{LEAF, substream};
 use crate::predict::{ArcMeans, PlanePolicy, placement_context};
+
+/// How a level's split-valence symbols are coded (SPEC §5.1, level header
+/// byte 10, format 3.3): which contexts deficit-p and deficit-c use.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum DeficitContexts {
+    /// Formats 3.0 to 3.2: deficit-p in one context, deficit-c by whether P
+    /// is a leaf and by C's valence up to 6.
+    #[default]
+    Plain,
+    /// 3.3: each of P and C by its own valence right after the split, 4 (or
+    /// less) to 8 (or more); deficit-c also by whether P is a leaf. A split
+    /// valence is at least the valence, and it mostly settles near the
+    /// larger of the valence and 7, so the valence shapes its distribution.
+    Valence,
+}
+
+impl DeficitContexts {
+    /// Every choice, in byte order.
+    pub const ALL: [DeficitContexts; 2] = [DeficitContexts::Plain, DeficitContexts::Valence];
+
+    pub fn from_byte(b: u8) -> Option<DeficitContexts> {
+        DeficitContexts::ALL.get(b as usize).copied()
+    }
+
+    pub fn to_byte(self) -> u8 {
+        self as u8
+    }
+
+    /// The name `splitstream info` and the SPEC use.
+    pub fn name(self) -> &'static str {
+        match self {
+            DeficitContexts::Plain => "plain",
+            DeficitContexts::Valence => "valence",
+        }
+    }
+}
+
+/// Number of contexts (frequency tables per rANS chunk) of substream `id`
+/// in a level whose deficit contexts are `deficits` (SPEC §5.5.5).
+pub fn count(id: u8, deficits: DeficitContexts) -> usize {
+    match (id, deficits) {
+        (substream::DEFICIT_P, DeficitContexts::Valence) => 5,
+        (substream::DEFICIT_C, DeficitContexts::Valence) => 6,
+        _ => substream::CONTEXTS.get(id as usize).copied().unwrap_or(0) as usize,
+    }
+}
+
+/// P's split valence: under `valence`, P's valence 4 (or less) … 8 (or
+/// more) right after the split as 0..=4; under `plain`, 0.
+#[inline]
+pub fn deficit_p(deficits: DeficitContexts, valence_p: usize) -> u8 {
+    match deficits {
+        DeficitContexts::Plain => SINGLE,
+        DeficitContexts::Valence => (valence_p.clamp(4, 8) - 4) as u8,
+    }
+}
 
 /// Wing offset and wing distance, by the number `m` of ring entries that
 /// may be wings (SPEC §7.4): 2 or fewer, 3, …, 8, then 9 and more.
@@ -12,15 +68,17 @@ pub fn wing(eligible: usize) -> u8 {
     (eligible.clamp(2, 9) - 2) as u8
 }
 
-/// C's split valence, by P's deficit and C's valence right after the split:
-/// 4 when P is a leaf, otherwise C's valence 3 (or less), 4, 5, or 6 and
-/// more as 0..=3.
+/// C's split valence, by P's deficit and C's valence right after the split.
+/// Under `plain`: 4 when P is a leaf, otherwise C's valence 3 (or less), 4,
+/// 5, or 6 and more as 0..=3. Under `valence`: 0 when P is a leaf,
+/// otherwise C's valence 4 (or less) … 8 (or more) as 1..=5.
 #[inline]
-pub fn deficit_c(deficit_p: u8, valence_c: usize) -> u8 {
-    if deficit_p == LEAF {
-        4
-    } else {
-        (valence_c.clamp(3, 6) - 3) as u8
+pub fn deficit_c(deficits: DeficitContexts, deficit_p: u8, valence_c: usize) -> u8 {
+    match (deficits, deficit_p == LEAF) {
+        (DeficitContexts::Plain, true) => 4,
+        (DeficitContexts::Plain, false) => (valence_c.clamp(3, 6) - 3) as u8,
+        (DeficitContexts::Valence, true) => 0,
+        (DeficitContexts::Valence, false) => (valence_c.clamp(4, 8) - 3) as u8,
     }
 }
 
@@ -50,3 +108,46 @@ pub fn axis(k: usize) -> u8 {
 
 /// Every other value: its substream's single table.
 pub const SINGLE: u8 = 0;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::limits::rans::MAX_CONTEXTS;
+
+    /// Every context a deficit can get is one of its substream's tables
+    /// (SPEC §5.5.5), for every valence a ring allows and both leafnesses.
+    #[test]
+    fn deficit_contexts_stay_below_the_table_count() {
+        for set in DeficitContexts::ALL {
+            let (p_tables, c_tables) = (
+                count(substream::DEFICIT_P, set),
+                count(substream::DEFICIT_C, set),
+            );
+            assert!(p_tables <= MAX_CONTEXTS && c_tables <= MAX_CONTEXTS);
+            let mut p_seen = [false; MAX_CONTEXTS];
+            let mut c_seen = [false; MAX_CONTEXTS];
+            for valence in 2..=257 {
+                let p = deficit_p(set, valence) as usize;
+                assert!(p < p_tables, "{set:?} P valence {valence}");
+                p_seen[p] = true;
+                for deficit_p in [0, 1, 7, LEAF] {
+                    let c = deficit_c(set, deficit_p, valence) as usize;
+                    assert!(c < c_tables, "{set:?} C valence {valence}");
+                    c_seen[c] = true;
+                }
+            }
+            // And every table is used by some split.
+            assert!(p_seen[..p_tables].iter().all(|&s| s), "{set:?}");
+            assert!(c_seen[..c_tables].iter().all(|&s| s), "{set:?}");
+        }
+    }
+
+    #[test]
+    fn deficit_context_bytes_round_trip_and_reserve_the_rest() {
+        for set in DeficitContexts::ALL {
+            assert_eq!(DeficitContexts::from_byte(set.to_byte()), Some(set));
+        }
+        assert_eq!(DeficitContexts::from_byte(2), None);
+        assert_eq!(DeficitContexts::from_byte(255), None);
+    }
+}

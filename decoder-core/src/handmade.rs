@@ -12,7 +12,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::Error;
-use crate::context;
+use crate::context::{self, DeficitContexts};
 use crate::header::PositionMode;
 use crate::limits::LEAF;
 use crate::owned::decode_all;
@@ -157,7 +157,10 @@ pub fn level_with(
         s[2].byte_in(wing, r.d);
         s[3].byte(r.sp);
         let deficit_p = if r.sp == 0 { LEAF } else { 0 };
-        s[4].byte_in(context::deficit_c(deficit_p, r.valence_c as usize), r.sc);
+        s[4].byte_in(
+            context::deficit_c(DeficitContexts::Plain, deficit_p, r.valence_c as usize),
+            r.sc,
+        );
         let order = match r.axis {
             None => [0, 1, 2],
             Some(j) => [(j + 1) % 3, (j + 2) % 3, j],
@@ -173,6 +176,7 @@ pub fn level_with(
         round_splits: rounds,
         plane,
         wings: WingPolicy::Ranks,
+        deficits: DeficitContexts::Plain,
         substreams: s,
         vertex_count: v,
         triangle_count: t,

@@ -1,14 +1,15 @@
-//! A level's own header: rounds, the plane and wing policies, split counts and the
-//! chunk directory (SPEC §5.1, §5.2).
+//! A level's own header: rounds, the plane and wing policies, the deficit
+//! contexts, split counts and the chunk directory (SPEC §5.1, §5.2).
 
 use crate::bytes::{crc32, u8_at, u16_at, u32_at};
+use crate::context::DeficitContexts;
 use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
 use crate::predict::PlanePolicy;
 use crate::wing_order::WingPolicy;
 use crate::{ChecksumScope, Error};
 
 /// Offset of the plane policy byte (SPEC §5.1), followed by the wing policy
-/// byte (3.2) and 2 reserved bytes.
+/// byte (3.2), the deficit contexts byte (3.3) and a reserved byte.
 const PLANE_AT: usize = 8;
 /// Offset of level 0's seed counts (SPEC §5.1).
 const SEED_AT: usize = 12;
@@ -39,7 +40,11 @@ pub struct LevelHeader<'l> {
     /// raw byte is checked by [`LevelHeader::parse`].
     pub wing_policy: WingPolicy,
     wing_byte: u8,
-    reserved: [u8; 2],
+    /// Which contexts code the level's split-valence symbols (SPEC §5.1,
+    /// §5.5.5; format 3.3); the raw byte is checked by [`LevelHeader::parse`].
+    pub deficit_contexts: DeficitContexts,
+    deficit_byte: u8,
+    reserved: u8,
     /// Level 0 only: vertex and triangle counts of the seed mesh its rounds
     /// start from (SPEC §5.1, §6.3); `(0, 0)` for other levels.
     pub seed_vertices: u32,
@@ -68,7 +73,8 @@ impl<'l> LevelHeader<'l> {
         };
         let plane_byte = u8_at(level, PLANE_AT)?;
         let wing_byte = u8_at(level, PLANE_AT + 1)?;
-        let reserved = [u8_at(level, PLANE_AT + 2)?, u8_at(level, PLANE_AT + 3)?];
+        let deficit_byte = u8_at(level, PLANE_AT + 2)?;
+        let reserved = u8_at(level, PLANE_AT + 3)?;
         let splits_len = (round_count as usize)
             .checked_mul(4)
             .ok_or(Error::Truncated)?;
@@ -90,6 +96,9 @@ impl<'l> LevelHeader<'l> {
             plane_byte,
             wing_policy: WingPolicy::from_byte(wing_byte).unwrap_or(WingPolicy::Ranks),
             wing_byte,
+            deficit_contexts: DeficitContexts::from_byte(deficit_byte)
+                .unwrap_or(DeficitContexts::Plain),
+            deficit_byte,
             reserved,
             seed_vertices,
             seed_triangles,
@@ -109,9 +118,12 @@ impl<'l> LevelHeader<'l> {
         if WingPolicy::from_byte(self.wing_byte).is_none() {
             return Err(Error::InvalidLevelHeader("unknown wing policy"));
         }
-        if self.reserved != [0; 2] {
+        if DeficitContexts::from_byte(self.deficit_byte).is_none() {
+            return Err(Error::InvalidLevelHeader("unknown deficit contexts"));
+        }
+        if self.reserved != 0 {
             return Err(Error::InvalidLevelHeader(
-                "reserved level header bytes not zero",
+                "reserved level header byte not zero",
             ));
         }
         if is_base && (self.seed_vertices == 0 || self.seed_triangles == 0) {

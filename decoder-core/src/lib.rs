@@ -55,6 +55,7 @@ pub mod wing_order;
 pub mod writer;
 
 pub use bytes::crc32;
+pub use context::DeficitContexts;
 pub use corner_refs::CornerRefs;
 pub use decoder::{Decoder, LevelDecoder, RoundInfo, declared_layout, layout_for};
 pub use error::{ChecksumScope, Error};

@@ -6,11 +6,14 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 
 /// Format version this crate reads and writes (SPEC §1).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 2;
+pub const VERSION_MINOR: u8 = 3;
+/// The minor version written when a stream uses a wing policy other than
+/// `ranks` and no 3.3 feature, so that 3.2 decoders read it (SPEC §1).
+pub const VERSION_MINOR_WINGS: u8 = 2;
 /// The minor version written when a stream uses the plane policy `height`
-/// and no 3.2 feature, so that 3.1 decoders read it (SPEC §1).
+/// and no 3.2 or 3.3 feature, so that 3.1 decoders read it (SPEC §1).
 pub const VERSION_MINOR_HEIGHT: u8 = 1;
-/// The minor version written when a stream uses no 3.1 or 3.2 feature
+/// The minor version written when a stream uses no 3.1, 3.2 or 3.3 feature
 /// (every reserved field zero), so that 3.0 decoders read it (SPEC §1).
 pub const VERSION_MINOR_BASELINE: u8 = 0;
 
@@ -70,7 +73,9 @@ pub mod substream {
         "base-triangles",
         "base-deficits",
     ];
-    /// Contexts of each substream under the rANS codec (SPEC §5.5), by id.
+    /// Contexts of each substream under the rANS codec (SPEC §5.5), by id,
+    /// in a level with the deficit contexts `plain`; `context::count` gives
+    /// them for every level.
     pub const CONTEXTS: [u8; 11] = [0, 1, 8, 8, 1, 5, 3, 5, 3, 1, 1];
 }
 

@@ -1,7 +1,7 @@
 //! Reading split records and the base mesh from substreams (SPEC §6.3, §7.4).
 
 use crate::Error;
-use crate::context::{self, SINGLE};
+use crate::context::{self, DeficitContexts, SINGLE};
 use crate::header::PositionMode;
 use crate::limits::MAX_SPLIT_VALENCE;
 use crate::limits::substream::{self, SLOTS};
@@ -38,6 +38,8 @@ pub struct StreamSource<'s, 'l, 'b> {
     pub plane: PlanePolicy,
     /// The level's wing policy (SPEC §5.1, 3.2).
     pub wings: WingPolicy,
+    /// The level's deficit contexts (SPEC §5.1, 3.3).
+    pub deficits: DeficitContexts,
     /// The current ring's near keys, under a near wing policy.
     keys: NearKeys,
 }
@@ -48,11 +50,13 @@ impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
     pub fn new(subs: &'s mut Substreams<'l, 'b>, mode: PositionMode) -> Self {
         let plane = subs.level_header().plane_policy;
         let wings = subs.level_header().wing_policy;
+        let deficits = subs.level_header().deficit_contexts;
         StreamSource {
             subs,
             mode,
             plane,
             wings,
+            deficits,
             keys: [0; MAX_SPLIT_VALENCE],
         }
     }
@@ -84,7 +88,8 @@ impl RecordSource for StreamSource<'_, '_, '_> {
     }
 
     /// SPEC §7.4, fields in order: wing ranks (in ring order, or in the near
-    /// order of the level's wing policy), split valences of P and C,
+    /// order of the level's wing policy), split valences of P and C (in the
+    /// level's deficit contexts),
     /// then (constrained) the placement code and one residual vector, or
     /// (optimal) two residual vectors.
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
@@ -102,11 +107,18 @@ impl RecordSource for StreamSource<'_, '_, '_> {
             }
         };
         let (valence_p, valence_c) = (d + 2, k - d + 2);
-        let deficit_p = deficit_of(s.byte(slot(substream::DEFICIT_P), SINGLE)?, valence_p)?;
+        let contexts = self.deficits;
+        let deficit_p = deficit_of(
+            s.byte(
+                slot(substream::DEFICIT_P),
+                context::deficit_p(contexts, valence_p),
+            )?,
+            valence_p,
+        )?;
         let deficit_c = deficit_of(
             s.byte(
                 slot(substream::DEFICIT_C),
-                context::deficit_c(deficit_p, valence_c),
+                context::deficit_c(contexts, deficit_p, valence_c),
             )?,
             valence_c,
         )?;

@@ -9,10 +9,11 @@
 //! its slot's buffer then holds the chunk's frequency tables and lane states,
 //! and values are decoded straight from the level's bytes.
 
+use crate::context;
 use crate::inflate::Inflater;
 use crate::level_header::LevelHeader;
+use crate::limits::codec;
 use crate::limits::substream::SLOTS;
-use crate::limits::{codec, substream};
 use crate::rans::ChunkDecoder;
 use crate::{ChecksumScope, Error, bytes::crc32};
 
@@ -141,7 +142,8 @@ impl<'l, 'b> Substreams<'l, 'b> {
         }
         let raw = e.raw_len as usize;
         if r.rans {
-            open_rans_chunk(self.level, r, e.stored_len as usize, e.raw_len)?;
+            let contexts = context::count(r.id, self.header.deficit_contexts);
+            open_rans_chunk(self.level, r, e.stored_len as usize, e.raw_len, contexts)?;
         } else {
             let out = r.buf.get_mut(..raw).ok_or(Error::CapacityExceeded)?;
             match e.codec {
@@ -345,17 +347,18 @@ impl<'l, 'b> Substreams<'l, 'b> {
 }
 
 /// Loads a rANS chunk of `values` values whose `stored_len` payload bytes
-/// start at `r.payload_at` (SPEC §5.5.2, §5.5.3): its tables and lanes.
+/// start at `r.payload_at` (SPEC §5.5.2, §5.5.3): its tables (one per
+/// context, `contexts` of them) and lanes.
 fn open_rans_chunk(
     level: &[u8],
     r: &mut Reader<'_>,
     stored_len: usize,
     values: u32,
+    contexts: usize,
 ) -> Result<(), Error> {
     let Some(chunk) = r.chunk.as_mut() else {
         return Err(Error::CapacityExceeded);
     };
-    let contexts = substream::CONTEXTS[r.id as usize] as usize;
     chunk.open(
         level,
         r.payload_at,

@@ -5,13 +5,13 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::bytes::crc32;
-use crate::context;
+use crate::context::{self, DeficitContexts};
 use crate::header::{Header, PositionMode};
 use crate::layout::Layout;
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
     CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, VERSION_MINOR_BASELINE, VERSION_MINOR_HEIGHT,
-    codec, substream,
+    VERSION_MINOR_WINGS, codec, substream,
 };
 use crate::predict::PlanePolicy;
 use crate::rans_writer::{Symbol, encode_chunk};
@@ -154,6 +154,10 @@ pub struct LevelPayload {
     pub plane: PlanePolicy,
     /// The level's wing policy (SPEC §5.1, §7.4; 3.2).
     pub wings: WingPolicy,
+    /// The contexts of the level's split-valence symbols (SPEC §5.1,
+    /// §5.5.5; 3.3): they also set how many tables deficit-p and deficit-c
+    /// have.
+    pub deficits: DeficitContexts,
     /// Substreams in id order: ids 1..=7 for rounds (index 0 is id 1), or
     /// ids 8..=10 for a base level given to [`write_stream`].
     pub substreams: Vec<SubstreamWriter>,
@@ -230,6 +234,7 @@ impl SeedPayload {
             round_splits: Vec::new(),
             plane: PlanePolicy::Off,
             wings: WingPolicy::Ranks,
+            deficits: DeficitContexts::Plain,
             vertex_count: self.vertices,
             triangle_count: self.triangles,
             substreams: self.substreams,
@@ -304,11 +309,14 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.2 only where a 3.2 feature (a wing policy other than
-    // `ranks`) is used, 3.1 where a 3.1 feature (the plane policy `height`)
-    // is; every other stream stays readable by 3.0 decoders.
-    let version_minor = if levels.iter().any(|l| l.wings != WingPolicy::Ranks) {
+    // SPEC §1: 3.3 only where a 3.3 feature (the deficit contexts
+    // `valence`) is used, 3.2 where a 3.2 feature (a wing policy other than
+    // `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`) is;
+    // every other stream stays readable by 3.0 decoders.
+    let version_minor = if levels.iter().any(|l| l.deficits != DeficitContexts::Plain) {
         VERSION_MINOR
+    } else if levels.iter().any(|l| l.wings != WingPolicy::Ranks) {
+        VERSION_MINOR_WINGS
     } else if levels.iter().any(|l| l.plane == PlanePolicy::Height) {
         VERSION_MINOR_HEIGHT
     } else {
@@ -381,7 +389,8 @@ pub fn frame_level_with(
         .flat_map(|s| s.substreams.iter().enumerate())
         .map(|(i, s)| (substream::BASE_POSITIONS + i as u8, s));
     for (id, sub) in rounds.chain(base) {
-        let chunks = substream_chunks(sub, id, limit, params.codec, map);
+        let contexts = context::count(id, level.deficits);
+        let chunks = substream_chunks(sub, contexts, limit, params.codec, map);
         for chunk in chunks {
             let mut entry = [0u8; CHUNK_ENTRY_LEN];
             entry[0] = id;
@@ -397,7 +406,12 @@ pub fn frame_level_with(
     let mut out = Vec::new();
     out.extend_from_slice(&(level.round_splits.len() as u32).to_le_bytes());
     out.extend_from_slice(&(directory.len() as u32).to_le_bytes());
-    out.extend_from_slice(&[level.plane.to_byte(), level.wings.to_byte(), 0, 0]);
+    out.extend_from_slice(&[
+        level.plane.to_byte(),
+        level.wings.to_byte(),
+        level.deficits.to_byte(),
+        0,
+    ]);
     if let Some(seed) = seed {
         out.extend_from_slice(&seed.vertices.to_le_bytes());
         out.extend_from_slice(&seed.triangles.to_le_bytes());
@@ -423,10 +437,11 @@ pub fn frame_level_with(
 /// after the last level's replay and bounded the encoder's emission.
 const DEFLATE_QUICK_RATIO: (usize, usize) = (5, 3);
 
-/// The chunks of substream `id` as `frame_level` codes them.
+/// The chunks of a substream as `frame_level` codes them, in a level whose
+/// rANS chunks have `contexts` tables for it (`context::count`).
 fn substream_chunks(
     sub: &SubstreamWriter,
-    id: u8,
+    contexts: usize,
     limit: usize,
     chunk_codec: ChunkCodec,
     map: ChunkMap<'_>,
@@ -435,7 +450,7 @@ fn substream_chunks(
         ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None, map),
         ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l), map),
         ChunkCodec::Rans { lanes } => {
-            let rans = rans_chunks(sub.symbols(), limit, id, lanes as usize, map);
+            let rans = rans_chunks(sub.symbols(), limit, contexts, lanes as usize, map);
             let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
             // Level 10 is slow (up to 1,500 match probes per byte); a quick
             // level-1 pass first rules it out where it cannot win.
@@ -451,17 +466,30 @@ fn substream_chunks(
             }
         }
         ChunkCodec::RansAlways { lanes } => {
-            rans_chunks(sub.symbols(), limit, id, lanes as usize, map)
+            rans_chunks(sub.symbols(), limit, contexts, lanes as usize, map)
         }
     }
 }
 
-/// Bytes substream `id` takes in a level framed with `params`: its chunk
-/// payloads and directory entries. Lets an encoder compare alternatives
-/// (the plane policies of SPEC §7.4) by their real cost.
+/// Bytes substream `id` takes in a level framed with `params`, whose deficit
+/// contexts are `plain`: its chunk payloads and directory entries. Lets an
+/// encoder compare alternatives (the plane policies of SPEC §7.4) by their
+/// real cost.
 pub fn coded_len(sub: &SubstreamWriter, id: u8, params: &StreamParams) -> usize {
+    coded_len_in(sub, id, DeficitContexts::Plain, params)
+}
+
+/// [`coded_len`] in a level whose deficit contexts are `deficits` (they set
+/// the table count of deficit-p and deficit-c, SPEC §5.5.5).
+pub fn coded_len_in(
+    sub: &SubstreamWriter,
+    id: u8,
+    deficits: DeficitContexts,
+    params: &StreamParams,
+) -> usize {
     let limit = params.chunk_limit.max(1) as usize;
-    substream_chunks(sub, id, limit, params.codec, &one_by_one)
+    let contexts = context::count(id, deficits);
+    substream_chunks(sub, contexts, limit, params.codec, &one_by_one)
         .iter()
         .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)
         .sum()
@@ -495,15 +523,15 @@ fn byte_chunks(bytes: &[u8], limit: usize, level: Option<u8>, map: ChunkMap<'_>)
     })
 }
 
-/// rANS chunks of at most `limit` values each (SPEC §5.5).
+/// rANS chunks of at most `limit` values each, `contexts` tables each
+/// (SPEC §5.5).
 fn rans_chunks(
     symbols: &[Symbol],
     limit: usize,
-    id: u8,
+    contexts: usize,
     lanes: usize,
     map: ChunkMap<'_>,
 ) -> Vec<Chunk> {
-    let contexts = substream::CONTEXTS[id as usize] as usize;
     map(symbols.len().div_ceil(limit), &|i| {
         let values = &symbols[i * limit..symbols.len().min((i + 1) * limit)];
         Chunk {

@@ -6,7 +6,7 @@ use splitstream_decoder_core::writer::{
     Chunk, ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level,
     frame_level_with,
 };
-use splitstream_decoder_core::{PlanePolicy, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, WingPolicy};
 
 fn params(codec: ChunkCodec) -> StreamParams {
     StreamParams {
@@ -42,6 +42,7 @@ fn level() -> LevelPayload {
         round_splits: vec![150, 250],
         plane: PlanePolicy::Dominant,
         wings: WingPolicy::Ranks,
+        deficits: DeficitContexts::Plain,
         substreams,
         vertex_count: 420,
         triangle_count: 836,

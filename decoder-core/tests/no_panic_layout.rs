@@ -18,7 +18,9 @@ use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{Decoder, Error, Inflater, PositionMode, WingPolicy, workspace_len};
+use splitstream_decoder_core::{
+    Decoder, DeficitContexts, Error, Inflater, PositionMode, WingPolicy, workspace_len,
+};
 
 /// 536 870 920 vertices and 690 662 050 triangles after level 1: within the
 /// header limits, consistent growth, and with 32-bit wrapping arithmetic the
@@ -57,6 +59,7 @@ fn huge_stream() -> Vec<u8> {
         round_splits: vec![],
         plane: Default::default(),
         wings: WingPolicy::Ranks,
+        deficits: DeficitContexts::Plain,
         substreams: base,
         vertex_count: 4,
         triangle_count: 4,
@@ -68,6 +71,7 @@ fn huge_stream() -> Vec<u8> {
         round_splits: vec![1],
         plane: Default::default(),
         wings: WingPolicy::Ranks,
+        deficits: DeficitContexts::Plain,
         substreams: vec![flags],
         vertex_count: V,
         triangle_count: T,

@@ -13,7 +13,7 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{PositionMode, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PositionMode, WingPolicy};
 
 /// A `w` x `w` grid whose centre vertex splits once per round, `rounds` times.
 fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
@@ -48,6 +48,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
         round_splits: vec![],
         plane: Default::default(),
         wings: WingPolicy::Ranks,
+        deficits: DeficitContexts::Plain,
         substreams: subs,
         vertex_count: nv,
         triangle_count: nt,
@@ -74,6 +75,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
         round_splits: vec![1; rounds as usize],
         plane: Default::default(),
         wings: WingPolicy::Ranks,
+        deficits: DeficitContexts::Plain,
         substreams: s,
         vertex_count: nv + rounds,
         triangle_count: nt + 2 * rounds,

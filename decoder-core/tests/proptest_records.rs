@@ -23,7 +23,7 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{PlanePolicy, PositionMode, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingPolicy};
 use streams::{Choices, bases};
 
 fn base_euler(base: &str) -> i64 {
@@ -87,6 +87,7 @@ proptest! {
             round_splits: rounds,
             plane: PlanePolicy::from_byte(plane).unwrap(),
             wings: WingPolicy::Ranks,
+            deficits: DeficitContexts::Plain,
             substreams: subs
                 .iter()
                 .map(|s| {

@@ -5,7 +5,9 @@ use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, write_stream,
 };
-use splitstream_decoder_core::{Fnv1a, PlanePolicy, PositionMode, WingPolicy, crc32};
+use splitstream_decoder_core::{
+    DeficitContexts, Fnv1a, PlanePolicy, PositionMode, WingPolicy, crc32,
+};
 
 fn params() -> StreamParams {
     StreamParams {
@@ -40,6 +42,7 @@ fn tetra_stream() -> Vec<u8> {
         round_splits: vec![],
         plane: PlanePolicy::Off,
         wings: WingPolicy::Ranks,
+        deficits: DeficitContexts::Plain,
         substreams: b,
         vertex_count: 4,
         triangle_count: 4,
@@ -62,6 +65,7 @@ fn tetra_stream() -> Vec<u8> {
         round_splits: vec![1],
         plane: PlanePolicy::Dominant,
         wings: WingPolicy::Ranks,
+        deficits: DeficitContexts::Plain,
         substreams: s,
         vertex_count: 5,
         triangle_count: 6,
@@ -510,6 +514,7 @@ fn section_5_4_varints() {
             round_splits: vec![],
             plane: PlanePolicy::Off,
             wings: WingPolicy::Ranks,
+            deficits: DeficitContexts::Plain,
             substreams: b,
             vertex_count: 3,
             triangle_count: 1,

@@ -6,7 +6,7 @@ mod roundtrip_check;
 
 use roundtrip_check::assert_roundtrip;
 
-use splitstream_decoder_core::{PlanePolicy, PositionMode, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingPolicy};
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::quantize::{Lattice, Quantization, Units};
 
@@ -100,6 +100,7 @@ fn height_policy_roundtrips_and_sets_the_minor_version() {
                     bits,
                     plane: Some(plane),
                     wings: Some(WingPolicy::Ranks),
+                    deficits: Some(DeficitContexts::Plain),
                     position_mode: mode,
                     ..EncodeOptions::default()
                 };
@@ -130,6 +131,7 @@ fn every_wing_policy_roundtrips_and_sets_the_minor_version() {
                         bits,
                         plane: Some(PlanePolicy::Dominant),
                         wings: Some(wings),
+                        deficits: Some(DeficitContexts::Plain),
                         position_mode: mode,
                         ..EncodeOptions::default()
                     };
@@ -156,6 +158,51 @@ fn the_chosen_wing_policy_is_never_larger_than_ranks() {
         };
         let ranks = encode(&mesh, &ranks, |_| {}).expect("encode");
         assert!(auto.stream.len() <= ranks.stream.len() + 64);
+    }
+}
+
+/// Format 3.3's deficit contexts, forced in every level, on a closed mesh
+/// and on terrain with a boundary, in both position modes, at 14 and 31
+/// bits; `valence` sets minor version 3, `plain` (with `ranks` wings) leaves
+/// it at 0 (SPEC §1, §5.5.5).
+#[test]
+fn both_deficit_contexts_roundtrip_and_set_the_minor_version() {
+    let meshes = [common::icosphere(2), common::bumpy_grid(21, 17, 3)];
+    for mesh in &meshes {
+        for mode in [PositionMode::Constrained, PositionMode::Optimal] {
+            for bits in [14, 31] {
+                for (deficits, minor) in
+                    [(DeficitContexts::Plain, 0), (DeficitContexts::Valence, 3)]
+                {
+                    let options = EncodeOptions {
+                        bits,
+                        plane: Some(PlanePolicy::Dominant),
+                        wings: Some(WingPolicy::Ranks),
+                        deficits: Some(deficits),
+                        position_mode: mode,
+                        ..EncodeOptions::default()
+                    };
+                    assert_roundtrip(mesh, &options);
+                    let encoded = encode(mesh, &options, |_| {}).expect("encode");
+                    assert_eq!(encoded.stream[9], minor, "{mode:?} {bits} {deficits:?}");
+                }
+            }
+        }
+    }
+}
+
+/// The default picks the deficit contexts per level by size: not larger
+/// than `plain` everywhere (a few bytes of slack, as for the wings).
+#[test]
+fn the_chosen_deficit_contexts_are_never_larger_than_plain() {
+    for mesh in [common::icosphere(3), common::bumpy_grid(31, 23, 2)] {
+        let auto = encode(&mesh, &EncodeOptions::default(), |_| {}).expect("encode");
+        let plain = EncodeOptions {
+            deficits: Some(DeficitContexts::Plain),
+            ..EncodeOptions::default()
+        };
+        let plain = encode(&mesh, &plain, |_| {}).expect("encode");
+        assert!(auto.stream.len() <= plain.stream.len() + 64);
     }
 }
 

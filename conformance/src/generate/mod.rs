@@ -13,7 +13,8 @@ use splitstream_decoder_core::limits::{LEAF, codec};
 use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
 use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
 use splitstream_decoder_core::{
-    Fnv1a, Header, LevelHeader, LevelTable, PlanePolicy, PositionMode, WingPolicy, head_len,
+    DeficitContexts, Fnv1a, Header, LevelHeader, LevelTable, PlanePolicy, PositionMode, WingPolicy,
+    head_len,
 };
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
@@ -598,6 +599,35 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             }
         }
     }
+    // Both deficit contexts (SPEC §5.1, §5.5.5; valence is 3.3), forced for
+    // every level, in both position modes, with the rANS codec (the
+    // contexts, and the number of tables, only matter to it).
+    for contexts in DeficitContexts::ALL {
+        for (mode, what) in [
+            (PositionMode::Constrained, "constrained"),
+            (PositionMode::Optimal, "optimal"),
+        ] {
+            for (mesh, name) in [(&sphere2, "icosphere"), (&small_holed, "grid-hole")] {
+                s.valid(
+                    &format!("deficits-{}-{name}-{what}", contexts.name()),
+                    &format!(
+                        "{name} ({what} positions, rANS) with deficit contexts `{}` (byte {}) in every level.",
+                        contexts.name(),
+                        contexts.to_byte()
+                    ),
+                    &["encoded", "deficit-contexts"],
+                    encoded(
+                        mesh,
+                        EncodeOptions {
+                            position_mode: mode,
+                            deficits: Some(contexts),
+                            ..opts()
+                        },
+                    ),
+                );
+            }
+        }
+    }
     // 31 bits per axis: the arithmetic of SPEC §7.4 at its widest (the
     // seed's rounds span the whole grid).
     for (mode, what) in [
@@ -983,11 +1013,41 @@ fn invalid_vectors(s: &mut Specs) {
         with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 1, 3),
     );
     s.invalid(
+        "deficit-contexts-reserved",
+        "malformed",
+        "Level 1's deficit contexts byte (level header byte 10) set to 2, the first value 3.3 reserves (level header CRC recomputed).",
+        &["reserved", "deficit-contexts"],
+        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 2, 2),
+    );
+    // A level whose rANS chunks were written under the deficit contexts
+    // `valence` (5 and 6 tables for deficit-p and deficit-c) read as
+    // `plain` (1 and 5): deficit-p's first chunk then ends its tables early
+    // and reads a table byte as its lane directory (SPEC §5.5.2, §5.5.3).
+    s.invalid(
+        "deficit-contexts-switched",
+        "malformed",
+        "Level 1, written with deficit contexts `valence` (byte 10 = 1), relabelled `plain` (level header CRC recomputed): its deficit-p and deficit-c chunks hold more tables than `plain` reads.",
+        &["deficit-contexts", "rans"],
+        {
+            let valence = encoded(
+                &sphere,
+                EncodeOptions {
+                    deficits: Some(DeficitContexts::Valence),
+                    codec: ChunkCodec::RansAlways { lanes: 4 },
+                    ..opts()
+                },
+            );
+            let at = plane_policy_at(&valence, 1) + 2;
+            assert_eq!(valence[at], 1);
+            with_level_header_byte(&valence, 1, at, 0)
+        },
+    );
+    s.invalid(
         "reserved-level-header",
         "malformed",
-        "Level 1's reserved level header byte 10 (after the wing policy) not zero (level header CRC recomputed).",
+        "Level 1's reserved level header byte 11 (after the deficit contexts) not zero (level header CRC recomputed).",
         &["reserved", "plane-policy"],
-        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 2, 1),
+        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 3, 1),
     );
     s.invalid(
         "unknown-codec",

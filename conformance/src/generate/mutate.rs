@@ -10,7 +10,8 @@ use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream_seeded,
 };
 use splitstream_decoder_core::{
-    Header, Inflater, LevelHeader, LevelTable, PlanePolicy, WingPolicy, crc32, head_len,
+    DeficitContexts, Header, Inflater, LevelHeader, LevelTable, PlanePolicy, WingPolicy, crc32,
+    head_len,
 };
 
 /// One level's content, substreams as raw bytes.
@@ -24,6 +25,8 @@ pub struct Level {
     pub plane: PlanePolicy,
     /// The level's wing policy (SPEC §5.1, 3.2).
     pub wings: WingPolicy,
+    /// The level's deficit contexts (SPEC §5.1, 3.3).
+    pub deficits: DeficitContexts,
     /// The rounds' substreams, ids 1..=7.
     pub substreams: Vec<Vec<u8>>,
     pub vertex_count: u32,
@@ -79,6 +82,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
             round_splits: (0..lh.round_count).map(|r| lh.split_count(r)).collect(),
             plane: lh.plane_policy,
             wings: lh.wing_policy,
+            deficits: lh.deficit_contexts,
             substreams,
             vertex_count: info.vertex_count,
             triangle_count: info.triangle_count,
@@ -124,6 +128,7 @@ pub fn reframe(u: &Unframed) -> Vec<u8> {
             round_splits: l.round_splits.clone(),
             plane: l.plane,
             wings: l.wings,
+            deficits: l.deficits,
             substreams: writers(&l.substreams),
             vertex_count: l.vertex_count,
             triangle_count: l.triangle_count,

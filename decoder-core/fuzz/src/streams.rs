@@ -29,9 +29,9 @@ use splitstream_decoder_core::writer::{
     write_stream_seeded,
 };
 use splitstream_decoder_core::{
-    Decoder, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane, PlanePolicy,
-    PositionMode, RecordSource, Ring, SplitFan, SplitRecord, Target, WingPolicy, arc_means,
-    constrained_positions, context, predict, wing_order, workspace_len,
+    Decoder, DeficitContexts, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane,
+    PlanePolicy, PositionMode, RecordSource, Ring, SplitFan, SplitRecord, Target, WingPolicy,
+    arc_means, constrained_positions, context, predict, wing_order, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -190,6 +190,7 @@ struct GenSource<'g, 'c> {
     mode: PositionMode,
     plane: PlanePolicy,
     wings: WingPolicy,
+    deficits: DeficitContexts,
     bits: u8,
     allow_invalid: bool,
 }
@@ -303,9 +304,9 @@ impl RecordSource for GenSource<'_, '_> {
             sp = c.byte();
             sc = c.byte();
         }
-        self.subs[3].byte(sp);
+        self.subs[3].byte_in(context::deficit_p(self.deficits, valence_p), sp);
         let deficit_p = deficit_of(sp, valence_p)?;
-        self.subs[4].byte_in(context::deficit_c(deficit_p, valence_c), sc);
+        self.subs[4].byte_in(context::deficit_c(self.deficits, deficit_p, valence_c), sc);
         let deficit_c = deficit_of(sc, valence_c)?;
         let limit = 1i64 << self.bits;
         let in_grid = |v: &[i64; 3]| v.iter().all(|&x| (0..limit).contains(&x));
@@ -486,6 +487,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         let level_start_v = state.vertex_count();
         let plane = PlanePolicy::ALL[choices.below(PlanePolicy::ALL.len())];
         let wings = WingPolicy::ALL[choices.below(WingPolicy::ALL.len())];
+        let deficits = DeficitContexts::ALL[choices.below(DeficitContexts::ALL.len())];
         let rounds = 3 - choices.below(3);
         for _ in 0..rounds {
             let n = state.vertex_count();
@@ -551,6 +553,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                 mode: position_mode,
                 plane,
                 wings,
+                deficits,
                 bits,
                 allow_invalid,
             };
@@ -563,6 +566,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                         round_splits,
                         plane,
                         wings,
+                        deficits,
                         substreams: subs,
                         vertex_count: n + declared,
                         triangle_count: state.triangle_count() + remaining,
@@ -581,6 +585,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
             round_splits,
             plane,
             wings,
+            deficits,
             substreams: subs,
             vertex_count: state.vertex_count(),
             triangle_count: state.triangle_count(),
@@ -764,7 +769,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
         .iter()
         .map(|l| l.substreams.iter().map(|s| s.as_bytes().to_vec()).collect())
         .collect();
-    let mut meta: Vec<(Vec<u32>, u32, u32, PlanePolicy, WingPolicy)> = g
+    let mut meta: Vec<(Vec<u32>, u32, u32, PlanePolicy, WingPolicy, DeficitContexts)> = g
         .levels
         .iter()
         .map(|l| {
@@ -774,6 +779,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 l.triangle_count,
                 l.plane,
                 l.wings,
+                l.deficits,
             )
         })
         .collect();
@@ -824,7 +830,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 }
             }
             6 => {
-                let (splits, _, _, _, _) = &mut meta[l];
+                let (splits, _, _, _, _, _) = &mut meta[l];
                 let r = ops.below(splits.len());
                 let delta = (ops.byte() as i8 % 3) as i32;
                 if let Some(x) = splits.get_mut(r) {
@@ -832,14 +838,14 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 }
             }
             7 => {
-                let (_, v, t, _, _) = &mut meta[l];
+                let (_, v, t, _, _, _) = &mut meta[l];
                 let dv = (ops.byte() as i8 % 3) as i64;
                 let dt = (ops.byte() as i8 % 3) as i64;
                 *v = (*v as i64 + dv).clamp(0, u32::MAX as i64) as u32;
                 *t = (*t as i64 + dt).clamp(0, u32::MAX as i64) as u32;
             }
             8 => {
-                let (splits, _, _, _, _) = &mut meta[l];
+                let (splits, _, _, _, _, _) = &mut meta[l];
                 if ops.byte() & 1 == 0 {
                     splits.pop();
                 } else {
@@ -873,12 +879,12 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 bytes.extend(core::iter::repeat_n(v, n as usize));
             }
             11 => {
-                // Another plane or wing policy for the level (SPEC §5.1,
-                // §7.4).
-                if ops.byte() & 1 == 0 {
-                    meta[l].3 = PlanePolicy::ALL[ops.below(PlanePolicy::ALL.len())];
-                } else {
-                    meta[l].4 = WingPolicy::ALL[ops.below(WingPolicy::ALL.len())];
+                // Another plane or wing policy, or other deficit contexts,
+                // for the level (SPEC §5.1, §5.5.5, §7.4).
+                match ops.byte() % 3 {
+                    0 => meta[l].3 = PlanePolicy::ALL[ops.below(PlanePolicy::ALL.len())],
+                    1 => meta[l].4 = WingPolicy::ALL[ops.below(WingPolicy::ALL.len())],
+                    _ => meta[l].5 = DeficitContexts::ALL[ops.below(DeficitContexts::ALL.len())],
                 }
             }
             _ => {
@@ -894,23 +900,26 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
         .into_iter()
         .zip(meta)
         .map(
-            |(s, (round_splits, vertex_count, triangle_count, plane, wings))| LevelPayload {
-                round_splits,
-                plane,
-                wings,
-                substreams: s
-                    .into_iter()
-                    .map(|b| {
-                        let mut w = SubstreamWriter::default();
-                        for x in b {
-                            w.byte(x);
-                        }
-                        w
-                    })
-                    .collect(),
-                vertex_count,
-                triangle_count,
-                geometric_error: 0.0,
+            |(s, (round_splits, vertex_count, triangle_count, plane, wings, deficits))| {
+                LevelPayload {
+                    round_splits,
+                    plane,
+                    wings,
+                    deficits,
+                    substreams: s
+                        .into_iter()
+                        .map(|b| {
+                            let mut w = SubstreamWriter::default();
+                            for x in b {
+                                w.byte(x);
+                            }
+                            w
+                        })
+                        .collect(),
+                    vertex_count,
+                    triangle_count,
+                    geometric_error: 0.0,
+                }
             },
         )
         .collect();

@@ -12,7 +12,8 @@ use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh
 use splitstream_encoder::quantize::{Quantization, Units};
 
 use super::{
-    BackendArg, CliResult, Codec, LatticeArg, PlaneArg, Position, QuantizationArg, WingsArg,
+    BackendArg, CliResult, Codec, DeficitsArg, LatticeArg, PlaneArg, Position, QuantizationArg,
+    WingsArg,
 };
 
 /// `splitstream encode`'s arguments.
@@ -87,6 +88,11 @@ pub struct Args {
     /// centre (format 3.2) (SPEC §7.4); `auto` picks the cheapest per level.
     #[arg(long, value_enum, default_value_t = WingsArg::Auto)]
     pub wings: WingsArg,
+    /// Which contexts code each level's split valences: `plain`, or
+    /// `valence`, by the valences of P and C right after the split (format
+    /// 3.3) (SPEC §5.5.5); `auto` picks the cheaper per level.
+    #[arg(long, value_enum, default_value_t = DeficitsArg::Auto)]
+    pub deficits: DeficitsArg,
     /// Where the simplification's data-parallel passes run (GPU backends:
     /// quadrics, best edges and selection on the device, collapses on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
@@ -147,6 +153,7 @@ pub fn run(a: Args) -> CliResult {
         backend: a.backend.into(),
         plane: a.plane.policy(),
         wings: a.wings.policy(),
+        deficits: a.deficits.contexts(),
     };
     let degrees_unconverted = !a.geographic && looks_geographic(&mesh);
     if degrees_unconverted {

@@ -86,15 +86,20 @@ pub fn run(input: &Path, json: bool) -> CliResult {
     let table = LevelTable::parse(&stream, &header).map_err(fail)?;
     let sizes =
         field_sizes(&stream, &header, &table).map_err(|e| format!("{}: {e}", input.display()))?;
-    // Each level's plane and wing policies (SPEC §5.1, §7.4).
-    let policies: Vec<(&str, &str)> = (0..table.len())
+    // Each level's plane and wing policies and deficit contexts (SPEC §5.1,
+    // §5.5.5, §7.4).
+    let policies: Vec<(&str, &str, &str)> = (0..table.len())
         .map(|k| {
             let e = table.get(k);
             stream
                 .get(e.offset as usize..(e.offset + e.length as u64) as usize)
                 .and_then(|b| LevelHeader::parse(b, k == 0, header.max_chunk_len).ok())
-                .map_or(("?", "?"), |lh| {
-                    (lh.plane_policy.name(), lh.wing_policy.name())
+                .map_or(("?", "?", "?"), |lh| {
+                    (
+                        lh.plane_policy.name(),
+                        lh.wing_policy.name(),
+                        lh.deficit_contexts.name(),
+                    )
                 })
         })
         .collect();
@@ -127,6 +132,7 @@ pub fn run(input: &Path, json: bool) -> CliResult {
                     "rounds": e.round_count, "geometric_error": e.geometric_error,
                     "plane_policy": policies[k as usize].0,
                     "wing_policy": policies[k as usize].1,
+                    "deficit_contexts": policies[k as usize].2,
                     "workspace_bytes": memory[k as usize],
                 })
             })
@@ -192,12 +198,12 @@ pub fn run(input: &Path, json: bool) -> CliResult {
         header.max_chunk_len
     );
     println!(
-        "  level    offset     bytes   vertices  triangles rounds  plane     wings    decoder memory  geometric error"
+        "  level    offset     bytes   vertices  triangles rounds  plane     wings    deficits  decoder memory  geometric error"
     );
     for k in 0..table.len() {
         let e = table.get(k);
         println!(
-            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:>14}  {:.6}",
+            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:<8} {:>14}  {:.6}",
             k,
             e.offset,
             e.length,
@@ -206,6 +212,7 @@ pub fn run(input: &Path, json: bool) -> CliResult {
             e.round_count,
             policies[k as usize].0,
             policies[k as usize].1,
+            policies[k as usize].2,
             memory[k as usize],
             e.geometric_error
         );

@@ -143,6 +143,30 @@ impl WingsArg {
     }
 }
 
+/// Which contexts code each level's split valences (SPEC §5.5.5, format
+/// 3.3).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum DeficitsArg {
+    /// Per level, the contexts whose split valences take fewest bytes.
+    #[default]
+    Auto,
+    /// P's in one context, C's by its valence up to 6 (every 3.x decoder).
+    Plain,
+    /// P's and C's each by its own valence, up to 8 (3.3).
+    Valence,
+}
+
+impl DeficitsArg {
+    pub fn contexts(self) -> Option<splitstream_decoder_core::DeficitContexts> {
+        use splitstream_decoder_core::DeficitContexts;
+        match self {
+            DeficitsArg::Auto => None,
+            DeficitsArg::Plain => Some(DeficitContexts::Plain),
+            DeficitsArg::Valence => Some(DeficitContexts::Valence),
+        }
+    }
+}
+
 /// Where the simplifier's data-parallel passes run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {

@@ -2,13 +2,14 @@
 //! walked forward with decoder-core's own round procedure, and every flag and
 //! split record is written exactly as that procedure asks for it.
 
+mod deficits;
 mod levels;
 mod policies;
 mod replay;
 mod wings;
 
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
-use splitstream_decoder_core::{PlanePolicy, PositionMode, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingPolicy};
 
 use crate::mesh::Mesh;
 use crate::quantize::{Lattice, Quantization, QuantizedMesh, Units, quantize_with};
@@ -55,6 +56,9 @@ pub struct EncodeOptions {
     /// The wing policy of every level (SPEC §7.4, format 3.2); `None`: per
     /// level, the one whose wing ranks take fewest bytes.
     pub wings: Option<WingPolicy>,
+    /// The deficit contexts of every level (SPEC §5.5.5, format 3.3);
+    /// `None`: per level, the ones whose split valences take fewest bytes.
+    pub deficits: Option<DeficitContexts>,
 }
 
 impl Default for EncodeOptions {
@@ -75,6 +79,7 @@ impl Default for EncodeOptions {
             backend: Backend::Cpu,
             plane: None,
             wings: None,
+            deficits: None,
         }
     }
 }
@@ -231,6 +236,7 @@ pub fn encode_quantized(
         &params,
         options.plane,
         options.wings,
+        options.deficits,
     )
     .map_err(EncodeError::Replay)?;
     let level_vertex_counts = replayed

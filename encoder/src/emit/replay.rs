@@ -8,15 +8,16 @@ use splitstream_decoder_core::writer::{
     Chunk, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level_with,
 };
 use splitstream_decoder_core::{
-    CornerRefs, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource, Ring, SplitFan,
-    SplitOutcome, SplitRecord, StateMemory, Target, WingPolicy, add_residual, arc_means,
-    constrained_positions, context, predict, residual,
+    CornerRefs, DeficitContexts, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource,
+    Ring, SplitFan, SplitOutcome, SplitRecord, StateMemory, Target, WingPolicy, add_residual,
+    arc_means, constrained_positions, context, predict, residual,
 };
 
 use std::sync::mpsc;
 
 use rayon::prelude::*;
 
+use super::deficits::DeficitCoding;
 use super::levels::LevelPlan;
 use super::policies::{SplitResiduals, choose_policy, code_policies};
 use super::wings::WingCoding;
@@ -117,6 +118,8 @@ struct StepSource<'a> {
     subs: &'a mut [SubstreamWriter],
     /// The level's wings under every wing policy that may be chosen.
     wing_coding: &'a mut WingCoding,
+    /// The level's split-valence symbols in every choice of contexts.
+    deficit_coding: &'a mut DeficitCoding,
     /// The round's residual vectors, coded under every plane policy on
     /// another thread (`policies`).
     residuals: &'a mut Vec<SplitResiduals>,
@@ -226,12 +229,14 @@ impl RecordSource for StepSource<'_> {
                 "a wing of the collapse of {id} was a candidate at the start of its round"
             )));
         }
-        let s = &mut *self.subs;
-        s[slot(substream::DEFICIT_P)].byte_in(context::SINGLE, split_valence_symbol(dp, valence_p));
-        s[slot(substream::DEFICIT_C)].byte_in(
-            context::deficit_c(dp, valence_c),
+        self.deficit_coding.write(
+            split_valence_symbol(dp, valence_p),
             split_valence_symbol(dc, valence_c),
+            dp,
+            valence_p,
+            valence_c,
         );
+        let s = &mut *self.subs;
         let means = arc_means(state.positions(), parent, ring, o, d);
         let wide = |x: [u32; 3]| x.map(|v| v as i64);
         let sub = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] - b[i]) };
@@ -349,9 +354,9 @@ fn height_residual(
 type FramedLevel = (LevelPayload, (Vec<u8>, u32));
 
 /// Replays `s` level by level as planned, returning the level payloads,
-/// each with the plane policy `plane` and the wing policy `wing_policy`, or
-/// by default the ones whose residuals and wing ranks cost least under
-/// `params`.
+/// each with the plane policy `plane`, the wing policy `wing_policy` and
+/// the deficit contexts `deficit_contexts`, or by default the ones whose
+/// residuals, wing ranks and split valences cost least under `params`.
 pub fn replay(
     mesh: &QuantizedMesh,
     s: &Simplification,
@@ -359,6 +364,7 @@ pub fn replay(
     params: &StreamParams,
     plane: Option<PlanePolicy>,
     wing_policy: Option<WingPolicy>,
+    deficit_contexts: Option<DeficitContexts>,
 ) -> Result<Replayed, ReplayError> {
     let mode = params.position_mode;
     let n = mesh.positions.len();
@@ -425,6 +431,7 @@ pub fn replay(
         for (l, steps) in plan.rounds.iter().enumerate() {
             let mut subs = vec![SubstreamWriter::default(); 7];
             let mut wing_coding = WingCoding::new(wing_policy);
+            let mut deficit_coding = DeficitCoding::new(deficit_contexts);
             // The level's residuals go round by round to a thread that
             // codes them under every plane policy.
             let (batches, coded_batches) = mpsc::channel();
@@ -458,6 +465,7 @@ pub fn replay(
                     dec2enc: &mut dec2enc,
                     subs: &mut subs,
                     wing_coding: &mut wing_coding,
+                    deficit_coding: &mut deficit_coding,
                     residuals: &mut residuals,
                     mode,
                     heights: plane.is_none_or(|p| p == PlanePolicy::Height),
@@ -490,10 +498,12 @@ pub fn replay(
                 let plane = choose_policy(&mut subs, residuals, params, plane)
                     .map_err(|why| level_error(why.to_string()))?;
                 let wings = wing_coding.choose(&mut subs, params);
+                let deficits = deficit_coding.choose(&mut subs, params);
                 let level = LevelPayload {
                     round_splits,
                     plane,
                     wings,
+                    deficits,
                     substreams: subs,
                     vertex_count,
                     triangle_count,
@@ -586,6 +596,7 @@ mod tests {
         }
         let mut subs = vec![SubstreamWriter::default(); 7];
         let mut wing_coding = WingCoding::new(None);
+        let mut deficit_coding = DeficitCoding::new(None);
         let mut residuals = Vec::new();
         let mut source = StepSource {
             collapses: &[],
@@ -595,6 +606,7 @@ mod tests {
             dec2enc: &mut dec2enc,
             subs: &mut subs,
             wing_coding: &mut wing_coding,
+            deficit_coding: &mut deficit_coding,
             residuals: &mut residuals,
             mode: PositionMode::Optimal,
             heights: true,
