@@ -3,14 +3,22 @@
 
 use std::path::PathBuf;
 use std::process::{Command, Output};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Writes `contents` to `name` in a scratch folder of this test process
-/// (`tag` keeps test binaries apart) and returns its path.
+/// (`tag` keeps test binaries apart) and returns its path. Tests of one
+/// binary run on several threads and may write the same file at once: each
+/// writes a file of its own and renames it into place, so that a reader
+/// never sees one half written (`encode_cli` failed that way).
 pub fn temp(tag: &str, name: &str, contents: &str) -> PathBuf {
+    static WRITES: AtomicUsize = AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!("splitstream-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join(name);
-    std::fs::write(&path, contents).unwrap();
+    let n = WRITES.fetch_add(1, Ordering::Relaxed);
+    let staged = dir.join(format!("{name}.{n}.part"));
+    std::fs::write(&staged, contents).unwrap();
+    std::fs::rename(&staged, &path).unwrap();
     path
 }
 
