@@ -8,7 +8,9 @@
 use splitstream_decoder_core::DeficitContexts;
 use splitstream_decoder_core::context;
 use splitstream_decoder_core::limits::substream;
-use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, SubstreamWriter, coded_len_in};
+use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter, coded_len_in};
+
+use super::policies::ranking_params;
 
 /// One level's split-valence symbols in the contexts of every choice.
 #[derive(Clone)]
@@ -42,15 +44,7 @@ impl DeficitCoding {
     /// Puts the cheapest choice's substreams into `subs` (ids 1..=7 at
     /// 0..=6) and returns it; ties go to `plain`, which 3.2 decoders read.
     pub fn choose(self, subs: &mut [SubstreamWriter], params: &StreamParams) -> DeficitContexts {
-        // Ranked as the rANS codec would code them, deflate fallback aside
-        // (as the wing and plane policies are).
-        let ranking = match params.codec {
-            ChunkCodec::Rans { lanes } => StreamParams {
-                codec: ChunkCodec::RansAlways { lanes },
-                ..*params
-            },
-            _ => *params,
-        };
+        let ranking = ranking_params(params);
         let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
         let (contexts, [p, c]) = DeficitContexts::ALL
             .into_iter()

@@ -137,6 +137,22 @@ fn write_vector(
     Ok(true)
 }
 
+/// The parameters a level's alternatives (plane and wing policies, deficit
+/// contexts) are ranked under: under the rANS codec their rANS cost alone.
+/// Framing may still deflate the chosen substreams where that is smaller,
+/// but deflating every alternative (at level 10) took a third of the
+/// replay on the 1M terrain and never changed the ranking on the real
+/// meshes.
+pub fn ranking_params(params: &StreamParams) -> StreamParams {
+    match params.codec {
+        ChunkCodec::Rans { lanes } => StreamParams {
+            codec: ChunkCodec::RansAlways { lanes },
+            ..*params
+        },
+        _ => *params,
+    }
+}
+
 /// Puts the cheapest usable policy's residual substreams (or those of
 /// `forced`) into `subs` (a level's substreams from id 1: ids 6 and 7; in
 /// constrained mode id 7 holds the placement codes, which do not depend on
@@ -149,17 +165,7 @@ pub fn choose_policy(
     forced: Option<PlanePolicy>,
 ) -> Result<PlanePolicy, String> {
     let optimal = params.position_mode == PositionMode::Optimal;
-    // Under the rANS codec the policies are ranked by their rANS cost alone:
-    // framing may still deflate the chosen residuals where that is smaller,
-    // but deflating all five (at level 10) took a third of the replay on the
-    // 1M terrain and never changed the ranking on the real meshes.
-    let ranking = match params.codec {
-        ChunkCodec::Rans { lanes } => StreamParams {
-            codec: ChunkCodec::RansAlways { lanes },
-            ..*params
-        },
-        _ => *params,
-    };
+    let ranking = ranking_params(params);
     let params = &ranking;
     let costs: Vec<Option<usize>> = residuals
         .par_iter()

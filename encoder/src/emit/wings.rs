@@ -4,7 +4,9 @@
 
 use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, substream};
 use splitstream_decoder_core::wing_order::{NearKeys, near_keys, near_keys_both, near_ranks};
-use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, SubstreamWriter, coded_len};
+use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter, coded_len};
+
+use super::policies::ranking_params;
 use splitstream_decoder_core::{MeshState, Ring, WingCandidates, WingPolicy, context};
 
 /// One level's wing ranks under every wing policy that may be chosen.
@@ -71,15 +73,7 @@ impl WingCoding {
     /// 0..=6) and returns it; ties go to the earlier policy, so `ranks`
     /// (readable by 3.0 and 3.1 decoders) wins when nothing is gained.
     pub fn choose(self, subs: &mut [SubstreamWriter], params: &StreamParams) -> WingPolicy {
-        // Ranked as the rANS codec would code them, deflate fallback aside
-        // (as the plane policies are, `policies::choose_policy`).
-        let ranking = match params.codec {
-            ChunkCodec::Rans { lanes } => StreamParams {
-                codec: ChunkCodec::RansAlways { lanes },
-                ..*params
-            },
-            _ => *params,
-        };
+        let ranking = ranking_params(params);
         let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
         let (policy, [offset, distance]) = WingPolicy::ALL
             .into_iter()
