@@ -14,7 +14,8 @@
 //! closed arc from wing a to wing b, C's from b round to a) how many of its
 //! vertices are leaves, the sum of the others' deficits, and whether it
 //! holds the ghost; the squared length of the edge PC; whether R was
-//! created in this level. Deficits are the live ones, as the record sees
+//! created in this level; where R lay (0 at P, 1 at C, 2 at their midpoint,
+//! 3 elsewhere: optimal mode) and that code's context (SPEC §5.5.5). Deficits are the live ones, as the record sees
 //! them (earlier splits of the round may have decremented a wing's).
 
 use std::io::Write;
@@ -23,11 +24,13 @@ use splitstream_decoder_core::limits::{LEAF, NONE, substream};
 use splitstream_decoder_core::record::{StreamSource, read_base};
 use splitstream_decoder_core::substream::Substreams;
 use splitstream_decoder_core::{
-    Error, Header, Inflater, LevelTable, MeshState, RecordSource, Ring, SplitRecord, layout_for,
+    Error, Header, Inflater, LevelTable, MeshState, RecordSource, Ring, SplitRecord, arc_means,
+    context, layout_for,
 };
 
 const COLUMNS: &str = "level\tround\tk\tm\to\td\tvalence_p\tvalence_c\tsymbol_p\tsymbol_c\t\
-leaves_p\tdeficits_p\tghost_p\tleaves_c\tdeficits_c\tghost_c\tedge2\tnew";
+leaves_p\tdeficits_p\tghost_p\tleaves_c\tdeficits_c\tghost_c\tedge2\tnew\tplacement\t\
+placement_context";
 
 /// Passes the stream's records through and writes one line per split.
 struct Fields<'a, S> {
@@ -80,12 +83,26 @@ impl<S: RecordSource> RecordSource for Fields<'_, S> {
         let v = ring.vertices();
         let arc_p = arc(state, v[o..=o + d].iter().copied());
         let arc_c = arc(state, v[o + d..].iter().chain(&v[..=o]).copied());
+        let parent = state.positions()[r as usize];
+        let (p, c) = (rec.position_p, rec.position_c);
+        let mid: [u32; 3] =
+            core::array::from_fn(|a| (p[a] as i64 + ((c[a] as i64 - p[a] as i64) >> 1)) as u32);
+        let placement = if parent == p {
+            0
+        } else if parent == c {
+            1
+        } else if parent == mid {
+            2
+        } else {
+            3
+        };
+        let means = arc_means(state.positions(), parent, ring, o, d);
         let edge2: i64 = (0..3)
             .map(|a| (rec.position_c[a] as i64 - rec.position_p[a] as i64).pow(2))
             .sum();
         writeln!(
             self.out,
-            "{}\t{}\t{k}\t{}\t{o}\t{d}\t{valence_p}\t{valence_c}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{edge2}\t{}",
+            "{}\t{}\t{k}\t{}\t{o}\t{d}\t{valence_p}\t{valence_c}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{edge2}\t{}\t{placement}\t{}",
             self.level,
             self.round,
             state.wing_candidates(ring).count(),
@@ -98,6 +115,7 @@ impl<S: RecordSource> RecordSource for Fields<'_, S> {
             arc_c.1,
             arc_c.2,
             (r >= self.level_start) as u8,
+            context::placement(&means),
         )
         .map_err(|_| Error::CapacityExceeded)?;
         Ok(rec)
