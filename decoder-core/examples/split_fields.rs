@@ -15,31 +15,35 @@
 //! vertices are leaves, the sum of the others' deficits, and whether it
 //! holds the ghost; the squared length of the edge PC; whether R was
 //! created in this level; where R lay (0 at P, 1 at C, 2 at their midpoint,
-//! 3 elsewhere: optimal mode) and that code's context (SPEC §5.5.5). Deficits are the live ones, as the record sees
-//! them (earlier splits of the round may have decremented a wing's).
+//! 3 elsewhere: optimal mode) and that code's context (SPEC §5.5.5).
+//! Deficits are the live ones, as the record sees them (earlier splits of
+//! the round may have decremented a wing's).
+//!
+//! It decodes with decoder-core's own `Decoder`, whose
+//! `LevelDecoder::next_round_observed` shows it each record before the
+//! split is applied.
 
 use std::io::Write;
 
-use splitstream_decoder_core::limits::{LEAF, NONE, substream};
-use splitstream_decoder_core::record::{StreamSource, read_base};
-use splitstream_decoder_core::substream::Substreams;
+use splitstream_decoder_core::limits::{LEAF, NONE};
+use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::{
-    Error, Header, Inflater, LevelTable, MeshState, RecordSource, Ring, SplitRecord, arc_means,
-    context, layout_for,
+    Error, MeshState, Ring, SplitObserver, SplitRecord, arc_means, context,
 };
 
 const COLUMNS: &str = "level\tround\tk\tm\to\td\tvalence_p\tvalence_c\tsymbol_p\tsymbol_c\t\
 leaves_p\tdeficits_p\tghost_p\tleaves_c\tdeficits_c\tghost_c\tedge2\tnew\tplacement\t\
 placement_context";
 
-/// Passes the stream's records through and writes one line per split.
-struct Fields<'a, S> {
-    inner: S,
+/// Writes one line per split record the decoder shows it.
+struct Fields<'a> {
     out: &'a mut dyn Write,
     level: u16,
     round: u32,
     /// Vertices below this index existed when the level started.
     level_start: u32,
+    /// The first write error, reported after the round.
+    failed: Option<std::io::Error>,
 }
 
 /// What P's or C's arc holds: leaves, the sum of the other deficits, the ghost.
@@ -56,17 +60,8 @@ fn arc(state: &MeshState<'_>, vertices: impl Iterator<Item = u32>) -> (u32, u32,
     (leaves, deficits, ghost)
 }
 
-impl<S: RecordSource> RecordSource for Fields<'_, S> {
-    fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
-        self.inner.flag(state, v)
-    }
-
-    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
-        self.inner.likely_flags(state, upcoming)
-    }
-
-    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
-        let rec = self.inner.record(state, r, ring)?;
+impl SplitObserver for Fields<'_> {
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, rec: &SplitRecord) {
         let (k, o, d) = (
             ring.len(),
             rec.wing_offset as usize,
@@ -97,10 +92,8 @@ impl<S: RecordSource> RecordSource for Fields<'_, S> {
             3
         };
         let means = arc_means(state.positions(), parent, ring, o, d);
-        let edge2: i64 = (0..3)
-            .map(|a| (rec.position_c[a] as i64 - rec.position_p[a] as i64).pow(2))
-            .sum();
-        writeln!(
+        let edge2: i64 = (0..3).map(|a| (c[a] as i64 - p[a] as i64).pow(2)).sum();
+        let written = writeln!(
             self.out,
             "{}\t{}\t{k}\t{}\t{o}\t{d}\t{valence_p}\t{valence_c}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{edge2}\t{}\t{placement}\t{}",
             self.level,
@@ -116,13 +109,10 @@ impl<S: RecordSource> RecordSource for Fields<'_, S> {
             arc_c.2,
             (r >= self.level_start) as u8,
             context::placement(&means),
-        )
-        .map_err(|_| Error::CapacityExceeded)?;
-        Ok(rec)
-    }
-
-    fn applied(&mut self, r: u32, c: u32, outcome: &splitstream_decoder_core::SplitOutcome) {
-        self.inner.applied(r, c, outcome);
+        );
+        if let Err(e) = written {
+            self.failed.get_or_insert(e);
+        }
     }
 }
 
@@ -132,81 +122,50 @@ fn main() {
         eprintln!("usage: split_fields IN.sps OUT.tsv");
         std::process::exit(2);
     };
-    let stream = std::fs::read(input).unwrap_or_else(|e| {
-        eprintln!("split_fields: {input}: {e}");
+    let fail = |what: &str, why: &dyn std::fmt::Display| -> ! {
+        eprintln!("split_fields: {what}: {why}");
         std::process::exit(1)
-    });
-    let file = std::fs::File::create(output).unwrap_or_else(|e| {
-        eprintln!("split_fields: {output}: {e}");
-        std::process::exit(1)
-    });
+    };
+    let stream = std::fs::read(input).unwrap_or_else(|e| fail(input, &e));
+    let file = std::fs::File::create(output).unwrap_or_else(|e| fail(output, &e));
     let mut out = std::io::BufWriter::new(file);
-    if let Err(e) = write_fields(&stream, &mut out).and_then(|n| {
-        out.flush().map_err(|_| Error::CapacityExceeded)?;
-        Ok(n)
-    }) {
-        eprintln!("split_fields: {input}: {e}");
-        std::process::exit(1);
+    match write_fields(&stream, &mut out) {
+        Ok(Ok(())) => {}
+        Ok(Err(e)) => fail(output, &e),
+        Err(e) => fail(input, &e),
     }
+    out.flush().unwrap_or_else(|e| fail(output, &e));
 }
 
-/// Decodes `stream` level by level (the order of SPEC §10.3) and writes its
-/// splits; returns how many.
-fn write_fields(stream: &[u8], out: &mut dyn Write) -> Result<u64, Error> {
-    writeln!(out, "{COLUMNS}").map_err(|_| Error::CapacityExceeded)?;
-    let header = Header::parse(stream)?;
-    let table = LevelTable::parse(stream, &header)?;
-    let layout = layout_for(&header, &table, header.level_count - 1);
-    let len = usize::try_from(layout.bytes_unaligned()).map_err(|_| Error::CapacityExceeded)?;
-    let mut workspace = vec![0u8; len];
-    let (memory, mut buffers) = layout.carve(&mut workspace)?;
-    let mut state = MeshState::new(memory, header.bits);
-    let mut inflater = Box::new(Inflater::new());
-    let mut ring = Box::new(Ring::default());
-    let mut splits = 0u64;
-    for k in 0..header.level_count {
-        let info = table.get(k);
-        let bytes = usize::try_from(info.offset)
-            .ok()
-            .and_then(|s| stream.get(s..s.checked_add(info.length as usize)?))
-            .ok_or(Error::Truncated)?;
-        let level_header = table.level_header(k, bytes, header.max_chunk_len)?;
-        state.set_triangle_limit(info.triangle_count);
-        if k == 0 {
-            let slots = buffers.each_mut().map(|b| &mut **b);
-            let mut seed = Substreams::open(
-                bytes,
-                level_header,
-                substream::BASE_POSITIONS,
-                slots,
-                &mut inflater,
-                header.lane_count,
-            );
-            let (v, t) = (level_header.seed_vertices, level_header.seed_triangles);
-            read_base(&mut state, &mut seed, v, t)?;
-        }
-        let level_start = state.vertex_count();
-        let slots = buffers.each_mut().map(|b| &mut **b);
-        let mut subs = Substreams::open(
-            bytes,
-            level_header,
-            substream::FLAGS,
-            slots,
-            &mut inflater,
-            header.lane_count,
-        );
-        for round in 0..level_header.round_count {
-            let declared = level_header.split_count(round);
-            let mut fields = Fields {
-                inner: StreamSource::new(&mut subs, header.position_mode),
-                out: &mut *out,
-                level: k,
-                round,
-                level_start,
-            };
-            splits += state.run_round(declared, &mut fields, &mut ring)?.splits as u64;
-        }
-        subs.finish()?;
+/// Decodes `stream` with decoder-core's `Decoder`, level by level and round
+/// by round, writing every split record; the outer error is the stream's,
+/// the inner one the output's.
+fn write_fields(stream: &[u8], out: &mut dyn Write) -> Result<std::io::Result<()>, Error> {
+    if let Err(e) = writeln!(out, "{COLUMNS}") {
+        return Ok(Err(e));
     }
-    Ok(splits)
+    let mut workspace = OwnedWorkspace::for_stream(stream)?;
+    let mut decoder = workspace.decoder(stream)?;
+    let mut fields = Fields {
+        out,
+        level: 0,
+        round: 0,
+        level_start: 0,
+        failed: None,
+    };
+    while let Some(k) = decoder.next_level() {
+        let bytes = decoder.level_bytes(k, stream)?;
+        let mut level = decoder.begin_level(k, bytes)?;
+        // Level 0's seed is decoded by now: its vertices are old too.
+        fields.level = k;
+        fields.level_start = level.state().vertex_count();
+        fields.round = 0;
+        while level.next_round_observed(&mut fields)?.is_some() {
+            if let Some(e) = fields.failed.take() {
+                return Ok(Err(e));
+            }
+            fields.round += 1;
+        }
+    }
+    Ok(Ok(()))
 }

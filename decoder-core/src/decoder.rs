@@ -9,9 +9,56 @@ use crate::level_table::{LevelInfo, LevelTable};
 use crate::limits::substream::{self, SLOTS};
 use crate::record::{StreamSource, read_base};
 use crate::ring::Ring;
-use crate::round::RoundStats;
+use crate::round::{RecordSource, RoundStats};
+use crate::split::{SplitOutcome, SplitRecord};
 use crate::state::MeshState;
 use crate::substream::Substreams;
+
+/// Sees every split record as the decoder reads it (SPEC §7.4), with the
+/// state it is read against: for tools that study a stream (the
+/// `split_fields` example) or mirror its splits, through
+/// [`LevelDecoder::next_round_observed`]. Nothing it does changes decoding.
+pub trait SplitObserver {
+    /// The record of the split of `r`, whose canonical ring is `ring`, read
+    /// and not applied yet: `state` is as the record saw it.
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, record: &SplitRecord);
+}
+
+/// Observes nothing: [`LevelDecoder::next_round`].
+impl SplitObserver for () {
+    #[inline(always)]
+    fn record(&mut self, _: &MeshState<'_>, _: u32, _: &Ring, _: &SplitRecord) {}
+}
+
+/// The stream's records, each shown to an observer before it is applied.
+struct Observed<'o, S, O> {
+    source: S,
+    observer: &'o mut O,
+}
+
+impl<S: RecordSource, O: SplitObserver> RecordSource for Observed<'_, S, O> {
+    #[inline(always)]
+    fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
+        self.source.flag(state, v)
+    }
+
+    #[inline(always)]
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
+        let record = self.source.record(state, r, ring)?;
+        self.observer.record(state, r, ring, &record);
+        Ok(record)
+    }
+
+    #[inline(always)]
+    fn applied(&mut self, r: u32, c: u32, outcome: &SplitOutcome) {
+        self.source.applied(r, c, outcome);
+    }
+
+    #[inline(always)]
+    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+        self.source.likely_flags(state, upcoming)
+    }
+}
 
 /// What one finished round did, with the counts after it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -282,6 +329,15 @@ pub struct LevelDecoder<'d, 'l, 'ws> {
 impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
     /// Decodes the next round; `None` once the level is complete and verified.
     pub fn next_round(&mut self) -> Result<Option<RoundInfo>, Error> {
+        self.next_round_observed(&mut ())
+    }
+
+    /// [`LevelDecoder::next_round`], showing `observer` every split record
+    /// of the round before it is applied.
+    pub fn next_round_observed<O: SplitObserver>(
+        &mut self,
+        observer: &mut O,
+    ) -> Result<Option<RoundInfo>, Error> {
         if *self.poisoned {
             return Err(Error::Poisoned);
         }
@@ -298,7 +354,10 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
             };
         }
         let declared = self.header.split_count(self.round);
-        let mut source = StreamSource::new(&mut self.subs, self.mode);
+        let mut source = Observed {
+            source: StreamSource::new(&mut self.subs, self.mode),
+            observer,
+        };
         match self.state.run_round(declared, &mut source, self.ring) {
             Ok(stats) => {
                 let info = RoundInfo {

@@ -57,7 +57,7 @@ pub mod writer;
 pub use bytes::crc32;
 pub use context::DeficitContexts;
 pub use corner_refs::CornerRefs;
-pub use decoder::{Decoder, LevelDecoder, RoundInfo, declared_layout, layout_for};
+pub use decoder::{Decoder, LevelDecoder, RoundInfo, SplitObserver, declared_layout, layout_for};
 pub use error::{ChecksumScope, Error};
 pub use hash::Fnv1a;
 pub use header::{Header, PositionMode};

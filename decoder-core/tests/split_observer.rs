@@ -1,0 +1,57 @@
+//! `LevelDecoder::next_round_observed` shows every split record the decoder
+//! applies, once, in decoding order, and decodes exactly as `next_round`.
+
+#[path = "../fuzz/src/streams.rs"]
+mod streams;
+
+use splitstream_decoder_core::{
+    Decoder, Inflater, MeshState, Ring, SplitObserver, SplitRecord, workspace_len,
+};
+
+/// Records what it is shown, and the vertex count it was shown it at.
+#[derive(Default)]
+struct Seen {
+    records: Vec<(u32, u32, SplitRecord)>,
+}
+
+impl SplitObserver for Seen {
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, record: &SplitRecord) {
+        assert!(ring.len() >= 2, "a split's ring");
+        self.records.push((r, state.vertex_count(), *record));
+    }
+}
+
+#[test]
+fn the_observer_sees_every_applied_split_and_decoding_is_unchanged() {
+    for g in streams::seed_generated() {
+        let stream = &g.stream;
+        let mut ws = vec![0u8; workspace_len(stream).unwrap()];
+        let mut inflater = Box::new(Inflater::new());
+        let mut d = Decoder::new(stream, &mut ws, &mut inflater).unwrap();
+        let mut seen = Seen::default();
+        let mut splits = 0;
+        while let Some(k) = d.next_level() {
+            let bytes = d.level_bytes(k, stream).unwrap();
+            let mut level = d.begin_level(k, bytes).unwrap();
+            while let Some(info) = level.next_round_observed(&mut seen).unwrap() {
+                splits += info.stats.splits as usize;
+                assert_eq!(seen.records.len(), splits, "{}", g.base);
+            }
+        }
+        // The C of the j-th split overall is vertex (base vertices + j), and
+        // the records' positions are where P and C ended up, unless a later
+        // split moved them (R keeps P's index and gets P's position).
+        let positions = d.positions();
+        for (j, &(r, n, record)) in seen.records.iter().enumerate() {
+            assert_eq!(n, g.base_vertices + j as u32, "{}", g.base);
+            let later = |v: u32| seen.records[j + 1..].iter().any(|&(r2, _, _)| r2 == v);
+            if !later(n) {
+                assert_eq!(positions[n as usize], record.position_c, "{}", g.base);
+            }
+            if !later(r) {
+                assert_eq!(positions[r as usize], record.position_p, "{}", g.base);
+            }
+        }
+        assert_eq!(d.state_hash(), *g.hashes.last().unwrap(), "{}", g.base);
+    }
+}
