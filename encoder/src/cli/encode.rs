@@ -5,16 +5,13 @@ use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use splitstream_decoder_core::PositionMode;
-use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, SEED_VERTICES, encode, encode_auto_position};
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::{Quantization, Units};
 
-use super::{
-    BackendArg, CliResult, Codec, DeficitsArg, LatticeArg, PlaneArg, Position, QuantizationArg,
-    WingsArg,
-};
+use super::coding::CodingArgs;
+use super::{BackendArg, CliResult, LatticeArg, Position, QuantizationArg};
 
 /// `splitstream encode`'s arguments.
 #[derive(clap::Args)]
@@ -36,15 +33,8 @@ pub struct Args {
     /// Largest quadric error a collapse may have.
     #[arg(long)]
     pub max_error: Option<f64>,
-    #[arg(long, value_enum, default_value_t = Codec::Rans)]
-    pub codec: Codec,
-    /// rANS lanes per chunk (1..=32): independent streams a decoder may
-    /// decode in parallel.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(1..=32))]
-    pub lanes: u8,
-    /// Largest raw chunk in bytes (bounds decoder buffers).
-    #[arg(long, default_value_t = 16384)]
-    pub chunk_size: u32,
+    #[command(flatten)]
+    pub coding: CodingArgs,
     /// Keep boundary vertices in place (patch borders).
     #[arg(long)]
     pub lock_boundary: bool,
@@ -78,21 +68,6 @@ pub struct Args {
     /// constrained mode only.
     #[arg(long, value_enum, default_value_t = LatticeArg::Auto)]
     pub lattice: LatticeArg,
-    /// Which axis of each position residual the split's plane predicts, or
-    /// `height`: z from the surface of the split vertex's fan (terrain,
-    /// format 3.1) (SPEC §7.4); `auto` picks the cheapest per level.
-    #[arg(long, value_enum, default_value_t = PlaneArg::Auto)]
-    pub plane: PlaneArg,
-    /// How each level names its splits' wings: `ranks` in ring order, or
-    /// `near`/`near-xy`, in the order of their distance to the ring's
-    /// centre (format 3.2) (SPEC §7.4); `auto` picks the cheapest per level.
-    #[arg(long, value_enum, default_value_t = WingsArg::Auto)]
-    pub wings: WingsArg,
-    /// Which contexts code each level's split valences: `plain`, or
-    /// `valence`, by the valences of P and C right after the split (format
-    /// 3.3) (SPEC §5.5.5); `auto` picks the cheaper per level.
-    #[arg(long, value_enum, default_value_t = DeficitsArg::Auto)]
-    pub deficits: DeficitsArg,
     /// Where the simplification's data-parallel passes run (GPU backends:
     /// quadrics, best edges and selection on the device, collapses on the CPU).
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
@@ -109,9 +84,7 @@ pub fn run(a: Args) -> CliResult {
     if !(a.admit > 0.0 && a.admit <= 1.0) {
         return Err(format!("--admit {} is outside (0, 1]", a.admit));
     }
-    if a.chunk_size == 0 {
-        return Err("--chunk-size must be at least 1".into());
-    }
+    a.coding.check()?;
     let started = Instant::now();
     let read = ReadOptions {
         npz_array: a.npz_array.clone(),
@@ -135,12 +108,8 @@ pub fn run(a: Args) -> CliResult {
             Position::Constrained => PositionMode::Constrained,
         },
         max_error: a.max_error,
-        codec: match a.codec {
-            Codec::Rans => ChunkCodec::Rans { lanes: a.lanes },
-            Codec::Deflate => ChunkCodec::Deflate(9),
-            Codec::Stored => ChunkCodec::Stored,
-        },
-        chunk_limit: a.chunk_size,
+        codec: a.coding.chunk_codec(),
+        chunk_limit: a.coding.chunk_size,
         lock_boundary: a.lock_boundary,
         admit_quantile: a.admit,
         units: if a.geographic {
@@ -151,9 +120,9 @@ pub fn run(a: Args) -> CliResult {
         quantization: a.quantization.into(),
         lattice: a.lattice.lattice(),
         backend: a.backend.into(),
-        plane: a.plane.policy(),
-        wings: a.wings.policy(),
-        deficits: a.deficits.contexts(),
+        plane: a.coding.plane(),
+        wings: a.coding.wings(),
+        deficits: a.coding.deficits(),
     };
     let degrees_unconverted = !a.geographic && looks_geographic(&mesh);
     if degrees_unconverted {

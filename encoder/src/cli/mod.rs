@@ -1,6 +1,7 @@
 //! Command-line definitions and dispatch.
 
 mod bench;
+mod coding;
 mod decode;
 mod demo;
 mod encode;
@@ -8,6 +9,7 @@ mod gpu_bench;
 mod grid;
 mod info;
 mod output;
+mod transcode;
 mod verify;
 
 use std::path::PathBuf;
@@ -203,6 +205,11 @@ pub enum Command {
     /// Encode a mesh (.ply .obj .off .gltf .glb .stl) or elevation grid (.tif
     /// .asc .npy .npz).
     Encode(encode::Args),
+    /// Write a stream again from its own refinement, without the input
+    /// mesh: another codec, lane count or chunk size (smaller chunks, less
+    /// decoder memory), each level's coding chosen again (older streams get
+    /// the newest); the same state after every round.
+    Transcode(transcode::Args),
     /// Decode a stream to .ply, .obj or .glb, in decoded vertex order.
     Decode {
         input: PathBuf,
@@ -218,6 +225,11 @@ pub enum Command {
         input: PathBuf,
         #[arg(long)]
         json: bool,
+        /// Also code the stream again with rANS and with deflate (as
+        /// `transcode` would, nothing written) and give every field's bits
+        /// per vertex under each.
+        #[arg(long)]
+        codecs: bool,
     },
     /// Decode fully, checking every checksum and rule; print the state hash.
     Verify { input: PathBuf },
@@ -248,12 +260,17 @@ pub enum Command {
 pub fn run(cli: Cli) -> CliResult {
     match cli.command {
         Command::Encode(args) => encode::run(args),
+        Command::Transcode(args) => transcode::run(args),
         Command::Decode {
             input,
             output,
             level,
         } => decode::run(&input, &output, level),
-        Command::Info { input, json } => info::run(&input, json),
+        Command::Info {
+            input,
+            json,
+            codecs,
+        } => info::run(&input, json, codecs),
         Command::Verify { input } => verify::run(&input),
         Command::Bench(settings) => bench::run(&settings),
         Command::GpuBench(settings) => gpu_bench::run(&settings),

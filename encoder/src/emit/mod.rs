@@ -6,6 +6,7 @@ mod deficits;
 mod levels;
 mod policies;
 mod replay;
+mod transcode;
 mod wings;
 
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
@@ -16,6 +17,7 @@ use crate::quantize::{Lattice, Quantization, QuantizedMesh, Units, quantize_with
 use crate::simplify::{Backend, GpuError, SimplifyOptions, simplify_on};
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
+pub use transcode::{TranscodeError, TranscodeOptions, Transcoded, transcode};
 
 /// Vertices the simplification aims for below the base mesh: a seed just
 /// large enough that closed shapes keep a valid manifold.

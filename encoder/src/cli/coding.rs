@@ -1,0 +1,66 @@
+//! How a stream's substreams are coded: the options `encode` and
+//! `transcode` share.
+
+use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, WingPolicy};
+
+use super::{CliResult, Codec, DeficitsArg, PlaneArg, WingsArg};
+
+#[derive(clap::Args)]
+pub struct CodingArgs {
+    #[arg(long, value_enum, default_value_t = Codec::Rans)]
+    pub codec: Codec,
+    /// rANS lanes per chunk (1..=32): independent streams a decoder may
+    /// decode in parallel.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(1..=32))]
+    pub lanes: u8,
+    /// Largest raw chunk in bytes (bounds decoder buffers: 7 chunks, or
+    /// 1,856 bytes each at least, SPEC §9).
+    #[arg(long, default_value_t = 16384)]
+    pub chunk_size: u32,
+    /// Which axis of each position residual the split's plane predicts, or
+    /// `height`: z from the surface of the split vertex's fan (terrain,
+    /// format 3.1) (SPEC §7.4); `auto` picks the cheapest per level.
+    #[arg(long, value_enum, default_value_t = PlaneArg::Auto)]
+    pub plane: PlaneArg,
+    /// How each level names its splits' wings: `ranks` in ring order, or
+    /// `near`/`near-xy`, in the order of their distance to the ring's
+    /// centre (format 3.2) (SPEC §7.4); `auto` picks the cheapest per level.
+    #[arg(long, value_enum, default_value_t = WingsArg::Auto)]
+    pub wings: WingsArg,
+    /// Which contexts code each level's split valences: `plain`, or
+    /// `valence`, by the valences of P and C right after the split (format
+    /// 3.3) (SPEC §5.5.5); `auto` picks the cheaper per level.
+    #[arg(long, value_enum, default_value_t = DeficitsArg::Auto)]
+    pub deficits: DeficitsArg,
+}
+
+impl CodingArgs {
+    /// Refuses what clap cannot: a chunk size of 0.
+    pub fn check(&self) -> CliResult {
+        if self.chunk_size == 0 {
+            return Err("--chunk-size must be at least 1".into());
+        }
+        Ok(())
+    }
+
+    pub fn chunk_codec(&self) -> ChunkCodec {
+        match self.codec {
+            Codec::Rans => ChunkCodec::Rans { lanes: self.lanes },
+            Codec::Deflate => ChunkCodec::Deflate(9),
+            Codec::Stored => ChunkCodec::Stored,
+        }
+    }
+
+    pub fn plane(&self) -> Option<PlanePolicy> {
+        self.plane.policy()
+    }
+
+    pub fn wings(&self) -> Option<WingPolicy> {
+        self.wings.policy()
+    }
+
+    pub fn deficits(&self) -> Option<DeficitContexts> {
+        self.deficits.contexts()
+    }
+}

@@ -1,0 +1,324 @@
+//! Transcoding: a stream written again from its own refinement, without
+//! the input mesh.
+//!
+//! The stream is decoded with decoder-core, every split record is kept as
+//! the collapse it reverses (in the stream's own vertex ids), and the
+//! emission replays those collapses as it replays a simplification
+//! ([`replay`]). The rounds, splits and positions are the stream's, so the
+//! new stream reaches the same state after every round (the same state
+//! hashes, SPEC §8); what changes is how they are coded: another codec,
+//! lane count or chunk size (smaller chunks lower the decoder's buffers,
+//! SPEC §9), and each level's plane, wing and deficit coding chosen again,
+//! so that a stream written by an older encoder gets the newest coding
+//! (SPEC §1).
+
+use splitstream_decoder_core::limits::LEAF;
+use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, assemble_stream};
+use splitstream_decoder_core::{
+    DeficitContexts, MeshState, PlanePolicy, Ring, SplitObserver, SplitRecord, WingPolicy,
+};
+
+use super::levels::LevelPlan;
+use super::replay::{ReplayError, replay};
+use crate::corner_table::{CornerTable, Fan};
+use crate::quantize::QuantizedMesh;
+use crate::simplify::{Collapse, MAX_VALENCE, Simplification};
+
+/// How [`transcode`] codes the stream it writes.
+#[derive(Clone, Copy, Debug)]
+pub struct TranscodeOptions {
+    pub codec: ChunkCodec,
+    /// Largest raw chunk (bytes or values); bounds the decoder's buffers
+    /// (SPEC §9).
+    pub chunk_limit: u32,
+    /// The plane policy of every level; `None`: chosen per level by size.
+    pub plane: Option<PlanePolicy>,
+    /// The wing policy of every level; `None`: chosen per level by size.
+    pub wings: Option<WingPolicy>,
+    /// The deficit contexts of every level; `None`: chosen per level by size.
+    pub deficits: Option<DeficitContexts>,
+}
+
+impl Default for TranscodeOptions {
+    /// The reference encoder's defaults: rANS in 4 lanes, 16 KiB chunks,
+    /// every policy chosen by size.
+    fn default() -> Self {
+        TranscodeOptions {
+            codec: ChunkCodec::Rans { lanes: 4 },
+            chunk_limit: 16 * 1024,
+            plane: None,
+            wings: None,
+            deficits: None,
+        }
+    }
+}
+
+/// A transcoded stream.
+#[derive(Debug)]
+pub struct Transcoded {
+    pub stream: Vec<u8>,
+    /// The state hash after the last round, the same for both streams.
+    pub final_hash: u64,
+    pub levels: usize,
+    pub rounds: usize,
+}
+
+/// Why a stream could not be transcoded.
+#[derive(Debug)]
+pub enum TranscodeError {
+    /// The input stream does not decode (SPEC §10).
+    Decode(splitstream_decoder_core::Error),
+    /// A split valence the encoder cannot represent (255: its leaf mark).
+    SplitValence {
+        vertex: u32,
+    },
+    /// The replay refused the refinement, or reached another state: a bug.
+    Replay(ReplayError),
+    BadOption(String),
+}
+
+impl std::fmt::Display for TranscodeError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TranscodeError::Decode(e) => write!(f, "the stream does not decode: {e}"),
+            TranscodeError::SplitValence { vertex } => write!(
+                f,
+                "vertex {vertex} has split valence 255, which the encoder cannot write (at most {MAX_VALENCE})"
+            ),
+            TranscodeError::Replay(e) => write!(f, "{e}"),
+            TranscodeError::BadOption(s) => write!(f, "{s}"),
+        }
+    }
+}
+
+impl std::error::Error for TranscodeError {}
+
+impl From<splitstream_decoder_core::Error> for TranscodeError {
+    fn from(e: splitstream_decoder_core::Error) -> Self {
+        TranscodeError::Decode(e)
+    }
+}
+
+/// Writes `stream` again under `options` (see the module documentation).
+pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded, TranscodeError> {
+    if options.chunk_limit == 0 {
+        return Err(TranscodeError::BadOption(
+            "the chunk size must be at least 1".into(),
+        ));
+    }
+    if let ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } = options.codec
+        && !(1..=32).contains(&lanes)
+    {
+        return Err(TranscodeError::BadOption(format!(
+            "{lanes} lanes is outside 1..=32"
+        )));
+    }
+    let refinement = Refinement::decode(stream)?;
+    let params = StreamParams {
+        position_mode: refinement.position_mode,
+        bits: refinement.mesh.bits,
+        origin: refinement.mesh.origin,
+        scale: refinement.mesh.scale,
+        codec: options.codec,
+        chunk_limit: options.chunk_limit,
+    };
+    let simplification = refinement.simplification()?;
+    let replayed = replay(
+        &refinement.mesh,
+        &simplification,
+        &refinement.plan,
+        &params,
+        options.plane,
+        options.wings,
+        options.deficits,
+    )
+    .map_err(TranscodeError::Replay)?;
+    if replayed.final_hash != refinement.final_hash {
+        return Err(TranscodeError::Replay(ReplayError(format!(
+            "the transcoded stream ends in state {:016x}, the input in {:016x}",
+            replayed.final_hash, refinement.final_hash
+        ))));
+    }
+    let rounds = replayed.levels.iter().map(|l| l.round_splits.len()).sum();
+    let levels = replayed.levels.len();
+    Ok(Transcoded {
+        stream: assemble_stream(&params, &replayed.levels, replayed.framed),
+        final_hash: replayed.final_hash,
+        levels,
+        rounds,
+    })
+}
+
+/// What a decoded stream holds: its seed, its rounds as collapses (in
+/// decoding order), its level structure and its final mesh.
+struct Refinement {
+    position_mode: splitstream_decoder_core::PositionMode,
+    /// The final mesh, in the stream's vertex ids (the replay's input ids).
+    mesh: QuantizedMesh,
+    seed_positions: Vec<[u32; 3]>,
+    seed_triangles: Vec<[u32; 3]>,
+    seed_deficits: Vec<u8>,
+    /// Every round's collapses, in decoding order.
+    rounds: Vec<Vec<Collapse>>,
+    plan: LevelPlan,
+    final_hash: u64,
+}
+
+/// Keeps each split record of a round as the collapse it reverses: P is
+/// the split vertex (it keeps its id), C the vertex the split adds (the
+/// next id), the wings the ring entries at `o` and `o + d` (SPEC §7.4).
+#[derive(Default)]
+struct Recorder {
+    round: Vec<Collapse>,
+    /// The first vertex whose split valence the encoder cannot represent.
+    unrepresentable: Option<u32>,
+}
+
+impl SplitObserver for Recorder {
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, rec: &SplitRecord) {
+        let entries = ring.vertices();
+        let (k, o, d) = (
+            entries.len(),
+            rec.wing_offset as usize,
+            rec.wing_distance as usize,
+        );
+        let c = state.vertex_count();
+        // Split valence = valence right after the split + deficit (§7.4).
+        let mut split_valence = |deficit: u8, valence: usize, vertex: u32| {
+            if deficit == LEAF {
+                return LEAF;
+            }
+            let sv = deficit as usize + valence;
+            if sv > MAX_VALENCE {
+                self.unrepresentable.get_or_insert(vertex);
+            }
+            sv.min(MAX_VALENCE) as u8
+        };
+        let split_valence_p = split_valence(rec.deficit_p, d + 2, r);
+        let split_valence_c = split_valence(rec.deficit_c, k - d + 2, c);
+        self.round.push(Collapse {
+            p: r,
+            c,
+            wing_a: entries[o],
+            wing_b: entries[o + d],
+            position_p: rec.position_p,
+            position_c: rec.position_c,
+            position_r: state.positions()[r as usize],
+            split_valence_p,
+            split_valence_c,
+            error: 0.0,
+            distance: 0.0,
+        });
+    }
+}
+
+impl Refinement {
+    /// Decodes the whole stream with decoder-core, keeping its records.
+    fn decode(stream: &[u8]) -> Result<Refinement, TranscodeError> {
+        let mut workspace = OwnedWorkspace::for_stream(stream)?;
+        let mut decoder = workspace.decoder(stream)?;
+        let header = *decoder.header();
+        let table = decoder.level_table();
+        let errors: Vec<f32> = (0..table.len())
+            .map(|k| table.get(k).geometric_error)
+            .collect();
+        let mut recorder = Recorder::default();
+        let mut rounds = Vec::new();
+        let mut plan_rounds = Vec::new();
+        let mut seed = None;
+        while let Some(k) = decoder.next_level() {
+            let bytes = decoder.level_bytes(k, stream)?;
+            let mut level = decoder.begin_level(k, bytes)?;
+            if k == 0 {
+                // The seed is decoded by `begin_level`.
+                let state = level.state();
+                let (v0, t0) = (
+                    state.vertex_count() as usize,
+                    state.triangle_count() as usize,
+                );
+                seed = Some((
+                    state.positions()[..v0].to_vec(),
+                    state.triangles()[..t0].to_vec(),
+                    state.deficits()[..v0].to_vec(),
+                ));
+            }
+            let mut level_rounds = Vec::new();
+            while level.next_round_observed(&mut recorder)?.is_some() {
+                level_rounds.push(rounds.len());
+                rounds.push(std::mem::take(&mut recorder.round));
+            }
+            plan_rounds.push(level_rounds);
+        }
+        if let Some(vertex) = recorder.unrepresentable {
+            return Err(TranscodeError::SplitValence { vertex });
+        }
+        // `for_stream` sizes the workspace for every level, so all decode.
+        let (seed_positions, seed_triangles, seed_deficits) = seed.ok_or(
+            TranscodeError::Decode(splitstream_decoder_core::Error::Truncated),
+        )?;
+        // Simplification steps run in the opposite order to the rounds.
+        let last = rounds.len().saturating_sub(1);
+        let plan = LevelPlan {
+            rounds: plan_rounds
+                .into_iter()
+                .map(|level| level.into_iter().map(|t| last - t).collect())
+                .collect(),
+            errors,
+        };
+        let mesh = QuantizedMesh {
+            positions: decoder.positions().to_vec(),
+            triangles: decoder.triangles().to_vec(),
+            bits: header.bits,
+            origin: header.origin,
+            scale: header.scale,
+            metric: header.scale,
+            on_lattice: [false; 3],
+        };
+        Ok(Refinement {
+            position_mode: header.position_mode,
+            mesh,
+            seed_positions,
+            seed_triangles,
+            seed_deficits,
+            rounds,
+            plan,
+            final_hash: decoder.state_hash(),
+        })
+    }
+
+    /// The simplification these rounds reverse: the seed mesh is what it
+    /// left, its steps are the rounds in reverse order.
+    fn simplification(&self) -> Result<Simplification, TranscodeError> {
+        let n = self.mesh.positions.len();
+        let v0 = self.seed_positions.len();
+        let table = CornerTable::new(n, &self.seed_triangles);
+        // The seed's split valences: deficit + valence, the ghost counted
+        // on a boundary (SPEC §6.2), as the replay computes them back.
+        let mut split_valence = vec![LEAF; n];
+        let mut fan = Fan::default();
+        for (v, &deficit) in self.seed_deficits.iter().enumerate() {
+            if deficit == LEAF {
+                continue;
+            }
+            table.fan(v as u32, &mut fan);
+            let valence = fan.corners.len() + if fan.boundary { 2 } else { 0 };
+            let sv = deficit as usize + valence;
+            if sv > MAX_VALENCE {
+                return Err(TranscodeError::SplitValence { vertex: v as u32 });
+            }
+            split_valence[v] = sv as u8;
+        }
+        let mut positions = self.mesh.positions.clone();
+        positions[..v0].copy_from_slice(&self.seed_positions);
+        Ok(Simplification {
+            steps: self.rounds.iter().rev().cloned().collect(),
+            table,
+            positions,
+            split_valence,
+            alive: (0..n).map(|v| v < v0).collect(),
+            alive_count: v0,
+            step_errors: vec![0.0; self.rounds.len()],
+        })
+    }
+}
