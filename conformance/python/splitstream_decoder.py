@@ -1,10 +1,11 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.2 decoder, in Python, written from
+"""A second splitstream 3.4 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
-plane policy `height` and 3.2's wing policies were added with the SPEC
-sections that define them.) It speaks the conformance protocol (a stream
+plane policy `height`, 3.2's wing policies, 3.3's deficit contexts and
+3.4's rANS chunks beyond max_chunk_len were added with the SPEC sections
+that define them.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -499,7 +500,9 @@ class Decoder:
                 raise Fail("malformed")
             prev_id = sid
             prev_rans = rans
-            if raw_len == 0 or raw_len > self.mcl:
+            # max_chunk_len bounds stored and deflate chunks only (3.4):
+            # a rANS chunk may code any number of values.
+            if raw_len == 0 or (not rans and raw_len > self.mcl):
                 raise Fail("malformed")
             if codec == 0 and stored_len != raw_len:
                 raise Fail("malformed")

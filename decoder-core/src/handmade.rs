@@ -34,6 +34,7 @@ pub fn params(codec: ChunkCodec) -> StreamParams {
         scale: [1.0; 3],
         codec,
         chunk_limit: 4,
+        rans_chunk_limit: 4,
     }
 }
 

@@ -155,9 +155,12 @@ impl<'l> LevelHeader<'l> {
             }
             previous_id = e.substream;
             previous_rans = rans;
-            if e.raw_len == 0 || e.raw_len > max_chunk_len {
+            // `max_chunk_len` bounds what a decoder buffers: byte-codec
+            // chunks. A rANS chunk needs only its tables and lanes, whatever
+            // its value count (SPEC §5.2, format 3.4).
+            if e.raw_len == 0 || (!rans && e.raw_len > max_chunk_len) {
                 return Err(Error::InvalidLevelHeader(
-                    "chunk raw length 0 or above the header maximum",
+                    "chunk raw length 0, or a byte-codec chunk above the header maximum",
                 ));
             }
             match e.codec {

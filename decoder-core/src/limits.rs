@@ -6,15 +6,19 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 
 /// Format version this crate reads and writes (SPEC §1).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 3;
+pub const VERSION_MINOR: u8 = 4;
+/// The minor version written when a stream uses the deficit contexts
+/// `valence` and no 3.4 feature, so that 3.3 decoders read it (SPEC §1).
+pub const VERSION_MINOR_DEFICITS: u8 = 3;
 /// The minor version written when a stream uses a wing policy other than
-/// `ranks` and no 3.3 feature, so that 3.2 decoders read it (SPEC §1).
+/// `ranks` and no 3.3 or 3.4 feature, so that 3.2 decoders read it (SPEC §1).
 pub const VERSION_MINOR_WINGS: u8 = 2;
 /// The minor version written when a stream uses the plane policy `height`
-/// and no 3.2 or 3.3 feature, so that 3.1 decoders read it (SPEC §1).
+/// and no 3.2, 3.3 or 3.4 feature, so that 3.1 decoders read it (SPEC §1).
 pub const VERSION_MINOR_HEIGHT: u8 = 1;
-/// The minor version written when a stream uses no 3.1, 3.2 or 3.3 feature
-/// (every reserved field zero), so that 3.0 decoders read it (SPEC §1).
+/// The minor version written when a stream uses no 3.1 to 3.4 feature
+/// (every reserved field zero, every chunk within `max_chunk_len`), so that
+/// 3.0 decoders read it (SPEC §1).
 pub const VERSION_MINOR_BASELINE: u8 = 0;
 
 /// Size of the fixed header in bytes (SPEC §3).

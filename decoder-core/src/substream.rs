@@ -400,8 +400,9 @@ mod tests {
             scale: [1.0; 3],
             codec,
             chunk_limit: chunk,
+            rans_chunk_limit: chunk,
         };
-        frame_level(&payload, None, &params).0
+        frame_level(&payload, None, &params).bytes
     }
 
     /// Reads every flag of `bytes`, peeking before each read when `peek`

@@ -7,11 +7,11 @@ use alloc::vec::Vec;
 use crate::bytes::crc32;
 use crate::context::{self, DeficitContexts};
 use crate::header::{Header, PositionMode};
-use crate::layout::Layout;
+use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
-    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, VERSION_MINOR_BASELINE, VERSION_MINOR_HEIGHT,
-    VERSION_MINOR_WINGS, codec, substream,
+    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, VERSION_MINOR_BASELINE, VERSION_MINOR_DEFICITS,
+    VERSION_MINOR_HEIGHT, VERSION_MINOR_WINGS, codec, substream,
 };
 use crate::predict::PlanePolicy;
 use crate::rans_writer::{Symbol, encode_chunk};
@@ -174,13 +174,20 @@ pub struct StreamParams {
     pub origin: [f64; 3],
     pub scale: [f64; 3],
     pub codec: ChunkCodec,
-    /// Largest raw chunk the writer cuts (SPEC §5.2).
+    /// Largest stored or deflate chunk the writer cuts, in raw bytes: the
+    /// header's `max_chunk_len`, which sets the decoder's buffers (SPEC §5.2,
+    /// §9).
     pub chunk_limit: u32,
+    /// Largest rANS chunk the writer cuts, in values. A rANS chunk needs no
+    /// buffer of its length (only its tables and lanes), so from format 3.4
+    /// it may exceed `max_chunk_len` (SPEC §5.2); smaller chunks have
+    /// tables fitted to fewer values and cost more table bytes.
+    pub rans_chunk_limit: u32,
 }
 
 impl Default for StreamParams {
     /// The reference encoder's defaults on a unit grid: optimal positions,
-    /// 14 bits, rANS in 4 lanes, chunks of 16 KiB.
+    /// 14 bits, rANS in 4 lanes, chunks of 16 KiB and of 16,384 values.
     fn default() -> Self {
         StreamParams {
             position_mode: PositionMode::Optimal,
@@ -189,6 +196,7 @@ impl Default for StreamParams {
             scale: [1.0; 3],
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
+            rans_chunk_limit: 16 * 1024,
         }
     }
 }
@@ -243,6 +251,16 @@ impl SeedPayload {
     }
 }
 
+/// One level as [`frame_level`] writes it, with the largest chunks it cut.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FramedLevel {
+    pub bytes: Vec<u8>,
+    /// Raw bytes of its largest stored or deflate chunk (0 if none).
+    pub largest_byte_chunk: u32,
+    /// Values of its largest rANS chunk (0 if none).
+    pub largest_rans_chunk: u32,
+}
+
 /// Frames a base level (seed mesh only) and refinement levels.
 pub fn write_stream(params: &StreamParams, levels: &[LevelPayload]) -> Vec<u8> {
     let base = &levels[0];
@@ -264,7 +282,7 @@ pub fn write_stream_seeded(
     seed: &SeedPayload,
     levels: &[LevelPayload],
 ) -> Vec<u8> {
-    let framed: Vec<(Vec<u8>, u32)> = levels
+    let framed: Vec<FramedLevel> = levels
         .iter()
         .enumerate()
         .map(|(k, level)| frame_level(level, (k == 0).then_some(seed), params))
@@ -278,14 +296,26 @@ pub fn write_stream_seeded(
 pub fn assemble_stream(
     params: &StreamParams,
     levels: &[LevelPayload],
-    framed: Vec<(Vec<u8>, u32)>,
+    framed: Vec<FramedLevel>,
 ) -> Vec<u8> {
-    let max_chunk = framed
-        .iter()
-        .map(|(_, largest)| *largest)
-        .max()
-        .unwrap_or(0);
-    let framed: Vec<Vec<u8>> = framed.into_iter().map(|(bytes, _)| bytes).collect();
+    // `max_chunk_len` bounds the byte-codec chunks only (SPEC §5.2, 3.4):
+    // they are what a decoder buffers. Where the rANS chunks fit under it
+    // anyway (the buffers are at least RANS_SLOT_BYTES, §9), it covers them
+    // too, so that the stream stays readable by 3.3 decoders for the same
+    // memory.
+    let largest_byte = framed.iter().map(|f| f.largest_byte_chunk).max();
+    let largest_byte = largest_byte.unwrap_or(0);
+    let largest_rans = framed.iter().map(|f| f.largest_rans_chunk).max();
+    let largest_rans = largest_rans.unwrap_or(0);
+    let free = largest_byte.max(RANS_SLOT_BYTES as u32);
+    let rans_above = largest_rans > free;
+    let max_chunk = if rans_above {
+        largest_byte
+    } else {
+        largest_byte.max(largest_rans)
+    }
+    .max(1);
+    let framed: Vec<Vec<u8>> = framed.into_iter().map(|f| f.bytes).collect();
     let level_count = levels.len() as u16;
     let mut offset = head_len(level_count) as u64;
     let mut entries = Vec::with_capacity(levels.len());
@@ -300,7 +330,6 @@ pub fn assemble_stream(
         });
         offset += bytes.len() as u64;
     }
-    let max_chunk = max_chunk.max(1);
     let (base, top) = (&levels[0], &levels[levels.len() - 1]);
     let layout = Layout::new(
         top.vertex_count,
@@ -309,12 +338,15 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.3 only where a 3.3 feature (the deficit contexts
-    // `valence`) is used, 3.2 where a 3.2 feature (a wing policy other than
-    // `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`) is;
-    // every other stream stays readable by 3.0 decoders.
-    let version_minor = if levels.iter().any(|l| l.deficits != DeficitContexts::Plain) {
+    // SPEC §1: 3.4 only where a 3.4 feature (a rANS chunk longer than
+    // `max_chunk_len`) is used, 3.3 where a 3.3 feature (the deficit
+    // contexts `valence`) is, 3.2 where a 3.2 feature (a wing policy other
+    // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
+    // is; every other stream stays readable by 3.0 decoders.
+    let version_minor = if rans_above {
         VERSION_MINOR
+    } else if levels.iter().any(|l| l.deficits != DeficitContexts::Plain) {
+        VERSION_MINOR_DEFICITS
     } else if levels.iter().any(|l| l.wings != WingPolicy::Ranks) {
         VERSION_MINOR_WINGS
     } else if levels.iter().any(|l| l.plane == PlanePolicy::Height) {
@@ -346,13 +378,12 @@ pub fn assemble_stream(
     out
 }
 
-/// Frames one level (SPEC §5.1); returns its bytes and its largest raw chunk.
-/// `seed` is given for level 0 only.
+/// Frames one level (SPEC §5.1). `seed` is given for level 0 only.
 pub fn frame_level(
     level: &LevelPayload,
     seed: Option<&SeedPayload>,
     params: &StreamParams,
-) -> (Vec<u8>, u32) {
+) -> FramedLevel {
     frame_level_with(level, seed, params, &one_by_one)
 }
 
@@ -374,11 +405,10 @@ pub fn frame_level_with(
     seed: Option<&SeedPayload>,
     params: &StreamParams,
     map: ChunkMap<'_>,
-) -> (Vec<u8>, u32) {
-    let limit = params.chunk_limit.max(1) as usize;
+) -> FramedLevel {
     let mut directory = Vec::new();
     let mut payload = Vec::new();
-    let mut largest = 0u32;
+    let (mut largest_byte_chunk, mut largest_rans_chunk) = (0u32, 0u32);
     let rounds = level
         .substreams
         .iter()
@@ -390,7 +420,7 @@ pub fn frame_level_with(
         .map(|(i, s)| (substream::BASE_POSITIONS + i as u8, s));
     for (id, sub) in rounds.chain(base) {
         let contexts = context::count(id, level.deficits);
-        let chunks = substream_chunks(sub, contexts, limit, params.codec, map);
+        let chunks = substream_chunks(sub, contexts, params, map);
         for chunk in chunks {
             let mut entry = [0u8; CHUNK_ENTRY_LEN];
             entry[0] = id;
@@ -399,7 +429,12 @@ pub fn frame_level_with(
             entry[8..12].copy_from_slice(&(chunk.stored.len() as u32).to_le_bytes());
             entry[12..16].copy_from_slice(&crc32(&chunk.stored).to_le_bytes());
             directory.push(entry);
-            largest = largest.max(chunk.raw_len);
+            let largest = if chunk.codec == codec::RANS {
+                &mut largest_rans_chunk
+            } else {
+                &mut largest_byte_chunk
+            };
+            *largest = (*largest).max(chunk.raw_len);
             payload.extend_from_slice(&chunk.stored);
         }
     }
@@ -425,7 +460,11 @@ pub fn frame_level_with(
     let crc = crc32(&out);
     out.extend_from_slice(&crc.to_le_bytes());
     out.extend_from_slice(&payload);
-    (out, largest)
+    FramedLevel {
+        bytes: out,
+        largest_byte_chunk,
+        largest_rans_chunk,
+    }
 }
 
 /// Under the rANS codec a substream is deflated at level 10 too, and the
@@ -438,19 +477,22 @@ pub fn frame_level_with(
 const DEFLATE_QUICK_RATIO: (usize, usize) = (5, 3);
 
 /// The chunks of a substream as `frame_level` codes them, in a level whose
-/// rANS chunks have `contexts` tables for it (`context::count`).
+/// rANS chunks have `contexts` tables for it (`context::count`): byte-codec
+/// chunks of at most `params.chunk_limit` bytes, rANS chunks of at most
+/// `params.rans_chunk_limit` values.
 fn substream_chunks(
     sub: &SubstreamWriter,
     contexts: usize,
-    limit: usize,
-    chunk_codec: ChunkCodec,
+    params: &StreamParams,
     map: ChunkMap<'_>,
 ) -> Vec<Chunk> {
-    match chunk_codec {
+    let limit = params.chunk_limit.max(1) as usize;
+    let rans_limit = params.rans_chunk_limit.max(1) as usize;
+    match params.codec {
         ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None, map),
         ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l), map),
         ChunkCodec::Rans { lanes } => {
-            let rans = rans_chunks(sub.symbols(), limit, contexts, lanes as usize, map);
+            let rans = rans_chunks(sub.symbols(), rans_limit, contexts, lanes as usize, map);
             let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
             // Level 10 is slow (up to 1,500 match probes per byte); a quick
             // level-1 pass first rules it out where it cannot win.
@@ -466,7 +508,7 @@ fn substream_chunks(
             }
         }
         ChunkCodec::RansAlways { lanes } => {
-            rans_chunks(sub.symbols(), limit, contexts, lanes as usize, map)
+            rans_chunks(sub.symbols(), rans_limit, contexts, lanes as usize, map)
         }
     }
 }
@@ -487,9 +529,8 @@ pub fn coded_len_in(
     deficits: DeficitContexts,
     params: &StreamParams,
 ) -> usize {
-    let limit = params.chunk_limit.max(1) as usize;
     let contexts = context::count(id, deficits);
-    substream_chunks(sub, contexts, limit, params.codec, &one_by_one)
+    substream_chunks(sub, contexts, params, &one_by_one)
         .iter()
         .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)
         .sum()

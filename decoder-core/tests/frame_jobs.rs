@@ -13,6 +13,7 @@ fn params(codec: ChunkCodec) -> StreamParams {
         codec,
         // Small chunks: every substream below has several.
         chunk_limit: 64,
+        rans_chunk_limit: 64,
         ..StreamParams::default()
     }
 }

@@ -38,6 +38,7 @@ fn huge_stream() -> Vec<u8> {
         scale: [1.0; 3],
         codec: ChunkCodec::Stored,
         chunk_limit: 4,
+        rans_chunk_limit: 4,
     };
     let mut base = vec![SubstreamWriter::default(); 3];
     let mut prev = [0i32; 3];

@@ -88,6 +88,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
         scale: [1.0; 3],
         codec: ChunkCodec::Deflate(9),
         chunk_limit: 1 << 16,
+        rans_chunk_limit: 1 << 16,
     };
     write_stream(&params, &[base, level])
 }

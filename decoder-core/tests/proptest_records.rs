@@ -109,6 +109,7 @@ proptest! {
             scale: [1.0; 3],
             codec: ChunkCodec::Stored,
             chunk_limit: 5,
+            rans_chunk_limit: 5,
         };
         let stream = write_stream(&params, &[base_level, level]);
         match decode_all(&stream, true) {

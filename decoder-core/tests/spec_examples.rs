@@ -14,6 +14,7 @@ fn params() -> StreamParams {
         bits: 8,
         codec: ChunkCodec::Stored,
         chunk_limit: 4,
+        rans_chunk_limit: 4,
         ..StreamParams::default()
     }
 }
@@ -590,4 +591,36 @@ fn appendix_a_predictions() {
     assert_eq!(plane.order().map(|a| plane.context(a)), [0, 0, 1]);
     assert_eq!(plane.decode([0, 1, 0]), [0, 1, 0]);
     assert_eq!(plane.decode([4, 0, 2]), [2, 0, 2]);
+}
+
+/// §5.2 (format 3.4): `max_chunk_len` bounds stored and deflate chunks, not
+/// rANS chunks. The hand-made split with 4-value rANS chunks decodes the
+/// same with a header maximum of 1; with 4-byte stored chunks the same
+/// header is `malformed`. (Both maxima are below RANS_SLOT_BYTES, so the
+/// declared workspace of §9 is the same.)
+#[test]
+fn section_5_2_max_chunk_len_bounds_byte_codec_chunks_only() {
+    use splitstream_decoder_core::handmade::tetra_stream;
+    let with_max = |stream: &[u8], max: u32| {
+        let mut s = stream.to_vec();
+        s[24..28].copy_from_slice(&max.to_le_bytes());
+        let crc = crc32(&s[..92]);
+        s[92..96].copy_from_slice(&crc.to_le_bytes());
+        s
+    };
+    let rans = tetra_stream(ChunkCodec::RansAlways { lanes: 2 });
+    assert_eq!(u32::from_le_bytes(rans[24..28].try_into().unwrap()), 4);
+    let expected = decode_all(&rans, true).unwrap().round_hashes;
+    assert_eq!(
+        decode_all(&with_max(&rans, 1), true).unwrap().round_hashes,
+        expected
+    );
+    let stored = tetra_stream(ChunkCodec::Stored);
+    assert!(decode_all(&with_max(&stored, 4), false).is_ok());
+    assert_eq!(
+        decode_all(&with_max(&stored, 3), false)
+            .unwrap_err()
+            .class(),
+        "malformed"
+    );
 }

@@ -6,6 +6,7 @@ mod roundtrip_check;
 
 use roundtrip_check::assert_roundtrip;
 
+use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingPolicy};
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::quantize::{Lattice, Quantization, Units};
@@ -269,4 +270,49 @@ fn the_automatic_position_mode_follows_the_lattice() {
         .unwrap()
         .stream;
     assert_eq!(encoded.stream, bytes);
+}
+
+/// Format 3.4: `max_chunk_len` bounds stored and deflate chunks only
+/// (SPEC §5.2). A stream whose rANS chunks code more values than a
+/// decoder's minimum buffer (RANS_SLOT_BYTES) declares its largest byte-codec
+/// chunk and minor version 4; one whose rANS chunks fit within that buffer
+/// declares the largest chunk of any codec and stays readable by 3.3.
+#[test]
+fn rans_chunks_beyond_max_chunk_len_set_minor_version_4() {
+    use splitstream_decoder_core::Header;
+    let large = common::bumpy_grid(80, 60, 5);
+    for (codec, chunk_limit) in [
+        (ChunkCodec::RansAlways { lanes: 4 }, 512),
+        (ChunkCodec::Rans { lanes: 4 }, 512),
+        (ChunkCodec::Rans { lanes: 2 }, 16 * 1024),
+    ] {
+        let options = EncodeOptions {
+            codec,
+            chunk_limit,
+            position_mode: PositionMode::Constrained,
+            ..EncodeOptions::default()
+        };
+        assert_roundtrip(&large, &options);
+        let stream = encode(&large, &options, |_| {}).expect("encode").stream;
+        let header = Header::parse(&stream).unwrap();
+        assert_eq!(header.version_minor, 4, "{codec:?} {chunk_limit}");
+        assert!(
+            header.max_chunk_len <= chunk_limit,
+            "{codec:?} {chunk_limit}"
+        );
+        if matches!(codec, ChunkCodec::RansAlways { .. }) {
+            // No stored or deflate chunk at all.
+            assert_eq!(header.max_chunk_len, 1);
+        }
+    }
+    // Short rANS chunks: the largest chunk of any codec, 3.3 at most.
+    let small = common::icosphere(2);
+    let options = EncodeOptions {
+        codec: ChunkCodec::RansAlways { lanes: 4 },
+        ..EncodeOptions::default()
+    };
+    let stream = encode(&small, &options, |_| {}).expect("encode").stream;
+    let header = Header::parse(&stream).unwrap();
+    assert!(header.version_minor <= 3);
+    assert!(header.max_chunk_len > 1 && header.max_chunk_len <= 1856);
 }

@@ -39,6 +39,13 @@ fn options(
         admit_quantile: admit,
         lock_boundary: lock,
         chunk_limit: 61,
+        // rANS chunks as short as the byte-codec ones, or longer than
+        // max_chunk_len (format 3.4), by the level count's parity.
+        rans_chunk_limit: if levels.is_multiple_of(2) {
+            61
+        } else {
+            1 << 14
+        },
         ..EncodeOptions::default()
     }
 }

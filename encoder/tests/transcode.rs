@@ -76,7 +76,9 @@ fn another_codec_gives_that_codecs_encoding_byte_for_byte() {
 }
 
 /// Chunk buffers take `7 × max(M, RANS_SLOT_BYTES)` of the decoder's
-/// memory (SPEC §9): streams cut in smaller chunks need less of it.
+/// memory (SPEC §9), M bounding stored and deflate chunks only (format 3.4):
+/// a stream cut in small byte-codec chunks needs less memory, and keeping
+/// its rANS chunks long keeps its size.
 #[test]
 fn smaller_chunks_lower_the_workspace_and_keep_every_round() {
     for (name, mesh) in [
@@ -86,20 +88,18 @@ fn smaller_chunks_lower_the_workspace_and_keep_every_round() {
         let stream = encode_with(
             &mesh,
             PositionMode::Constrained,
-            ChunkCodec::Rans { lanes: 4 },
+            ChunkCodec::Deflate(9),
             16 * 1024,
         );
-        let small =
-            transcode(&stream, &to(ChunkCodec::Rans { lanes: 4 }, 1024)).expect("transcode");
-        let (before, after) = (
-            Header::parse(&stream).unwrap(),
-            Header::parse(&small.stream).unwrap(),
-        );
+        let before = Header::parse(&stream).unwrap();
         assert!(
             before.max_chunk_len > 4096,
             "{name}: {}",
             before.max_chunk_len
         );
+        // Deflate in 1 KiB chunks: less memory, every round kept.
+        let small = transcode(&stream, &to(ChunkCodec::Deflate(9), 1024)).expect("transcode");
+        let after = Header::parse(&small.stream).unwrap();
         assert!(after.max_chunk_len <= 1024, "{name}");
         assert!(
             after.workspace_bytes + 7 * 2048 <= before.workspace_bytes,
@@ -110,6 +110,26 @@ fn smaller_chunks_lower_the_workspace_and_keep_every_round() {
         let hashes = round_hashes(&stream);
         assert_eq!(round_hashes(&small.stream), hashes, "{name}");
         assert_eq!(Some(&small.final_hash), hashes.last(), "{name}");
+        // rANS: chunks of 1 KiB and 1,024 values (as format 3.3 had to cut
+        // them) against 1 KiB and long rANS chunks (3.4): the same memory,
+        // fewer bytes.
+        let short = TranscodeOptions {
+            rans_chunk_limit: 1024,
+            ..to(ChunkCodec::Rans { lanes: 4 }, 1024)
+        };
+        let short = transcode(&stream, &short).expect("transcode");
+        let long = transcode(&stream, &to(ChunkCodec::Rans { lanes: 4 }, 1024)).expect("transcode");
+        let (short_header, long_header) = (
+            Header::parse(&short.stream).unwrap(),
+            Header::parse(&long.stream).unwrap(),
+        );
+        assert_eq!(
+            short_header.workspace_bytes, long_header.workspace_bytes,
+            "{name}"
+        );
+        assert!(long.stream.len() < short.stream.len(), "{name}");
+        assert_eq!(long_header.version_minor, 4, "{name}");
+        assert_eq!(round_hashes(&long.stream), hashes, "{name}");
     }
 }
 
@@ -210,6 +230,8 @@ proptest! {
         codec_b in codec(),
         chunk_a in 1u32..300,
         chunk_b in 1u32..300,
+        rans_a in prop_oneof![1u32..300, Just(1 << 14)],
+        rans_b in prop_oneof![1u32..300, Just(1 << 14)],
     ) {
         let mesh = common::bumpy_grid(cols, rows, seed);
         let options = EncodeOptions {
@@ -217,12 +239,15 @@ proptest! {
             levels,
             codec: codec_a,
             chunk_limit: chunk_a,
+            rans_chunk_limit: rans_a,
             ..EncodeOptions::default()
         };
         let stream = encode(&mesh, &options, |_| {}).expect("encode").stream;
-        let other = transcode(&stream, &to(codec_b, chunk_b)).expect("transcode");
+        let b = TranscodeOptions { rans_chunk_limit: rans_b, ..to(codec_b, chunk_b) };
+        let other = transcode(&stream, &b).expect("transcode");
         prop_assert_eq!(round_hashes(&other.stream), round_hashes(&stream));
-        let back = transcode(&other.stream, &to(codec_a, chunk_a)).expect("transcode back");
+        let a = TranscodeOptions { rans_chunk_limit: rans_a, ..to(codec_a, chunk_a) };
+        let back = transcode(&other.stream, &a).expect("transcode back");
         prop_assert!(back.stream == stream);
     }
 }
@@ -266,7 +291,20 @@ fn real_streams_transcode_and_back() {
 /// neighbours), is refused with that reason.
 #[test]
 fn conformance_vectors_transcode_or_are_refused() {
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../conformance/vectors/3.3");
+    // The current set: the highest format version.
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../conformance/vectors");
+    let dir = std::fs::read_dir(&root)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .max_by_key(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().to_string();
+            let (major, minor) = name.split_once('.').unwrap_or((&name, "0"));
+            (
+                major.parse::<u32>().unwrap_or(0),
+                minor.parse::<u32>().unwrap_or(0),
+            )
+        })
+        .unwrap();
     let mut seen = 0;
     for (kind, valid) in [("valid", true), ("invalid", false)] {
         let mut paths: Vec<_> = std::fs::read_dir(dir.join(kind))

@@ -401,6 +401,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
                 position_mode: PositionMode::Constrained,
                 codec: ChunkCodec::Stored,
                 chunk_limit: 7,
+                rans_chunk_limit: 7,
                 ..opts()
             },
         ),
@@ -413,6 +414,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             &sphere2,
             EncodeOptions {
                 chunk_limit: 24,
+                rans_chunk_limit: 24,
                 ..deflate_opts()
             },
         ),
@@ -438,6 +440,7 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             EncodeOptions {
                 codec: ChunkCodec::Stored,
                 chunk_limit: 64,
+                rans_chunk_limit: 64,
                 ..opts()
             },
         )),
@@ -533,9 +536,32 @@ fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
             EncodeOptions {
                 codec: ChunkCodec::RansAlways { lanes: 3 },
                 chunk_limit: 5,
+                rans_chunk_limit: 5,
                 ..opts()
             },
         ),
+    );
+    // Format 3.4: `max_chunk_len` bounds byte-codec chunks only. With every
+    // substream rANS-coded there is no byte-codec chunk, the header says 1,
+    // and every rANS chunk codes more values than that (SPEC §5.2).
+    s.valid(
+        "icosphere4-rans-chunks-above-max-chunk-len",
+        "Icosphere (2,562 vertices), every substream rANS-coded in chunks of up to 16,384 values, no byte-codec chunk: max_chunk_len is 1, and the finest level's edge substream codes more values than RANS_SLOT_BYTES (format 3.4; a rANS chunk needs no buffer of its length).",
+        &["encoded", "rans", "rans-chunk-above-max"],
+        {
+            let sphere4 = meshes::checked(meshes::icosphere(4), "icosphere(4)");
+            let stream = encoded(
+                &sphere4,
+                EncodeOptions {
+                    codec: ChunkCodec::RansAlways { lanes: 4 },
+                    chunk_limit: 1,
+                    ..opts()
+                },
+            );
+            let header = Header::parse(&stream).expect("valid");
+            assert_eq!((header.max_chunk_len, header.version_minor), (1, 4));
+            stream
+        },
     );
     s.valid(
         "handmade-tetra-split-rans",
@@ -1049,6 +1075,31 @@ fn invalid_vectors(s: &mut Specs) {
         &["reserved", "plane-policy"],
         with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 3, 1),
     );
+    // A stored chunk longer than the header's max_chunk_len: the buffer a
+    // decoder sized from the header could not hold it (SPEC §5.2). Both
+    // lengths are below RANS_SLOT_BYTES, so the declared workspace stays
+    // right (SPEC §9) and the level header is what fails.
+    s.invalid(
+        "byte-chunk-above-max-chunk-len",
+        "malformed",
+        "A stream of 64-byte stored chunks whose header says max_chunk_len 63 (header CRC recomputed; the declared workspace is unchanged, both lengths being below RANS_SLOT_BYTES): level 0's first 64-byte chunk is above the maximum.",
+        &["codec", "rans-chunk-above-max"],
+        {
+            let mut stream = encoded(
+                &sphere,
+                EncodeOptions {
+                    codec: ChunkCodec::Stored,
+                    chunk_limit: 64,
+                    rans_chunk_limit: 64,
+                    ..opts()
+                },
+            );
+            assert_eq!(Header::parse(&stream).expect("valid").max_chunk_len, 64);
+            stream[24..28].copy_from_slice(&63u32.to_le_bytes());
+            fix_header_crc(&mut stream);
+            stream
+        },
+    );
     s.invalid(
         "unknown-codec",
         "malformed",
@@ -1529,6 +1580,7 @@ fn rans_vectors(s: &mut Specs) {
                 EncodeOptions {
                     codec: ChunkCodec::RansAlways { lanes: 2 },
                     chunk_limit: 5,
+                    rans_chunk_limit: 5,
                     ..opts()
                 },
             );

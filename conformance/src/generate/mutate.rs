@@ -101,6 +101,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
                 ChunkCodec::Stored
             },
             chunk_limit: header.max_chunk_len,
+            rans_chunk_limit: header.max_chunk_len,
         },
         levels,
     }

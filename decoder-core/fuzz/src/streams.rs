@@ -439,6 +439,14 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         scale: [1.0; 3],
         codec,
         chunk_limit,
+        // rANS chunks as short as the byte-codec ones, or as long as the
+        // reference encoder's (format 3.4), by the bit count's parity (no
+        // choice of its own, so that existing corpora keep their meaning).
+        rans_chunk_limit: if bits.is_multiple_of(2) {
+            chunk_limit
+        } else {
+            1 << 14
+        },
     };
     let refinement_levels = 4 - choices.below(4);
     // With 31 bits, the base mesh is scaled towards the top of the grid.
@@ -860,7 +868,10 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                     }
                 }
                 1 => params.bits = 1 + ops.byte() % 31,
-                2 => params.chunk_limit = 1 + ops.byte() as u32,
+                2 => {
+                    params.chunk_limit = 1 + ops.byte() as u32;
+                    params.rans_chunk_limit = 1 + ops.byte() as u32 * 64;
+                }
                 _ => {
                     params.codec = match ops.byte() % 3 {
                         0 => ChunkCodec::Stored,

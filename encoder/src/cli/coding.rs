@@ -14,10 +14,14 @@ pub struct CodingArgs {
     /// decode in parallel.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(1..=32))]
     pub lanes: u8,
-    /// Largest raw chunk in bytes (bounds decoder buffers: 7 chunks, or
-    /// 1,856 bytes each at least, SPEC §9).
+    /// Largest stored or deflate chunk in bytes: bounds the decoder's
+    /// buffers (7 chunks, or 1,856 bytes each at least, SPEC §9).
     #[arg(long, default_value_t = 16384)]
     pub chunk_size: u32,
+    /// Largest rANS chunk in values (each chunk has its own tables; no
+    /// effect on the decoder's memory, format 3.4).
+    #[arg(long, default_value_t = 16384)]
+    pub rans_chunk: u32,
     /// Which axis of each position residual the split's plane predicts, or
     /// `height`: z from the surface of the split vertex's fan (terrain,
     /// format 3.1) (SPEC §7.4); `auto` picks the cheapest per level.
@@ -40,6 +44,9 @@ impl CodingArgs {
     pub fn check(&self) -> CliResult {
         if self.chunk_size == 0 {
             return Err("--chunk-size must be at least 1".into());
+        }
+        if self.rans_chunk == 0 {
+            return Err("--rans-chunk must be at least 1".into());
         }
         Ok(())
     }

@@ -110,6 +110,7 @@ pub fn run(a: Args) -> CliResult {
         max_error: a.max_error,
         codec: a.coding.chunk_codec(),
         chunk_limit: a.coding.chunk_size,
+        rans_chunk_limit: a.coding.rans_chunk,
         lock_boundary: a.lock_boundary,
         admit_quantile: a.admit,
         units: if a.geographic {

@@ -3,6 +3,7 @@
 use std::path::Path;
 
 use splitstream_decoder_core::limits::VERSION_MAJOR;
+use splitstream_decoder_core::limits::codec;
 use splitstream_decoder_core::limits::substream::{self, NAMES};
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{Header, LevelHeader, LevelTable, PositionMode, layout_for};
@@ -22,6 +23,8 @@ pub struct FieldSizes {
     /// Per id, a bit per codec id seen (1 stored, 2 deflate, 4 rANS).
     pub codecs: [u8; FIELDS],
     pub framing: u64,
+    /// Values of the longest rANS chunk (0 if none).
+    pub largest_rans_chunk: u32,
 }
 
 impl FieldSizes {
@@ -69,6 +72,9 @@ pub fn field_sizes(
             sizes.stored[chunk.substream as usize] += chunk.stored_len as u64;
             sizes.raw[chunk.substream as usize] += chunk.raw_len as u64;
             sizes.codecs[chunk.substream as usize] |= 1 << chunk.codec.min(7);
+            if chunk.codec == codec::RANS {
+                sizes.largest_rans_chunk = sizes.largest_rans_chunk.max(chunk.raw_len);
+            }
         }
     }
     Ok(sizes)
@@ -89,12 +95,18 @@ struct Recoded {
     bytes: u64,
 }
 
-/// The stream re-coded with rANS and with deflate, at its own chunk size
-/// and lane count (4 lanes for a stream without rANS chunks), each level's
-/// plane, wing and deficit coding chosen again for that codec.
+/// The stream re-coded with rANS and with deflate, at its own chunk sizes
+/// and lane count (4 lanes and rANS chunks of 16,384 values for a stream
+/// without rANS chunks), each level's plane, wing and deficit coding chosen
+/// again for that codec.
 fn recode(stream: &[u8], header: &Header, sizes: &FieldSizes) -> Result<Vec<Recoded>, String> {
-    let has_rans = sizes.codecs.iter().any(|c| c & 4 != 0);
+    let has_rans = sizes.largest_rans_chunk > 0;
     let lanes = if has_rans { header.lane_count } else { 4 };
+    let rans_chunk_limit = if has_rans {
+        sizes.largest_rans_chunk
+    } else {
+        TranscodeOptions::default().rans_chunk_limit
+    };
     let codecs = [
         ("rans", ChunkCodec::Rans { lanes }),
         ("deflate", ChunkCodec::Deflate(9)),
@@ -105,6 +117,7 @@ fn recode(stream: &[u8], header: &Header, sizes: &FieldSizes) -> Result<Vec<Reco
             let options = TranscodeOptions {
                 codec: chunk_codec,
                 chunk_limit: header.max_chunk_len,
+                rans_chunk_limit,
                 ..TranscodeOptions::default()
             };
             let done = transcode(stream, &options).map_err(|e| e.to_string())?;

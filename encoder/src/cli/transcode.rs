@@ -26,6 +26,7 @@ pub fn run(a: Args) -> CliResult {
     let options = TranscodeOptions {
         codec: a.coding.chunk_codec(),
         chunk_limit: a.coding.chunk_size,
+        rans_chunk_limit: a.coding.rans_chunk,
         plane: a.coding.plane(),
         wings: a.coding.wings(),
         deficits: a.coding.deficits(),

@@ -36,8 +36,12 @@ pub struct EncodeOptions {
     /// Maximum quadric error of any collapse (stops simplification early).
     pub max_error: Option<f64>,
     pub codec: ChunkCodec,
-    /// Largest raw chunk (bytes); bounds the decoder's buffers (SPEC §9).
+    /// Largest stored or deflate chunk (raw bytes): the header's
+    /// `max_chunk_len`, which bounds the decoder's buffers (SPEC §9).
     pub chunk_limit: u32,
+    /// Largest rANS chunk (values); no effect on the decoder's memory
+    /// (SPEC §5.2, format 3.4).
+    pub rans_chunk_limit: u32,
     pub lock_boundary: bool,
     pub admit_quantile: f64,
     /// Units of the input coordinates, for the error metric.
@@ -73,6 +77,7 @@ impl Default for EncodeOptions {
             max_error: None,
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
+            rans_chunk_limit: 16 * 1024,
             lock_boundary: false,
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,
@@ -230,6 +235,7 @@ pub fn encode_quantized(
         scale: mesh.scale,
         codec: options.codec,
         chunk_limit: options.chunk_limit,
+        rans_chunk_limit: options.rans_chunk_limit,
     };
     let replayed = replay(
         mesh,

@@ -5,7 +5,7 @@ use splitstream_decoder_core::corner_refs;
 use splitstream_decoder_core::limits::{LEAF, NONE, substream};
 use splitstream_decoder_core::symbols::split_valence_symbol;
 use splitstream_decoder_core::writer::{
-    Chunk, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level_with,
+    Chunk, FramedLevel, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level_with,
 };
 use splitstream_decoder_core::{
     CornerRefs, DeficitContexts, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource,
@@ -45,8 +45,8 @@ pub struct Replayed {
     pub seed: SeedPayload,
     /// Level 0's rounds, then the refinement levels.
     pub levels: Vec<LevelPayload>,
-    /// Each level framed (`writer::frame_level`: bytes, largest chunk).
-    pub framed: Vec<(Vec<u8>, u32)>,
+    /// Each level framed (`writer::frame_level`).
+    pub framed: Vec<FramedLevel>,
     /// Input vertex id of each decoded vertex.
     pub permutation: Vec<u32>,
     /// State hash after the last round.
@@ -349,9 +349,9 @@ fn height_residual(
     fan.residual(PlanePolicy::Height, target, prediction, x)[2]
 }
 
-/// A level's payload and its framed bytes with its largest chunk
+/// A level's payload and its framed bytes with its largest chunks
 /// (`writer::frame_level`).
-type FramedLevel = (LevelPayload, (Vec<u8>, u32));
+type LevelAndFrame = (LevelPayload, FramedLevel);
 
 /// Replays `s` level by level as planned, returning the level payloads,
 /// each with the plane policy `plane`, the wing policy `wing_policy` and
@@ -426,7 +426,7 @@ pub fn replay(
     // level run on another while the next level replays (same bytes: the
     // replay itself is sequential).
     let seed_ref = &seed;
-    let done = std::thread::scope(|scope| -> Result<Vec<FramedLevel>, ReplayError> {
+    let done = std::thread::scope(|scope| -> Result<Vec<LevelAndFrame>, ReplayError> {
         let mut choosing = Vec::with_capacity(plan.rounds.len());
         for (l, steps) in plan.rounds.iter().enumerate() {
             let mut subs = vec![SubstreamWriter::default(); 7];

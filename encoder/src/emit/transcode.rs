@@ -29,9 +29,12 @@ use crate::simplify::{Collapse, MAX_VALENCE, Simplification};
 #[derive(Clone, Copy, Debug)]
 pub struct TranscodeOptions {
     pub codec: ChunkCodec,
-    /// Largest raw chunk (bytes or values); bounds the decoder's buffers
-    /// (SPEC §9).
+    /// Largest stored or deflate chunk (raw bytes): the header's
+    /// `max_chunk_len`, which bounds the decoder's buffers (SPEC §9).
     pub chunk_limit: u32,
+    /// Largest rANS chunk (values); no effect on the decoder's memory
+    /// (SPEC §5.2, format 3.4).
+    pub rans_chunk_limit: u32,
     /// The plane policy of every level; `None`: chosen per level by size.
     pub plane: Option<PlanePolicy>,
     /// The wing policy of every level; `None`: chosen per level by size.
@@ -41,12 +44,13 @@ pub struct TranscodeOptions {
 }
 
 impl Default for TranscodeOptions {
-    /// The reference encoder's defaults: rANS in 4 lanes, 16 KiB chunks,
-    /// every policy chosen by size.
+    /// The reference encoder's defaults: rANS in 4 lanes, chunks of 16 KiB
+    /// and of 16,384 values, every policy chosen by size.
     fn default() -> Self {
         TranscodeOptions {
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
+            rans_chunk_limit: 16 * 1024,
             plane: None,
             wings: None,
             deficits: None,
@@ -102,9 +106,9 @@ impl From<splitstream_decoder_core::Error> for TranscodeError {
 
 /// Writes `stream` again under `options` (see the module documentation).
 pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded, TranscodeError> {
-    if options.chunk_limit == 0 {
+    if options.chunk_limit == 0 || options.rans_chunk_limit == 0 {
         return Err(TranscodeError::BadOption(
-            "the chunk size must be at least 1".into(),
+            "chunk sizes must be at least 1".into(),
         ));
     }
     if let ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } = options.codec
@@ -122,6 +126,7 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
         scale: refinement.mesh.scale,
         codec: options.codec,
         chunk_limit: options.chunk_limit,
+        rans_chunk_limit: options.rans_chunk_limit,
     };
     let simplification = refinement.simplification()?;
     let replayed = replay(
