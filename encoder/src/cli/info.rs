@@ -268,7 +268,7 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
         header.bits, header.origin, header.scale
     );
     println!(
-        "  decoder memory: {} bytes ({:.1} bytes/vertex), chunks up to {} bytes",
+        "  decoder memory: {} bytes ({:.1} bytes/vertex), stored and deflate chunks up to {} bytes",
         header.workspace_bytes,
         header.workspace_bytes as f64 / n,
         header.max_chunk_len

@@ -50,7 +50,7 @@ pub fn run(a: Args) -> CliResult {
         done.final_hash,
     );
     println!(
-        "decoder memory: {} -> {} bytes (chunks up to {} -> {} bytes)",
+        "decoder memory: {} -> {} bytes (stored and deflate chunks up to {} -> {} bytes)",
         before.workspace_bytes, after.workspace_bytes, before.max_chunk_len, after.max_chunk_len
     );
     println!("time: {seconds:.2} s");
