@@ -110,6 +110,15 @@ fn bad_streams_and_arguments_get_one_line() {
         "0",
     ]));
     assert!(err.contains("--chunk-size"), "{err}");
+    let err = one_line_error(&splitstream(&[
+        "transcode",
+        s,
+        "-o",
+        o,
+        "--rans-chunk",
+        "0",
+    ]));
+    assert!(err.contains("--rans-chunk"), "{err}");
     let bytes = std::fs::read(&input).unwrap();
     let cut = input.with_file_name("cut.sps");
     std::fs::write(&cut, &bytes[..bytes.len() - 3]).unwrap();

@@ -206,9 +206,10 @@ pub enum Command {
     /// .asc .npy .npz).
     Encode(encode::Args),
     /// Write a stream again from its own refinement, without the input
-    /// mesh: another codec, lane count or chunk size (smaller chunks, less
-    /// decoder memory), each level's coding chosen again (older streams get
-    /// the newest); the same state after every round.
+    /// mesh: another codec, lane count or chunk size (smaller stored and
+    /// deflate chunks, less decoder memory), each level's coding chosen
+    /// again (older streams get the newest); the same state after every
+    /// round.
     Transcode(transcode::Args),
     /// Decode a stream to .ply, .obj or .glb, in decoded vertex order.
     Decode {
