@@ -37,3 +37,14 @@ pub fn one_line_error(out: &Output) -> String {
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     err
 }
+
+/// A successful run's stdout (its stderr shown if it failed).
+pub fn succeeded(out: &Output) -> String {
+    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+    assert!(
+        out.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stdout
+}

@@ -5,22 +5,11 @@
 mod cli;
 
 use std::path::PathBuf;
-use std::process::Output;
 
-use cli::{one_line_error, splitstream};
+use cli::{one_line_error, splitstream, succeeded};
 
 fn temp(name: &str, contents: &str) -> PathBuf {
     cli::temp("encode-cli", name, contents)
-}
-
-fn succeeded(out: &Output) -> String {
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
 }
 
 /// A 12 x 10 ESRI ASCII raster, 30 m cells, heights in whole metres.

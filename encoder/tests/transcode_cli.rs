@@ -3,22 +3,11 @@
 mod cli;
 
 use std::path::PathBuf;
-use std::process::Output;
 
-use cli::{one_line_error, splitstream};
+use cli::{one_line_error, splitstream, succeeded};
 
 fn temp(name: &str, contents: &str) -> PathBuf {
     cli::temp("transcode-cli", name, contents)
-}
-
-fn succeeded(out: &Output) -> String {
-    let stdout = String::from_utf8_lossy(&out.stdout).to_string();
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    stdout
 }
 
 /// A stream of a 16 x 14 ESRI ASCII raster (30 m cells, whole metres),
