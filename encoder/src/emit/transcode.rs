@@ -118,7 +118,7 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
             "{lanes} lanes is outside 1..=32"
         )));
     }
-    let refinement = Refinement::decode(stream)?;
+    let mut refinement = Refinement::decode(stream)?;
     let params = StreamParams {
         position_mode: refinement.position_mode,
         bits: refinement.mesh.bits,
@@ -293,8 +293,9 @@ impl Refinement {
     }
 
     /// The simplification these rounds reverse: the seed mesh is what it
-    /// left, its steps are the rounds in reverse order.
-    fn simplification(&self) -> Result<Simplification, TranscodeError> {
+    /// left, its steps are the rounds in reverse order. Takes the rounds (they become the steps: no copy of the collapse
+    /// records, 72 bytes each).
+    fn simplification(&mut self) -> Result<Simplification, TranscodeError> {
         let n = self.mesh.positions.len();
         let v0 = self.seed_positions.len();
         let table = CornerTable::new(n, &self.seed_triangles);
@@ -316,14 +317,17 @@ impl Refinement {
         }
         let mut positions = self.mesh.positions.clone();
         positions[..v0].copy_from_slice(&self.seed_positions);
+        let mut steps = std::mem::take(&mut self.rounds);
+        steps.reverse();
+        let step_errors = vec![0.0; steps.len()];
         Ok(Simplification {
-            steps: self.rounds.iter().rev().cloned().collect(),
+            steps,
             table,
             positions,
             split_valence,
             alive: (0..n).map(|v| v < v0).collect(),
             alive_count: v0,
-            step_errors: vec![0.0; self.rounds.len()],
+            step_errors,
         })
     }
 }
