@@ -24,7 +24,7 @@ use super::wings::WingCoding;
 use crate::corner_table::Fan;
 use crate::prefetch::prefetch;
 use crate::quantize::QuantizedMesh;
-use crate::simplify::{Collapse, Simplification};
+use crate::simplify::{Collapse, NO_SPLIT, Simplification};
 
 /// The replay found the simplification and the decoder disagreeing: an
 /// encoder bug, never a property of the input.
@@ -206,7 +206,7 @@ impl RecordSource for StepSource<'_> {
         let k = ring.len();
         let len_p = d;
         let deficit = |split_valence: u8, valence: usize| -> Option<u8> {
-            if split_valence == LEAF {
+            if split_valence == NO_SPLIT {
                 Some(LEAF)
             } else {
                 (split_valence as usize)
@@ -393,7 +393,7 @@ pub fn replay(
         .iter()
         .map(|&e| {
             let sv = s.split_valence[e as usize];
-            if sv == LEAF {
+            if sv == NO_SPLIT {
                 return LEAF;
             }
             s.table.fan(e, &mut fan);

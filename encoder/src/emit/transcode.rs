@@ -23,7 +23,7 @@ use super::levels::LevelPlan;
 use super::replay::{ReplayError, replay};
 use crate::corner_table::{CornerTable, Fan};
 use crate::quantize::QuantizedMesh;
-use crate::simplify::{Collapse, MAX_VALENCE, Simplification};
+use crate::simplify::{Collapse, NO_SPLIT, Simplification};
 
 /// How [`transcode`] codes the stream it writes.
 #[derive(Clone, Copy, Debug)]
@@ -73,10 +73,6 @@ pub struct Transcoded {
 pub enum TranscodeError {
     /// The input stream does not decode (SPEC §10).
     Decode(splitstream_decoder_core::Error),
-    /// A split valence the encoder cannot represent (255: its leaf mark).
-    SplitValence {
-        vertex: u32,
-    },
     /// The replay refused the refinement, or reached another state: a bug.
     Replay(ReplayError),
     BadOption(String),
@@ -86,10 +82,6 @@ impl std::fmt::Display for TranscodeError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             TranscodeError::Decode(e) => write!(f, "the stream does not decode: {e}"),
-            TranscodeError::SplitValence { vertex } => write!(
-                f,
-                "vertex {vertex} has split valence 255, which the encoder cannot write (at most {MAX_VALENCE})"
-            ),
             TranscodeError::Replay(e) => write!(f, "{e}"),
             TranscodeError::BadOption(s) => write!(f, "{s}"),
         }
@@ -128,7 +120,7 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
         chunk_limit: options.chunk_limit,
         rans_chunk_limit: options.rans_chunk_limit,
     };
-    let simplification = refinement.simplification()?;
+    let simplification = refinement.simplification();
     let replayed = replay(
         &refinement.mesh,
         &simplification,
@@ -170,14 +162,23 @@ struct Refinement {
     final_hash: u64,
 }
 
+/// The split valence of a vertex with `deficit` at `valence` (SPEC §7.4:
+/// valence + deficit), or [`NO_SPLIT`] for a leaf. The decoder holds every
+/// vertex to valence + deficit ≤ 255 (SPEC §6.2, `valence-overflow`), so
+/// every split valence of a decoded stream fits the encoder's `u8`.
+fn split_valence(deficit: u8, valence: usize) -> u8 {
+    if deficit == LEAF {
+        return NO_SPLIT;
+    }
+    u8::try_from(deficit as usize + valence).unwrap_or(u8::MAX)
+}
+
 /// Keeps each split record of a round as the collapse it reverses: P is
 /// the split vertex (it keeps its id), C the vertex the split adds (the
 /// next id), the wings the ring entries at `o` and `o + d` (SPEC §7.4).
 #[derive(Default)]
 struct Recorder {
     round: Vec<Collapse>,
-    /// The first vertex whose split valence the encoder cannot represent.
-    unrepresentable: Option<u32>,
 }
 
 impl SplitObserver for Recorder {
@@ -190,18 +191,8 @@ impl SplitObserver for Recorder {
         );
         let c = state.vertex_count();
         // Split valence = valence right after the split + deficit (§7.4).
-        let mut split_valence = |deficit: u8, valence: usize, vertex: u32| {
-            if deficit == LEAF {
-                return LEAF;
-            }
-            let sv = deficit as usize + valence;
-            if sv > MAX_VALENCE {
-                self.unrepresentable.get_or_insert(vertex);
-            }
-            sv.min(MAX_VALENCE) as u8
-        };
-        let split_valence_p = split_valence(rec.deficit_p, d + 2, r);
-        let split_valence_c = split_valence(rec.deficit_c, k - d + 2, c);
+        let split_valence_p = split_valence(rec.deficit_p, d + 2);
+        let split_valence_c = split_valence(rec.deficit_c, k - d + 2);
         self.round.push(Collapse {
             p: r,
             c,
@@ -255,9 +246,6 @@ impl Refinement {
             }
             plan_rounds.push(level_rounds);
         }
-        if let Some(vertex) = recorder.unrepresentable {
-            return Err(TranscodeError::SplitValence { vertex });
-        }
         // `for_stream` sizes the workspace for every level, so all decode.
         let (seed_positions, seed_triangles, seed_deficits) = seed.ok_or(
             TranscodeError::Decode(splitstream_decoder_core::Error::Truncated),
@@ -295,39 +283,32 @@ impl Refinement {
     /// The simplification these rounds reverse: the seed mesh is what it
     /// left, its steps are the rounds in reverse order. Takes the rounds (they become the steps: no copy of the collapse
     /// records, 72 bytes each).
-    fn simplification(&mut self) -> Result<Simplification, TranscodeError> {
+    fn simplification(&mut self) -> Simplification {
         let n = self.mesh.positions.len();
         let v0 = self.seed_positions.len();
         let table = CornerTable::new(n, &self.seed_triangles);
         // The seed's split valences: deficit + valence, the ghost counted
         // on a boundary (SPEC §6.2), as the replay computes them back.
-        let mut split_valence = vec![LEAF; n];
+        let mut split_valences = vec![NO_SPLIT; n];
         let mut fan = Fan::default();
         for (v, &deficit) in self.seed_deficits.iter().enumerate() {
-            if deficit == LEAF {
-                continue;
-            }
             table.fan(v as u32, &mut fan);
             let valence = fan.corners.len() + if fan.boundary { 2 } else { 0 };
-            let sv = deficit as usize + valence;
-            if sv > MAX_VALENCE {
-                return Err(TranscodeError::SplitValence { vertex: v as u32 });
-            }
-            split_valence[v] = sv as u8;
+            split_valences[v] = split_valence(deficit, valence);
         }
         let mut positions = self.mesh.positions.clone();
         positions[..v0].copy_from_slice(&self.seed_positions);
         let mut steps = std::mem::take(&mut self.rounds);
         steps.reverse();
         let step_errors = vec![0.0; steps.len()];
-        Ok(Simplification {
+        Simplification {
             steps,
             table,
             positions,
-            split_valence,
+            split_valence: split_valences,
             alive: (0..n).map(|v| v < v0).collect(),
             alive_count: v0,
             step_errors,
-        })
+        }
     }
 }

@@ -34,7 +34,7 @@ mod select;
 mod state;
 
 pub use backend::{Backend, GpuError};
-pub use state::{Collapse, MAX_VALENCE, Simplification, SimplifyOptions, simplify};
+pub use state::{Collapse, MAX_VALENCE, NO_SPLIT, Simplification, SimplifyOptions, simplify};
 
 /// [`simplify`] on `backend`. The CPU backend never fails; a GPU backend
 /// fails when it is not compiled in, has no adapter, or its kernels fail.

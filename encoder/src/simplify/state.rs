@@ -23,10 +23,15 @@ use crate::quantize::QuantizedMesh;
 /// time for the same collapses (encoder/BENCHMARKS.md, Speed).
 const VALIDATE_ABOVE: f64 = 0.05;
 
-/// Split valence stored for vertices that were never produced by a collapse.
-pub const LEAF: u8 = 0xFF;
-/// Largest valence (ghost included) a collapse may produce; below [`LEAF`].
-pub const MAX_VALENCE: usize = 254;
+/// Split valence stored for vertices that were never produced by a
+/// collapse (they never split). A real split valence is at least 3, so 0
+/// is free, and every split valence the format allows, 3 to 255, has its
+/// own value (SPEC §6.2). (The stream marks a leaf by its deficit instead:
+/// decoder-core's `limits::LEAF`.)
+pub const NO_SPLIT: u8 = 0;
+/// Largest valence (ghost included) a collapse may produce: the format's
+/// largest split valence (SPEC §6.2, `MAX_SPLIT_VALENCE`).
+pub const MAX_VALENCE: usize = splitstream_decoder_core::limits::MAX_SPLIT_VALENCE;
 
 /// Options of the parallel simplifier.
 #[derive(Clone, Debug)]
@@ -75,7 +80,7 @@ pub struct Collapse {
     pub position_p: [u32; 3],
     pub position_c: [u32; 3],
     pub position_r: [u32; 3],
-    /// Split valences P and C had before the collapse ([`LEAF`] if original).
+    /// Split valences P and C had before the collapse ([`NO_SPLIT`] if original).
     pub split_valence_p: u8,
     pub split_valence_c: u8,
     /// Quadric error of the collapse (metric units).
@@ -90,7 +95,7 @@ pub struct Simplification {
     pub steps: Vec<Vec<Collapse>>,
     pub table: CornerTable,
     pub positions: Vec<[u32; 3]>,
-    /// Split valence of each surviving vertex ([`LEAF`] for originals).
+    /// Split valence of each surviving vertex ([`NO_SPLIT`] for originals).
     pub split_valence: Vec<u8>,
     pub alive: Vec<bool>,
     pub alive_count: usize,
@@ -176,7 +181,7 @@ impl State {
             boundary,
             valence,
             alive,
-            split_valence: vec![LEAF; n],
+            split_valence: vec![NO_SPLIT; n],
             edges: Vec::new(),
             bits: mesh.bits,
             metric,
@@ -438,7 +443,7 @@ pub fn simplify(
     // away (see `compact`).
     let mut input = InputArrays {
         positions: mesh.positions.clone(),
-        split_valence: vec![LEAF; n],
+        split_valence: vec![NO_SPLIT; n],
     };
     while alive_count > options.target_vertices {
         let state = steps.len() as u32 + 1;
