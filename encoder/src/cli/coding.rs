@@ -5,6 +5,7 @@ use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{DeficitContexts, PlanePolicy, WingPolicy};
 
 use super::{CliResult, Codec, DeficitsArg, PlaneArg, WingsArg};
+use splitstream_encoder::emit::check_coding;
 
 #[derive(clap::Args)]
 pub struct CodingArgs {
@@ -40,15 +41,10 @@ pub struct CodingArgs {
 }
 
 impl CodingArgs {
-    /// Refuses what clap cannot: a chunk size of 0.
+    /// Refuses what clap cannot (a chunk size of 0) before any input is
+    /// read, by the library's own rules.
     pub fn check(&self) -> CliResult {
-        if self.chunk_size == 0 {
-            return Err("--chunk-size must be at least 1".into());
-        }
-        if self.rans_chunk == 0 {
-            return Err("--rans-chunk must be at least 1".into());
-        }
-        Ok(())
+        check_coding(self.chunk_codec(), self.chunk_size, self.rans_chunk)
     }
 
     pub fn chunk_codec(&self) -> ChunkCodec {

@@ -75,30 +75,8 @@ pub struct Args {
 }
 
 pub fn run(a: Args) -> CliResult {
-    if !(1..=31).contains(&a.bits) {
-        return Err(format!("--bits {} is outside 1..=31", a.bits));
-    }
-    if a.levels == 0 || a.levels > 64 {
-        return Err(format!("--levels {} is outside 1..=64", a.levels));
-    }
-    if !(a.admit > 0.0 && a.admit <= 1.0) {
-        return Err(format!("--admit {} is outside (0, 1]", a.admit));
-    }
-    a.coding.check()?;
-    let started = Instant::now();
-    let read = ReadOptions {
-        npz_array: a.npz_array.clone(),
-        z_scale: a.z_scale,
-        ..ReadOptions::default()
-    };
-    let mut mesh = read_mesh(&a.input, &read).map_err(|e| e.to_string())?;
-    if a.repair {
-        let (fixed, report) = repair_mesh(&mesh);
-        eprintln!("repair: {report}");
-        mesh = fixed;
-    }
-    let stats = check_mesh(&mesh).map_err(|e| format!("{}: {e}", a.input.display()))?;
-    let read_seconds = started.elapsed().as_secs_f64();
+    // The options do not depend on the input: checked by the library's
+    // rules (`EncodeOptions::check`) before anything is read.
     let options = EncodeOptions {
         bits: a.bits,
         levels: a.levels,
@@ -125,6 +103,21 @@ pub fn run(a: Args) -> CliResult {
         wings: a.coding.wings(),
         deficits: a.coding.deficits(),
     };
+    options.check().map_err(|e| e.to_string())?;
+    let started = Instant::now();
+    let read = ReadOptions {
+        npz_array: a.npz_array.clone(),
+        z_scale: a.z_scale,
+        ..ReadOptions::default()
+    };
+    let mut mesh = read_mesh(&a.input, &read).map_err(|e| e.to_string())?;
+    if a.repair {
+        let (fixed, report) = repair_mesh(&mesh);
+        eprintln!("repair: {report}");
+        mesh = fixed;
+    }
+    let stats = check_mesh(&mesh).map_err(|e| format!("{}: {e}", a.input.display()))?;
+    let read_seconds = started.elapsed().as_secs_f64();
     let degrees_unconverted = !a.geographic && looks_geographic(&mesh);
     if degrees_unconverted {
         eprintln!(

@@ -9,6 +9,7 @@ mod replay;
 mod transcode;
 mod wings;
 
+use splitstream_decoder_core::limits::rans::MAX_LANES;
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
 use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingPolicy};
 
@@ -132,7 +133,7 @@ pub fn encode(
     options: &EncodeOptions,
     progress: impl FnMut(usize),
 ) -> Result<Encoded, EncodeError> {
-    check_options(options)?;
+    options.check()?;
     let quantized = quantize_for(mesh, options);
     encode_quantized(&quantized, options, progress)
 }
@@ -148,7 +149,7 @@ pub fn encode_auto_position(
     options: &EncodeOptions,
     progress: impl FnMut(usize),
 ) -> Result<(Encoded, PositionMode), EncodeError> {
-    check_options(options)?;
+    options.check()?;
     // Quantized as constrained mode would: when no axis is on a lattice,
     // that is also optimal mode's quantization (a lattice is all that
     // differs), so the mesh is quantized once either way.
@@ -170,15 +171,61 @@ pub fn encode_auto_position(
     Ok((encoded, mode))
 }
 
-fn check_options(options: &EncodeOptions) -> Result<(), EncodeError> {
-    if !(1..=31).contains(&options.bits) {
-        return Err(EncodeError::BadOption(format!(
-            "--bits {} is outside 1..=31",
-            options.bits
-        )));
+/// Largest number of levels [`EncodeOptions::levels`] may ask for: each
+/// level about doubles the vertex count, so 64 levels cover any mesh.
+pub const MAX_LEVELS: usize = 64;
+
+impl EncodeOptions {
+    /// Refuses what the types allow but the format or the encoder does not,
+    /// with one message naming the `splitstream encode` option: [`encode`]
+    /// and [`encode_quantized`] call it first (a library caller gets the
+    /// same refusal as the command line, instead of a stream that no
+    /// decoder accepts).
+    pub fn check(&self) -> Result<(), EncodeError> {
+        let bad = |s: String| Err(EncodeError::BadOption(s));
+        if !(1..=31).contains(&self.bits) {
+            return bad(format!("--bits {} is outside 1..=31", self.bits));
+        }
+        if !(1..=MAX_LEVELS).contains(&self.levels) {
+            return bad(format!(
+                "--levels {} is outside 1..={MAX_LEVELS}",
+                self.levels
+            ));
+        }
+        if !(self.admit_quantile > 0.0 && self.admit_quantile <= 1.0) {
+            return bad(format!("--admit {} is outside (0, 1]", self.admit_quantile));
+        }
+        if let Some(e) = self.max_error
+            && !(e >= 0.0 && e.is_finite())
+        {
+            return bad(format!(
+                "--max-error {e} is not a finite error of 0 or more"
+            ));
+        }
+        check_coding(self.codec, self.chunk_limit, self.rans_chunk_limit)
+            .map_err(EncodeError::BadOption)
     }
-    if options.levels == 0 {
-        return Err(EncodeError::BadOption("--levels must be at least 1".into()));
+}
+
+/// The coding options' own rules, shared by [`EncodeOptions::check`] and
+/// [`transcode`]: chunks of at least one byte or value, and 1 to 32 rANS
+/// lanes (SPEC §5.5.3; the writer would put any other count in a header
+/// that every decoder refuses).
+pub fn check_coding(
+    codec: ChunkCodec,
+    chunk_limit: u32,
+    rans_chunk_limit: u32,
+) -> Result<(), String> {
+    if chunk_limit == 0 {
+        return Err("--chunk-size must be at least 1".into());
+    }
+    if rans_chunk_limit == 0 {
+        return Err("--rans-chunk must be at least 1".into());
+    }
+    if let ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } = codec
+        && !(1..=MAX_LANES).contains(&lanes)
+    {
+        return Err(format!("--lanes {lanes} is outside 1..={MAX_LANES}"));
     }
     Ok(())
 }
@@ -205,6 +252,7 @@ pub fn encode_quantized(
     options: &EncodeOptions,
     progress: impl FnMut(usize),
 ) -> Result<Encoded, EncodeError> {
+    options.check()?;
     let n = mesh.positions.len();
     let shift = (options.levels - 1).min(40) as u32;
     let base = options

@@ -19,6 +19,7 @@ use splitstream_decoder_core::{
     DeficitContexts, MeshState, PlanePolicy, Ring, SplitObserver, SplitRecord, WingPolicy,
 };
 
+use super::check_coding;
 use super::levels::LevelPlan;
 use super::replay::{ReplayError, replay};
 use crate::corner_table::{CornerTable, Fan};
@@ -98,18 +99,8 @@ impl From<splitstream_decoder_core::Error> for TranscodeError {
 
 /// Writes `stream` again under `options` (see the module documentation).
 pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded, TranscodeError> {
-    if options.chunk_limit == 0 || options.rans_chunk_limit == 0 {
-        return Err(TranscodeError::BadOption(
-            "chunk sizes must be at least 1".into(),
-        ));
-    }
-    if let ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } = options.codec
-        && !(1..=32).contains(&lanes)
-    {
-        return Err(TranscodeError::BadOption(format!(
-            "{lanes} lanes is outside 1..=32"
-        )));
-    }
+    check_coding(options.codec, options.chunk_limit, options.rans_chunk_limit)
+        .map_err(TranscodeError::BadOption)?;
     let mut refinement = Refinement::decode(stream)?;
     let params = StreamParams {
         position_mode: refinement.position_mode,

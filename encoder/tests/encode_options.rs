@@ -1,0 +1,114 @@
+//! `EncodeOptions::check`: what the option types allow but the format or
+//! the encoder does not is refused with one message, by the library as by
+//! the command line, instead of a stream that no decoder accepts.
+
+mod common;
+
+use splitstream_decoder_core::owned::decode_all;
+use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_encoder::emit::{
+    EncodeError, EncodeOptions, encode, encode_auto_position, encode_quantized, quantize_for,
+};
+
+fn refused(options: EncodeOptions, says: &str) {
+    let mesh = common::icosphere(1);
+    let quantized = quantize_for(&mesh, &EncodeOptions::default());
+    for result in [
+        encode(&mesh, &options, |_| {}).map(|_| ()),
+        encode_auto_position(&mesh, &options, |_| {}).map(|_| ()),
+        encode_quantized(&quantized, &options, |_| {}).map(|_| ()),
+    ] {
+        match result {
+            Err(EncodeError::BadOption(message)) => {
+                assert!(message.contains(says), "{message:?} names {says}");
+                assert!(!message.contains('\n'), "one line: {message:?}");
+            }
+            Err(e) => panic!("{says}: another error: {e}"),
+            Ok(()) => panic!("{says}: encoded"),
+        }
+    }
+}
+
+#[test]
+fn lane_counts_outside_the_format_are_refused() {
+    // Before the check these wrote streams whose header every decoder
+    // refuses (SPEC §5.5.3: 1 to 32 lanes).
+    for codec in [
+        ChunkCodec::Rans { lanes: 0 },
+        ChunkCodec::Rans { lanes: 33 },
+        ChunkCodec::RansAlways { lanes: 200 },
+    ] {
+        refused(
+            EncodeOptions {
+                codec,
+                ..Default::default()
+            },
+            "--lanes",
+        );
+    }
+}
+
+#[test]
+fn every_other_bad_option_is_refused() {
+    let d = EncodeOptions::default;
+    refused(EncodeOptions { bits: 0, ..d() }, "--bits");
+    refused(EncodeOptions { bits: 32, ..d() }, "--bits");
+    // `encode_quantized` used to compute `levels - 1` unchecked.
+    refused(EncodeOptions { levels: 0, ..d() }, "--levels");
+    refused(EncodeOptions { levels: 65, ..d() }, "--levels");
+    for admit in [0.0, -1.0, 1.5, f64::NAN] {
+        refused(
+            EncodeOptions {
+                admit_quantile: admit,
+                ..d()
+            },
+            "--admit",
+        );
+    }
+    for e in [-1.0, f64::NAN, f64::INFINITY] {
+        refused(
+            EncodeOptions {
+                max_error: Some(e),
+                ..d()
+            },
+            "--max-error",
+        );
+    }
+    refused(
+        EncodeOptions {
+            chunk_limit: 0,
+            ..d()
+        },
+        "--chunk-size",
+    );
+    refused(
+        EncodeOptions {
+            rans_chunk_limit: 0,
+            ..d()
+        },
+        "--rans-chunk",
+    );
+}
+
+#[test]
+fn the_edges_of_each_range_encode() {
+    let mesh = common::icosphere(1);
+    for options in [
+        EncodeOptions {
+            codec: ChunkCodec::Rans { lanes: 1 },
+            admit_quantile: 1.0,
+            max_error: Some(0.0),
+            ..Default::default()
+        },
+        EncodeOptions {
+            codec: ChunkCodec::RansAlways { lanes: 32 },
+            levels: 64,
+            chunk_limit: 1,
+            rans_chunk_limit: 1,
+            ..Default::default()
+        },
+    ] {
+        let encoded = encode(&mesh, &options, |_| {}).expect("encodes");
+        decode_all(&encoded.stream, false).expect("decodes");
+    }
+}
