@@ -1,0 +1,63 @@
+//! `transcode` on generated valid streams: decoder-core's fuzz generator
+//! builds a stream from the first bytes (any base mesh, both position
+//! modes, 8 to 31 bits per axis, every plane, wing and deficit policy,
+//! leaves, boundaries, seeded level 0), the next bytes pick the coding to
+//! write it in, and the transcoded stream must decode to the very same
+//! state hash after every round. A replay that refuses a valid stream, or
+//! reaches another state, is a finding; so is any panic.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, WingPolicy};
+use splitstream_decoder_core_fuzz::streams::{self, Choices};
+use splitstream_encoder::emit::{TranscodeOptions, transcode};
+
+/// The coding to write the stream in, from the bytes left.
+fn options(choices: &mut Choices<'_>) -> TranscodeOptions {
+    let codec = match choices.byte() % 6 {
+        0 => ChunkCodec::Stored,
+        1 => ChunkCodec::Deflate(1),
+        2 => ChunkCodec::RansAlways {
+            lanes: 1 + choices.byte() % 32,
+        },
+        _ => ChunkCodec::Rans {
+            lanes: 1 + choices.byte() % 32,
+        },
+    };
+    let pick = |b: u8, n: usize| (b as usize % (n + 1)).checked_sub(1);
+    TranscodeOptions {
+        codec,
+        chunk_limit: [16 * 1024, 1, 7, 64, 255][choices.below(5)],
+        rans_chunk_limit: [16 * 1024, 1, 3, 64][choices.below(4)],
+        plane: pick(choices.byte(), PlanePolicy::ALL.len()).map(|i| PlanePolicy::ALL[i]),
+        wings: pick(choices.byte(), WingPolicy::ALL.len()).map(|i| WingPolicy::ALL[i]),
+        deficits: pick(choices.byte(), DeficitContexts::ALL.len()).map(|i| DeficitContexts::ALL[i]),
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let mut choices = Choices::new(data);
+    let g = streams::generate(&mut choices, false);
+    assert_eq!(g.error, None, "the generator builds valid streams");
+    let options = options(&mut choices);
+    let transcoded = transcode(&g.stream, &options).unwrap_or_else(|e| {
+        panic!(
+            "a valid stream ({} base, {options:?}) was refused: {e}",
+            g.base
+        )
+    });
+    let input = streams::decode_full(&g.stream);
+    let output = streams::decode_full(&transcoded.stream);
+    assert_eq!(output.error, None, "the transcoded stream decodes");
+    assert_eq!(
+        output.hashes, input.hashes,
+        "the same state after every round"
+    );
+    assert_eq!(output.triangles, input.triangles);
+    assert_eq!(output.positions, input.positions);
+    assert_eq!(
+        transcoded.final_hash,
+        *input.hashes.last().expect("a base state")
+    );
+});
