@@ -34,13 +34,14 @@ pub fn run(side: usize, output: Option<&std::path::Path>) -> CliResult {
         std::fs::write(path, stream).map_err(|e| format!("{}: {e}", path.display()))?;
     }
     println!(
-        "encoded: {} bytes ({:.2} bits/vertex), {} levels, {} rounds, in {:.2} s ({:.2} M triangles/s; simplify {:.2} s, emit {:.2} s)",
+        "encoded: {} bytes ({:.2} bits/vertex), {} levels, {} rounds, in {:.2} s ({:.2} M triangles/s; check {:.2} s, simplify {:.2} s, emit {:.2} s)",
         stream.len(),
         8.0 * stream.len() as f64 / mesh.positions.len() as f64,
         encoded.level_vertex_counts.len(),
         encoded.rounds,
         seconds,
         mesh.triangles.len() as f64 / seconds / 1e6,
+        encoded.check_seconds,
         encoded.simplify_seconds,
         encoded.emit_seconds,
     );

@@ -6,8 +6,10 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use splitstream_decoder_core::PositionMode;
 use splitstream_encoder::Mesh;
-use splitstream_encoder::emit::{EncodeOptions, SEED_VERTICES, encode, encode_auto_position};
-use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh, repair_mesh};
+use splitstream_encoder::emit::{
+    EncodeError, EncodeOptions, SEED_VERTICES, encode, encode_auto_position,
+};
+use splitstream_encoder::input::{ReadOptions, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::{Quantization, Units};
 
 use super::coding::CodingArgs;
@@ -116,7 +118,7 @@ pub fn run(a: Args) -> CliResult {
         eprintln!("repair: {report}");
         mesh = fixed;
     }
-    let stats = check_mesh(&mesh).map_err(|e| format!("{}: {e}", a.input.display()))?;
+    // The mesh is checked by `encode` (check_mesh, before anything else).
     let read_seconds = started.elapsed().as_secs_f64();
     let degrees_unconverted = !a.geographic && looks_geographic(&mesh);
     if degrees_unconverted {
@@ -132,12 +134,16 @@ pub fn run(a: Args) -> CliResult {
     );
     bar.set_message("simplifying");
     let progress = |done| bar.set_position(done as u64);
-    let (encoded, mode) = match a.position {
+    let result = match a.position {
         Position::Auto => encode_auto_position(&mesh, &options, progress),
         _ => encode(&mesh, &options, progress).map(|e| (e, options.position_mode)),
-    }
-    .map_err(|e| e.to_string())?;
+    };
     bar.finish_and_clear();
+    let (encoded, mode) = result.map_err(|e| match e {
+        EncodeError::Input(e) => format!("{}: {e}", a.input.display()),
+        e => e.to_string(),
+    })?;
+    let stats = encoded.input;
     if encoded.rounds == 0 && n > SEED_VERTICES {
         // Seen on a DEM in degrees quantized with one step for degrees and
         // metres: x and y fell on a handful of steps, every triangle was
@@ -177,7 +183,9 @@ pub fn run(a: Args) -> CliResult {
     println!("{}", positions_line(mode, encoded.on_lattice));
     println!(
         "time: read+check {:.2} s, simplify {:.2} s, emit {:.2} s",
-        read_seconds, encoded.simplify_seconds, encoded.emit_seconds
+        read_seconds + encoded.check_seconds,
+        encoded.simplify_seconds,
+        encoded.emit_seconds
     );
     Ok(())
 }

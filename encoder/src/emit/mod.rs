@@ -13,6 +13,7 @@ use splitstream_decoder_core::limits::rans::MAX_LANES;
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
 use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingPolicy};
 
+use crate::input::{MeshError, MeshStats, check_mesh};
 use crate::mesh::Mesh;
 use crate::quantize::{Lattice, Quantization, QuantizedMesh, Units, quantize_with};
 use crate::simplify::{Backend, GpuError, SimplifyOptions, simplify_on};
@@ -105,12 +106,18 @@ pub struct Encoded {
     /// The axes quantized exactly on their own lattice
     /// ([`EncodeOptions::lattice`]).
     pub on_lattice: [bool; 3],
+    /// What the input check counted (`input::check_mesh`).
+    pub input: MeshStats,
+    pub check_seconds: f64,
 }
 
 /// Why encoding failed.
 #[derive(Debug)]
 pub enum EncodeError {
     BadOption(String),
+    /// The mesh is not one the encoder can take (`input::check_mesh`: the
+    /// first offending element).
+    Input(MeshError),
     Replay(ReplayError),
     Backend(GpuError),
 }
@@ -119,6 +126,7 @@ impl std::fmt::Display for EncodeError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             EncodeError::BadOption(s) => write!(f, "{s}"),
+            EncodeError::Input(e) => write!(f, "{e}"),
             EncodeError::Replay(e) => write!(f, "{e}"),
             EncodeError::Backend(e) => write!(f, "{e}"),
         }
@@ -127,15 +135,27 @@ impl std::fmt::Display for EncodeError {
 
 impl std::error::Error for EncodeError {}
 
-/// Encodes a checked mesh (see `input::check_mesh`) into a stream.
+/// Encodes a mesh into a stream. The options are checked first
+/// ([`EncodeOptions::check`]), then the mesh (`input::check_mesh`: an
+/// oriented 2-manifold with finite coordinates, every vertex used, no
+/// degenerate or duplicate triangle), each refusal a typed error naming
+/// the first offending element.
 pub fn encode(
     mesh: &Mesh,
     options: &EncodeOptions,
     progress: impl FnMut(usize),
 ) -> Result<Encoded, EncodeError> {
     options.check()?;
+    let (input, check_seconds) = timed_check(mesh)?;
     let quantized = quantize_for(mesh, options);
-    encode_quantized(&quantized, options, progress)
+    encode_checked(&quantized, options, progress, input, check_seconds)
+}
+
+/// `check_mesh` of `mesh`, and how long it took.
+fn timed_check(mesh: &Mesh) -> Result<(MeshStats, f64), EncodeError> {
+    let started = std::time::Instant::now();
+    let stats = check_mesh(mesh).map_err(EncodeError::Input)?;
+    Ok((stats, started.elapsed().as_secs_f64()))
 }
 
 /// Encodes like [`encode`] in the position mode that suits the mesh
@@ -150,6 +170,7 @@ pub fn encode_auto_position(
     progress: impl FnMut(usize),
 ) -> Result<(Encoded, PositionMode), EncodeError> {
     options.check()?;
+    let (input, check_seconds) = timed_check(mesh)?;
     // Quantized as constrained mode would: when no axis is on a lattice,
     // that is also optimal mode's quantization (a lattice is all that
     // differs), so the mesh is quantized once either way.
@@ -167,7 +188,7 @@ pub fn encode_auto_position(
         position_mode: mode,
         ..options.clone()
     };
-    let encoded = encode_quantized(&quantized, &options, progress)?;
+    let encoded = encode_checked(&quantized, &options, progress, input, check_seconds)?;
     Ok((encoded, mode))
 }
 
@@ -246,13 +267,52 @@ pub fn quantize_for(mesh: &Mesh, options: &EncodeOptions) -> QuantizedMesh {
     )
 }
 
-/// Encodes an already quantized mesh.
+/// Encodes an already quantized mesh (`options.bits` and the quantization
+/// options are the mesh's own). It is checked as [`encode`] checks a mesh,
+/// in its grid coordinates: a mesh built by hand gets the same typed
+/// errors, never a panic.
 pub fn encode_quantized(
     mesh: &QuantizedMesh,
     options: &EncodeOptions,
     progress: impl FnMut(usize),
 ) -> Result<Encoded, EncodeError> {
     options.check()?;
+    if !(1..=31).contains(&mesh.bits) {
+        return Err(EncodeError::BadOption(format!(
+            "the quantized mesh has {} bits, outside 1..=31",
+            mesh.bits
+        )));
+    }
+    let top = 1u64 << mesh.bits;
+    if let Some(v) = mesh
+        .positions
+        .iter()
+        .position(|p| p.iter().any(|&x| x as u64 >= top))
+    {
+        return Err(EncodeError::BadOption(format!(
+            "vertex {v} of the quantized mesh, {:?}, lies outside its {}-bit grid",
+            mesh.positions[v], mesh.bits
+        )));
+    }
+    let started = std::time::Instant::now();
+    let as_mesh = Mesh {
+        positions: mesh.positions.iter().map(|p| p.map(f64::from)).collect(),
+        triangles: mesh.triangles.clone(),
+    };
+    let input = check_mesh(&as_mesh).map_err(EncodeError::Input)?;
+    drop(as_mesh);
+    let check_seconds = started.elapsed().as_secs_f64();
+    encode_checked(mesh, options, progress, input, check_seconds)
+}
+
+/// [`encode_quantized`] of a mesh whose check passed with `input`.
+fn encode_checked(
+    mesh: &QuantizedMesh,
+    options: &EncodeOptions,
+    progress: impl FnMut(usize),
+    input: MeshStats,
+    check_seconds: f64,
+) -> Result<Encoded, EncodeError> {
     let n = mesh.positions.len();
     let shift = (options.levels - 1).min(40) as u32;
     let base = options
@@ -312,5 +372,7 @@ pub fn encode_quantized(
         simplify_seconds,
         emit_seconds: started.elapsed().as_secs_f64(),
         on_lattice: mesh.on_lattice,
+        input,
+        check_seconds,
     })
 }
