@@ -8,21 +8,34 @@ fn main() {
     let runs: usize = args.get(1).and_then(|r| r.parse().ok()).unwrap_or(5);
     let mesh = match what.parse::<usize>() {
         Ok(side) => fractal_terrain(side, 2012),
-        Err(_) => read_mesh(std::path::Path::new(what), &ReadOptions::default()).expect("read"),
+        Err(_) => match read_mesh(std::path::Path::new(what), &ReadOptions::default()) {
+            Ok(mesh) => mesh,
+            Err(e) => fail(&e.to_string()),
+        },
     };
     let mut times = Vec::new();
     let mut stats = None;
     for _ in 0..runs.max(1) {
         let t = std::time::Instant::now();
-        stats = Some(check_mesh(&mesh).expect("a valid mesh"));
+        match check_mesh(&mesh) {
+            Ok(s) => stats = Some(s),
+            Err(e) => fail(&format!("{what}: {e}")),
+        }
         times.push(t.elapsed().as_secs_f64() * 1e3);
     }
     times.sort_by(f64::total_cmp);
-    println!(
-        "{what}: check_mesh median {:.1} ms of {} runs (min {:.1}); {}",
-        times[times.len() / 2],
-        times.len(),
-        times[0],
-        stats.expect("one run")
-    );
+    if let Some(stats) = stats {
+        println!(
+            "{what}: check_mesh median {:.1} ms of {} runs (min {:.1}); {stats}",
+            times[times.len() / 2],
+            times.len(),
+            times[0],
+        );
+    }
+}
+
+/// One line on stderr and a non-zero exit, as the command line does.
+fn fail(message: &str) -> ! {
+    eprintln!("error: {message}");
+    std::process::exit(1)
 }

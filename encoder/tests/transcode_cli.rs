@@ -90,24 +90,10 @@ fn bad_streams_and_arguments_get_one_line() {
     assert!(err.contains("garbage.sps: "), "{err}");
     let input = stream("for-errors.sps");
     let s = input.to_str().unwrap();
-    let err = one_line_error(&splitstream(&[
-        "transcode",
-        s,
-        "-o",
-        o,
-        "--chunk-size",
-        "0",
-    ]));
-    assert!(err.contains("--chunk-size"), "{err}");
-    let err = one_line_error(&splitstream(&[
-        "transcode",
-        s,
-        "-o",
-        o,
-        "--rans-chunk",
-        "0",
-    ]));
-    assert!(err.contains("--rans-chunk"), "{err}");
+    for flag in ["--chunk-size", "--rans-chunk"] {
+        let err = one_line_error(&splitstream(&["transcode", s, "-o", o, flag, "0"]));
+        assert!(err.contains(flag), "{err}");
+    }
     let bytes = std::fs::read(&input).unwrap();
     let cut = input.with_file_name("cut.sps");
     std::fs::write(&cut, &bytes[..bytes.len() - 3]).unwrap();
