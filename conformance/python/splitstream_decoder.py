@@ -1,11 +1,13 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.4 decoder, in Python, written from
+"""A second splitstream 3.5 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
 plane policy `height`, 3.2's wing policies, 3.3's deficit contexts and
 3.4's rANS chunks beyond max_chunk_len were added with the SPEC sections
-that define them.) It speaks the conformance protocol (a stream
+that define them; 3.5 added one level header check, level 0's
+seed_triangles above its table entry's triangle_count failing
+count-mismatch before the seed is read.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -522,6 +524,8 @@ class Decoder:
                 raise Fail("malformed")
         before = SV if li == 0 else self.entries[li - 1]["V"]
         if before + sum(split_counts) != entry["V"]:
+            raise Fail("count-mismatch")
+        if li == 0 and ST > entry["T"]:  # the seed fits level 0's entry (3.5)
             raise Fail("count-mismatch")
         subs = {}
         for sid in range(1, 11):

@@ -93,7 +93,8 @@ pub struct Decoder<'h, 'ws> {
 impl<'h, 'ws> Decoder<'h, 'ws> {
     /// Parses the header and level table at the start of `head` (the whole
     /// stream or just its first bytes, see [`crate::head_len`]) and lays the
-    /// decoder out in `workspace`.
+    /// decoder out in `workspace` (SPEC §3.3, §4.2, §9, the first steps of
+    /// §10.3).
     pub fn new(
         head: &'h [u8],
         workspace: &'ws mut [u8],
@@ -187,14 +188,16 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
         stream.get(start..end).ok_or(Error::Truncated)
     }
 
-    /// The byte range of level `k` in the stream.
+    /// The byte range of level `k` in the stream (SPEC §4.1), for a range
+    /// request.
     pub fn level_range(&self, k: u16) -> core::ops::Range<u64> {
         let e = self.table.get(k);
         e.offset..e.offset + e.length as u64
     }
 
-    /// Starts level `level` from its bytes; decode its rounds with
-    /// [`LevelDecoder::next_round`]. The base level (0) is decoded at once.
+    /// Starts level `level` from its bytes (SPEC §5.1); decode its rounds
+    /// with [`LevelDecoder::next_round`]. The base level's seed (0, §6.3) is
+    /// decoded at once.
     pub fn begin_level<'d, 'l>(
         &'d mut self,
         level: u16,
@@ -246,15 +249,17 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
         Ok(open_level(self, level, info, header, bytes))
     }
 
-    /// Decodes a whole level (see [`Decoder::begin_level`]).
+    /// Decodes a whole level: its header, rounds and end (SPEC §5.1, §7.3,
+    /// §7.6; see [`Decoder::begin_level`]).
     pub fn decode_level(&mut self, level: u16, bytes: &[u8]) -> Result<(), Error> {
         let mut ld = self.begin_level(level, bytes)?;
         while ld.next_round()?.is_some() {}
         Ok(())
     }
 
-    /// Decodes every level that fits from the whole `stream`; returns the
-    /// number of levels decoded (base included).
+    /// Decodes every level that fits from the whole `stream` (SPEC §9
+    /// "Decoding as far as fits", §10.3); returns the number of levels
+    /// decoded (base included).
     pub fn decode_available(&mut self, stream: &[u8]) -> Result<u16, Error> {
         while let Some(k) = self.next_level() {
             let result = self
@@ -327,7 +332,8 @@ pub struct LevelDecoder<'d, 'l, 'ws> {
 }
 
 impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
-    /// Decodes the next round; `None` once the level is complete and verified.
+    /// Decodes the next round (SPEC §7.3); `None` once the level is complete
+    /// and verified (§7.6).
     pub fn next_round(&mut self) -> Result<Option<RoundInfo>, Error> {
         self.next_round_observed(&mut ())
     }

@@ -12,11 +12,13 @@ pub enum Error {
     BadMagic,
     /// §3.1: a major version other than 3.
     UnsupportedVersion { major: u8, minor: u8 },
-    /// §3.2: a header field out of its allowed range or a reserved field not zero.
+    /// §3.2, §3.3: a header field out of its allowed range or a reserved
+    /// field not zero; §9, §10.3: `workspace_bytes` not the layout's total.
     InvalidHeader(&'static str),
     /// §3.3, §4.2, §5.1, §5.2: a CRC-32 does not match.
     ChecksumMismatch(ChecksumScope),
-    /// §3, §4, §5: the bytes end before the structure they must hold.
+    /// §3, §4, §5, §10.3: the bytes end before the structure they must
+    /// hold, or a level's byte range is not (wholly) present.
     Truncated,
     /// §4.2: level table entries are inconsistent (offsets, counts, ordering).
     InvalidLevelTable(&'static str),
@@ -24,17 +26,23 @@ pub enum Error {
     InvalidLevelHeader(&'static str),
     /// §5.2: a deflate chunk does not inflate to exactly its declared length.
     CorruptChunk,
-    /// §9: a count exceeds the capacity declared in the header.
+    /// §4.2, §9: a level-table count exceeds the capacity declared in the
+    /// header (and, as a guard no valid stream meets since §5.1 bounds the
+    /// seed, a seed larger than the workspace's capacities).
     CapacityExceeded,
-    /// §9: the caller's workspace is smaller than the layout needs.
+    /// §9: the caller's workspace is smaller than the layout needs (an
+    /// API-level error, §10.1; its class is `capacity-exceeded`).
     WorkspaceTooSmall { needed: usize, available: usize },
     /// §7.3: the number of set flags in a round differs from the declared split count.
     FlagCountMismatch { round: u32 },
-    /// §5.4, §7.6: a substream ran out early or holds data after the level's last record,
-    /// or the level ended with other vertex/triangle counts than its table entry.
+    /// §5.4, §7.6: a substream ran out early, or holds data after the
+    /// level's last record (or a chunk it never loaded), in the substream
+    /// with this id.
     RecordCountMismatch(u8),
-    /// §5.1, §7.6: a level's declared split counts or its decoded triangle
-    /// count differ from its level-table entry.
+    /// §5.1, §7.5, §7.6: a level's round count, split counts or seed
+    /// triangles disagree with its level-table entry, a split would take the
+    /// triangle count past the entry's, or the level ended with other
+    /// vertex or triangle counts.
     LevelCountMismatch,
     /// §5.4: a varint longer than 5 bytes, over 32 bits, or not minimal.
     InvalidVarint(u8),
@@ -48,7 +56,9 @@ pub enum Error {
     /// wings (`d' = 0` or `o' + d' >= m`), or a wing offset or distance
     /// outside the ring of the split vertex.
     RingOffsetOutOfRange,
-    /// §6.2, §7.5: a valence above its split valence or above 255.
+    /// §6.2, §6.3, §7.1, §7.5: a valence above its split valence or above
+    /// 255 (a base vertex, a ring longer than 255, P or C after a split), or
+    /// a wing with deficit 0.
     ValenceOverflow,
     /// §7.4: a coded split valence of P or C below that vertex's valence
     /// right after the split, or above 255.
@@ -59,14 +69,16 @@ pub enum Error {
     PositionOutOfRange,
     /// §7.4: the constrained-mode placement code is not 0, 1 or 2.
     InvalidPlacement,
-    /// API misuse: levels must be fed in order, once each.
+    /// API misuse (§10.1, not a stream fault): levels must be fed in order,
+    /// once each.
     LevelOutOfOrder { expected: u16, got: u16 },
-    /// API misuse: the decoder already returned an error, or a level was
-    /// abandoned half way.
+    /// API misuse (§10.1, §10.2): the decoder already returned an error, or
+    /// a level was abandoned half way.
     Poisoned,
-    /// API misuse: a vertex index beyond the current vertex count.
+    /// API misuse (§10.1): a vertex index beyond the current vertex count.
     NoSuchVertex,
-    /// API misuse: a level index beyond the level table (`count` levels).
+    /// API misuse (§10.1, §4.1): a level index beyond the level table
+    /// (`count` levels).
     NoSuchLevel { level: u16, count: u16 },
 }
 

@@ -7,7 +7,8 @@ use crate::limits::{
 };
 use crate::{ChecksumScope, Error};
 
-/// How the two vertices of a split are placed relative to their parent (SPEC §3.2, §7.5).
+/// How the two vertices of a split are placed relative to their parent
+/// (SPEC §3.2 header flag bit 0, §7.4).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum PositionMode {
     /// Two deltas per split: the edge vector and the parent's offset from its midpoint.
@@ -31,7 +32,8 @@ pub struct Header {
     pub triangle_capacity: u32,
     /// Independent rANS lanes per chunk (SPEC §5.5), 1..=32.
     pub lane_count: u8,
-    /// Largest raw (decompressed) chunk length in the stream.
+    /// Largest `raw_len` of a stored or deflate chunk (SPEC §3.2, §5.2; since
+    /// 3.4 it does not bound rANS chunks, whose `raw_len` counts values).
     pub max_chunk_len: u32,
     /// Real coordinate of quantized value 0 on each axis.
     pub origin: [f64; 3],
@@ -126,8 +128,8 @@ impl Header {
         Ok(header)
     }
 
-    /// Writes the header into `out` (96 bytes), checksum included. Used by
-    /// encoders; the inverse of [`Header::parse`].
+    /// Writes the header into `out` (96 bytes, SPEC §3.2), checksum included
+    /// (§3.3). Used by encoders; the inverse of [`Header::parse`].
     pub fn write(&self, out: &mut [u8; HEADER_LEN]) {
         out.fill(0);
         out[..8].copy_from_slice(&MAGIC);

@@ -79,18 +79,20 @@ impl Layout {
         }
     }
 
-    /// Bytes a caller must provide when it cannot guarantee an 8-aligned buffer.
+    /// Bytes a caller must provide when it cannot guarantee an 8-aligned
+    /// buffer: the SPEC §9 total and 7 bytes of alignment slack.
     pub fn bytes_unaligned(&self) -> u64 {
         self.total + ALIGN as u64 - 1
     }
 
-    /// Whether `buffer` holds this layout once aligned.
+    /// Whether `buffer` holds this layout (SPEC §9) once aligned.
     pub fn fits(&self, buffer: &[u8]) -> bool {
         let skip = buffer.as_ptr().align_offset(ALIGN).min(ALIGN);
         buffer.len().saturating_sub(skip) as u64 >= self.total
     }
 
-    /// Carves `buffer` into the state arrays and the per-substream chunk buffers.
+    /// Carves `buffer` into the state arrays and the per-substream chunk
+    /// buffers: the regions of SPEC §9, in its order.
     pub fn carve<'ws>(
         &self,
         buffer: &'ws mut [u8],

@@ -29,7 +29,8 @@ pub struct LevelTable<'h> {
     count: u16,
 }
 
-/// Bytes from the stream start to the end of the level table, checksum included.
+/// Bytes from the stream start to the end of the level table, checksum
+/// included (SPEC §4.1, §4.2).
 pub fn head_len(level_count: u16) -> usize {
     HEADER_LEN + LEVEL_ENTRY_LEN * level_count as usize + 4
 }
@@ -183,10 +184,17 @@ impl<'h> LevelTable<'h> {
         if before + added != info.vertex_count as u64 {
             return Err(Error::LevelCountMismatch);
         }
+        // 3.5: every split adds triangles, so the seed holds at most level
+        // 0's; failing here, before the seed is read, gives every decoder
+        // the same class whether its memory holds level 0 or the stream.
+        if is_base && header.seed_triangles > info.triangle_count {
+            return Err(Error::LevelCountMismatch);
+        }
         Ok(header)
     }
 
-    /// End of the stream: offset just past the last level.
+    /// End of the stream: offset just past the last level (SPEC §4.2
+    /// `stream_len`).
     pub fn stream_len(&self) -> u64 {
         let last = self.get(self.count - 1);
         last.offset + last.length as u64

@@ -4,9 +4,14 @@
 /// catches text-mode transfers and truncation of the first bytes.
 pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 
-/// Format version this crate reads and writes (SPEC §1).
+/// Format version this crate implements (SPEC §1). It reads every 3.x
+/// stream; 3.5 added a check and no feature, so no stream is written with
+/// minor version 5 (the writer uses the constants below).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 4;
+pub const VERSION_MINOR: u8 = 5;
+/// The minor version written when a rANS chunk codes more values than
+/// `max_chunk_len` (SPEC §1, §5.2): 3.3 decoders reject such a chunk.
+pub const VERSION_MINOR_RANS_CHUNKS: u8 = 4;
 /// The minor version written when a stream uses the deficit contexts
 /// `valence` and no 3.4 feature, so that 3.3 decoders read it (SPEC §1).
 pub const VERSION_MINOR_DEFICITS: u8 = 3;

@@ -144,7 +144,7 @@ impl<'ws> MeshState<'ws> {
 
     /// Bounds the triangle count of the level being decoded: a split that
     /// would pass it fails with [`crate::Error::LevelCountMismatch`]
-    /// (SPEC §7.6), whatever the workspace could hold.
+    /// (SPEC §7.5), whatever the workspace could hold.
     pub fn set_triangle_limit(&mut self, limit: u32) {
         self.triangle_limit = limit;
     }

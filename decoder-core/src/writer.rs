@@ -10,8 +10,8 @@ use crate::header::{Header, PositionMode};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
-    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR, VERSION_MINOR_BASELINE, VERSION_MINOR_DEFICITS,
-    VERSION_MINOR_HEIGHT, VERSION_MINOR_WINGS, codec, substream,
+    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_BASELINE, VERSION_MINOR_DEFICITS,
+    VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_WINGS, codec, substream,
 };
 use crate::predict::PlanePolicy;
 use crate::rans_writer::{Symbol, encode_chunk};
@@ -344,7 +344,7 @@ pub fn assemble_stream(
     // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
     // is; every other stream stays readable by 3.0 decoders.
     let version_minor = if rans_above {
-        VERSION_MINOR
+        VERSION_MINOR_RANS_CHUNKS
     } else if levels.iter().any(|l| l.deficits != DeficitContexts::Plain) {
         VERSION_MINOR_DEFICITS
     } else if levels.iter().any(|l| l.wings != WingPolicy::Ranks) {

@@ -624,3 +624,68 @@ fn section_5_2_max_chunk_len_bounds_byte_codec_chunks_only() {
         "malformed"
     );
 }
+
+/// §5.1 (3.5): level 0's header may not declare more seed triangles than
+/// level 0's table entry holds, and a decoder holding level 0 alone (§9)
+/// reports the same class as one holding the whole stream (§10.3). The
+/// stream: the tetrahedron of Appendix A as the seed (4 triangles) and its
+/// split as level 0's round, level 0's entry claiming 3 triangles, and a
+/// level 1 whose counts keep the level table valid. Before 3.5 the whole
+/// stream's decoder met a split past T_0 (`count-mismatch`) while one sized
+/// for level 0 could not hold the seed (`capacity-exceeded`).
+#[test]
+fn section_5_1_seed_triangles_at_most_level_0s() {
+    use splitstream_decoder_core::owned::OwnedWorkspace;
+    use splitstream_decoder_core::writer::{SeedPayload, write_stream_seeded};
+    use splitstream_decoder_core::{Header, LevelTable, layout_for};
+
+    let seed = SeedPayload::new(
+        &[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]],
+        &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        &[0, LEAF, LEAF, LEAF],
+    );
+    let split = |vertex_count, triangle_count| {
+        let mut s = vec![SubstreamWriter::default(); 7];
+        s[0].bit(true);
+        s[1].byte(0);
+        s[2].byte(1);
+        s[3].byte(0);
+        s[4].byte(0);
+        for x in [1, 0, 0] {
+            s[5].signed(x);
+        }
+        for x in [0, 2, 4] {
+            s[6].signed(x);
+        }
+        LevelPayload {
+            round_splits: vec![1],
+            plane: PlanePolicy::Dominant,
+            wings: WingPolicy::Ranks,
+            deficits: DeficitContexts::Plain,
+            substreams: s,
+            vertex_count,
+            triangle_count,
+            geometric_error: 0.0,
+        }
+    };
+    let stream_with =
+        |t0: u32| write_stream_seeded(&params(), &seed, &[split(5, t0), split(6, t0 + 2)]);
+
+    // The claim at its lowest legal value (the seed's 4 triangles) passes the
+    // level header; the split then takes T past it (§7.5), as before 3.5.
+    // Below the seed's count the level header fails: same class, and for
+    // the decoder that holds level 0 alone, no longer capacity-exceeded.
+    for (t0, what) in [(4, "a split past T_0"), (3, "the seed above T_0")] {
+        let stream = stream_with(t0);
+        let header = Header::parse(&stream).unwrap();
+        let table = LevelTable::parse(&stream, &header).unwrap();
+        let whole = decode_all(&stream, false).unwrap_err();
+        assert_eq!(whole.class(), "count-mismatch", "{what}: {whole:?}");
+        let level_0 = layout_for(&header, &table, 0).total.div_ceil(8) * 8;
+        let mut ws = OwnedWorkspace::within(&stream, level_0).unwrap();
+        let mut decoder = ws.decoder(&stream).unwrap();
+        assert_eq!(decoder.levels_that_fit(), 1);
+        let prefix = decoder.decode_available(&stream).unwrap_err();
+        assert_eq!(prefix, whole, "{what}");
+    }
+}

@@ -1213,6 +1213,19 @@ fn invalid_vectors(s: &mut Specs) {
         },
     );
     s.invalid(
+        "seed-triangles-over-entry",
+        "count-mismatch",
+        "Level 0 alone, its table entry (and so the header capacity and workspace) one triangle short of the seed mesh its header declares (3.5, SPEC §5.1: failed in the level header, before the seed is read; a 3.4 decoder met it as capacity-exceeded or count-mismatch, by its memory).",
+        &["framing", "level-count", "capacity"],
+        {
+            let mut p = parts.clone();
+            p.levels.truncate(1);
+            let (_, seed_triangles, _) = p.levels[0].seed.as_ref().expect("level 0 has a seed");
+            p.levels[0].triangle_count = seed_triangles - 1;
+            reframe(&p)
+        },
+    );
+    s.invalid(
         "record-trailing-data",
         "count-mismatch",
         "One byte appended to the edge substream of the last level: data after the level's last record.",
