@@ -426,7 +426,7 @@ pub fn replay(
     // level run on another while the next level replays (same bytes: the
     // replay itself is sequential).
     let seed_ref = &seed;
-    let done = std::thread::scope(|scope| -> Result<Vec<LevelAndFrame>, ReplayError> {
+    let done = std::thread::scope(|scope| -> Result<(Vec<LevelAndFrame>, u64), ReplayError> {
         let mut choosing = Vec::with_capacity(plan.rounds.len());
         for (l, steps) in plan.rounds.iter().enumerate() {
             let mut subs = vec![SubstreamWriter::default(); 7];
@@ -518,13 +518,16 @@ pub fn replay(
                 Ok((level, framed))
             }));
         }
-        choosing
+        // The replay is over: check it and hash it while the last levels
+        // are still being chosen and framed.
+        let checked = check_exact(mesh, &state, &dec2enc).map(|()| state.state_hash());
+        let levels = choosing
             .into_iter()
             .map(|h| h.join().expect("choosing a plane policy does not panic"))
-            .collect()
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((levels, checked?))
     })?;
-    check_exact(mesh, &state, &dec2enc)?;
-    let final_hash = state.state_hash();
+    let (done, final_hash) = done;
     let (levels, framed) = done.into_iter().unzip();
     Ok(Replayed {
         seed,
