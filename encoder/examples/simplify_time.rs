@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use splitstream_encoder::input::fractal_terrain;
 use splitstream_encoder::quantize::{Lattice, Quantization, Units, quantize_with};
-use splitstream_encoder::simplify::{SimplifyOptions, simplify};
+use splitstream_encoder::simplify::{Checked, SimplifyOptions, simplify};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -30,6 +30,10 @@ fn main() {
         Quantization::PerAxis,
         Lattice::Ignore,
     );
+    let q = Checked::new(&q).unwrap_or_else(|e| {
+        eprintln!("simplify_time: {e}");
+        std::process::exit(1)
+    });
     let options = SimplifyOptions {
         target_vertices: 16,
         constrained,

@@ -17,6 +17,7 @@
 //! the position residuals code in a few bits where a finer step leaves the
 //! prediction's fractions of a cell to code.
 
+use crate::input::{MeshError, MeshStats, check_mesh};
 use crate::mesh::Mesh;
 
 /// A mesh on the integer grid `0 .. 2^bits` per axis.
@@ -48,7 +49,71 @@ impl QuantizedMesh {
             triangles: self.triangles.clone(),
         }
     }
+
+    /// Checks a quantized mesh as [`check_mesh`] checks an input mesh, in
+    /// its grid coordinates, after its bit count (1..=31) and that every
+    /// position lies on the grid: what the simplifier and the encoder
+    /// assume (a mesh built by hand gets these typed errors, not a panic
+    /// or a wrong stream).
+    pub fn check(&self) -> Result<MeshStats, GridError> {
+        if !(1..=31).contains(&self.bits) {
+            return Err(GridError::Bits(self.bits));
+        }
+        let top = 1u64 << self.bits;
+        if let Some(v) = self
+            .positions
+            .iter()
+            .position(|p| p.iter().any(|&x| x as u64 >= top))
+        {
+            return Err(GridError::OffGrid {
+                vertex: v,
+                position: self.positions[v],
+                bits: self.bits,
+            });
+        }
+        let as_mesh = Mesh {
+            positions: self.positions.iter().map(|p| p.map(f64::from)).collect(),
+            triangles: self.triangles.clone(),
+        };
+        check_mesh(&as_mesh).map_err(GridError::Mesh)
+    }
 }
+
+/// Why a quantized mesh failed [`QuantizedMesh::check`].
+#[derive(Clone, Debug, PartialEq)]
+pub enum GridError {
+    /// A bit count outside 1..=31.
+    Bits(u8),
+    /// A position with a coordinate at or above `2^bits`.
+    OffGrid {
+        vertex: usize,
+        position: [u32; 3],
+        bits: u8,
+    },
+    /// The mesh itself (in grid coordinates).
+    Mesh(MeshError),
+}
+
+impl std::fmt::Display for GridError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            GridError::Bits(bits) => {
+                write!(f, "the quantized mesh has {bits} bits, outside 1..=31")
+            }
+            GridError::OffGrid {
+                vertex,
+                position,
+                bits,
+            } => write!(
+                f,
+                "vertex {vertex} of the quantized mesh, {position:?}, lies outside its {bits}-bit grid"
+            ),
+            GridError::Mesh(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl std::error::Error for GridError {}
 
 /// How file units relate to metres, per axis.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -128,3 +128,63 @@ fn a_quantized_mesh_is_checked_too() {
         other => panic!("{:?}", other.map(|e| e.stream.len())),
     }
 }
+
+/// The simplifier's public entry points take a `Checked` mesh, which only
+/// `Checked::new` makes: the same checks, as a `GridError`. (Before, a
+/// triangle naming a missing vertex panicked in `simplify`, and a flipped
+/// triangle was simplified into a wrong mesh without a word.)
+#[test]
+fn the_simplifier_takes_only_a_checked_mesh() {
+    use splitstream_encoder::quantize::GridError;
+    use splitstream_encoder::simplify::{Backend, Checked, SimplifyOptions, simplify, simplify_on};
+
+    let good = quantize_for(&common::icosphere(3), &EncodeOptions::default());
+    let checked = Checked::new(&good).expect("the icosphere is a closed manifold");
+    assert_eq!(checked.stats().vertices, good.positions.len());
+    assert_eq!(checked.stats().genus, 0);
+    let options = SimplifyOptions {
+        target_vertices: 12,
+        ..SimplifyOptions::default()
+    };
+    let s = simplify(&checked, &options, |_| {});
+    assert_eq!(s.alive_count, 12);
+    let again = simplify_on(Backend::Cpu, &checked, &options, |_| {}).expect("the CPU backend");
+    assert_eq!(again.steps, s.steps);
+
+    let refused = |name: &str,
+                   mesh: &splitstream_encoder::quantize::QuantizedMesh,
+                   matches: fn(&GridError) -> bool| {
+        match Checked::new(mesh) {
+            Err(e) => assert!(matches(&e), "{name}: {e}"),
+            Ok(_) => panic!("{name}: accepted"),
+        }
+    };
+    let mut index = good.clone();
+    index.triangles[0][1] = index.positions.len() as u32;
+    refused("index", &index, |e| {
+        matches!(e, GridError::Mesh(MeshError::IndexOutOfRange { .. }))
+    });
+    let mut flipped = good.clone();
+    let t = flipped.triangles[10];
+    flipped.triangles[10] = [t[0], t[2], t[1]];
+    refused("flipped", &flipped, |e| {
+        matches!(
+            e,
+            GridError::Mesh(MeshError::InconsistentOrientation { .. })
+        )
+    });
+    let mut outside = good.clone();
+    outside.positions[7][0] = 1 << outside.bits;
+    refused("outside", &outside, |e| {
+        matches!(e, GridError::OffGrid { vertex: 7, .. })
+    });
+    let mut bits = good.clone();
+    bits.bits = 0;
+    refused("bits", &bits, |e| matches!(e, GridError::Bits(0)));
+    let mut empty = good.clone();
+    empty.positions.clear();
+    empty.triangles.clear();
+    refused("empty", &empty, |e| {
+        matches!(e, GridError::Mesh(MeshError::Empty { .. }))
+    });
+}

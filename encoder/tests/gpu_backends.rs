@@ -17,7 +17,7 @@ use splitstream_encoder::emit::EncodeOptions;
 use splitstream_encoder::input::fractal_terrain;
 use splitstream_encoder::metrics::surface_distance;
 use splitstream_encoder::quantize::{Units, quantize};
-use splitstream_encoder::simplify::{Backend, SimplifyOptions, simplify_on};
+use splitstream_encoder::simplify::{Backend, Checked, SimplifyOptions, simplify_on};
 
 const GPU: [Backend; 2] = [Backend::Wgpu, Backend::OpenCl];
 
@@ -88,7 +88,8 @@ fn quality_within_a_few_percent_of_the_cpu() {
             ..SimplifyOptions::default()
         };
         let measure = |backend: Backend| {
-            let s = simplify_on(backend, &q, &options, |_| {}).expect("simplify");
+            let checked = Checked::new(&q).expect("a checked mesh");
+            let s = simplify_on(backend, &checked, &options, |_| {}).expect("simplify");
             assert_eq!(s.alive_count, options.target_vertices, "{backend} {name}");
             surface_distance(&input, &s.to_mesh(&q), 100_000, 3)
         };

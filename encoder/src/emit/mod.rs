@@ -15,8 +15,8 @@ use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingP
 
 use crate::input::{MeshError, MeshStats, check_mesh};
 use crate::mesh::Mesh;
-use crate::quantize::{Lattice, Quantization, QuantizedMesh, Units, quantize_with};
-use crate::simplify::{Backend, GpuError, SimplifyOptions, simplify_on};
+use crate::quantize::{GridError, Lattice, Quantization, QuantizedMesh, Units, quantize_with};
+use crate::simplify::{Backend, Checked, GpuError, SimplifyOptions, simplify_on};
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
 pub use transcode::{TranscodeError, TranscodeOptions, Transcoded, transcode};
@@ -277,30 +277,11 @@ pub fn encode_quantized(
     progress: impl FnMut(usize),
 ) -> Result<Encoded, EncodeError> {
     options.check()?;
-    if !(1..=31).contains(&mesh.bits) {
-        return Err(EncodeError::BadOption(format!(
-            "the quantized mesh has {} bits, outside 1..=31",
-            mesh.bits
-        )));
-    }
-    let top = 1u64 << mesh.bits;
-    if let Some(v) = mesh
-        .positions
-        .iter()
-        .position(|p| p.iter().any(|&x| x as u64 >= top))
-    {
-        return Err(EncodeError::BadOption(format!(
-            "vertex {v} of the quantized mesh, {:?}, lies outside its {}-bit grid",
-            mesh.positions[v], mesh.bits
-        )));
-    }
     let started = std::time::Instant::now();
-    let as_mesh = Mesh {
-        positions: mesh.positions.iter().map(|p| p.map(f64::from)).collect(),
-        triangles: mesh.triangles.clone(),
-    };
-    let input = check_mesh(&as_mesh).map_err(EncodeError::Input)?;
-    drop(as_mesh);
+    let input = mesh.check().map_err(|e| match e {
+        GridError::Mesh(e) => EncodeError::Input(e),
+        other => EncodeError::BadOption(other.to_string()),
+    })?;
     let check_seconds = started.elapsed().as_secs_f64();
     encode_checked(mesh, options, progress, input, check_seconds)
 }
@@ -331,7 +312,8 @@ fn encode_checked(
         ..SimplifyOptions::default()
     };
     let started = std::time::Instant::now();
-    let simplification = simplify_on(options.backend, mesh, &simplify_options, progress)
+    let checked = Checked::already(mesh, input);
+    let simplification = simplify_on(options.backend, &checked, &simplify_options, progress)
         .map_err(EncodeError::Backend)?;
     let simplify_seconds = started.elapsed().as_secs_f64();
     let started = std::time::Instant::now();

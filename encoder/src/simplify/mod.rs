@@ -34,18 +34,64 @@ mod select;
 mod state;
 
 pub use backend::{Backend, GpuError};
-pub use state::{Collapse, MAX_VALENCE, NO_SPLIT, Simplification, SimplifyOptions, simplify};
+pub use state::{Collapse, MAX_VALENCE, NO_SPLIT, Simplification, SimplifyOptions};
+
+use crate::input::MeshStats;
+use crate::quantize::{GridError, QuantizedMesh};
+
+/// A quantized mesh that passed [`QuantizedMesh::check`], the only way to
+/// hand one to the simplifier: its steps assume a consistently oriented
+/// manifold on the grid (the corner table indexes by the triangles'
+/// vertices, and a fin edge or a flipped triangle breaks the fan walks of
+/// its checks), so an unchecked mesh would panic or simplify into nonsense.
+#[derive(Clone, Copy, Debug)]
+pub struct Checked<'m> {
+    mesh: &'m QuantizedMesh,
+    stats: MeshStats,
+}
+
+impl<'m> Checked<'m> {
+    /// Checks `mesh` (its bits, its grid, then `check_mesh` in grid
+    /// coordinates).
+    pub fn new(mesh: &'m QuantizedMesh) -> Result<Checked<'m>, GridError> {
+        let stats = mesh.check()?;
+        Ok(Checked { mesh, stats })
+    }
+
+    /// A mesh whose check the caller has just made, with its result.
+    pub(crate) fn already(mesh: &'m QuantizedMesh, stats: MeshStats) -> Checked<'m> {
+        Checked { mesh, stats }
+    }
+
+    pub fn mesh(&self) -> &'m QuantizedMesh {
+        self.mesh
+    }
+
+    /// What the check found (vertices, edges, boundary loops, genus, …).
+    pub fn stats(&self) -> &MeshStats {
+        &self.stats
+    }
+}
+
+/// Simplifies a checked mesh with the parallel algorithm on the CPU.
+pub fn simplify(
+    mesh: &Checked<'_>,
+    options: &SimplifyOptions,
+    progress: impl FnMut(usize),
+) -> Simplification {
+    state::simplify(mesh.mesh, options, progress)
+}
 
 /// [`simplify`] on `backend`. The CPU backend never fails; a GPU backend
 /// fails when it is not compiled in, has no adapter, or its kernels fail.
 pub fn simplify_on(
     backend: Backend,
-    mesh: &crate::quantize::QuantizedMesh,
+    mesh: &Checked<'_>,
     options: &SimplifyOptions,
     progress: impl FnMut(usize),
 ) -> Result<Simplification, GpuError> {
     match backend.api() {
-        None => Ok(simplify(mesh, options, progress)),
-        Some(api) => gpu::simplify_gpu(api, mesh, options, progress),
+        None => Ok(state::simplify(mesh.mesh, options, progress)),
+        Some(api) => gpu::simplify_gpu(api, mesh.mesh, options, progress),
     }
 }

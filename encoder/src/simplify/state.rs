@@ -400,8 +400,9 @@ struct Winner {
     fans: (u32, u32, u32),
 }
 
-/// Simplifies `mesh` (quantized, checked manifold) with the parallel algorithm.
-pub fn simplify(
+/// Simplifies `mesh` (quantized, checked manifold: [`super::Checked`]) with
+/// the parallel algorithm.
+pub(crate) fn simplify(
     mesh: &QuantizedMesh,
     options: &SimplifyOptions,
     mut progress: impl FnMut(usize),
