@@ -1,6 +1,21 @@
 //! The encoder's input mesh: positions in f64 (so geographic coordinates
 //! survive until quantization) and counter-clockwise triangles.
 
+/// Triangle `t` rotated so that its smallest vertex comes first: the same
+/// oriented triangle, so two triangle lists describe the same oriented mesh
+/// when their canonical forms, sorted, are equal (how every round trip
+/// compares decode(encode(M)) with M).
+pub fn canonical_triangle(t: [u32; 3]) -> [u32; 3] {
+    let r = if t[0] <= t[1] && t[0] <= t[2] {
+        0
+    } else if t[1] <= t[2] {
+        1
+    } else {
+        2
+    };
+    [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
+}
+
 /// An indexed triangle mesh as read from a file, before checking.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {

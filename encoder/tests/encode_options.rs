@@ -112,3 +112,29 @@ fn the_edges_of_each_range_encode() {
         decode_all(&encoded.stream, false).expect("decodes");
     }
 }
+
+/// Found by the `encode_generated` fuzz target (2026-12-03): one level
+/// with a base size below the mesh (an icosphere of 162 vertices, `levels:
+/// 1`, `base_vertices: Some(86)`) planned level 0 to end at the base, and
+/// the replay failed with "replay ended with 80 vertices, the input has
+/// 162". The last level always ends at the whole mesh; with one level the
+/// base size has no effect.
+#[test]
+fn one_level_with_a_base_size_holds_the_whole_mesh() {
+    let mesh = common::icosphere(2);
+    for base in [0, 4, 86, 161, 162, 1000] {
+        let options = EncodeOptions {
+            levels: 1,
+            base_vertices: Some(base),
+            ..EncodeOptions::default()
+        };
+        let encoded = encode(&mesh, &options, |_| {}).expect("one level encodes");
+        assert_eq!(
+            encoded.level_vertex_counts,
+            [mesh.positions.len() as u32],
+            "base {base}"
+        );
+        let decoded = decode_all(&encoded.stream, false).expect("decodes");
+        assert_eq!(decoded.triangles.len(), mesh.triangles.len());
+    }
+}

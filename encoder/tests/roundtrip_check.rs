@@ -4,11 +4,7 @@
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode, quantize_for};
-
-fn canonical(t: [u32; 3]) -> [u32; 3] {
-    let r = (0..3).min_by_key(|&i| t[i]).unwrap();
-    [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
-}
+use splitstream_encoder::mesh::canonical_triangle as canonical;
 
 /// Encodes, decodes with decoder-core from the bytes alone, and compares.
 pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {

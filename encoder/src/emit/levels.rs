@@ -16,7 +16,8 @@ pub struct LevelPlan {
 
 /// Picks `levels` level boundaries (as numbers of rounds undone): level 0
 /// ends closest to `base_vertices`, the others are as close as possible to
-/// a geometric sequence from there to the full mesh.
+/// a geometric sequence from there to the full mesh. The last level always
+/// ends at the full mesh, so with one level `base_vertices` has no effect.
 pub fn plan_levels(s: &Simplification, levels: usize, base_vertices: usize) -> LevelPlan {
     let steps = s.steps.len();
     // Vertex count after undoing the last i steps (i = 0: the seed).
@@ -32,7 +33,11 @@ pub fn plan_levels(s: &Simplification, levels: usize, base_vertices: usize) -> L
             .unwrap_or(hi)
     };
     let refinement = (levels.max(1) - 1).min(steps);
-    let base_end = closest(0, steps - refinement, base_vertices as f64);
+    let base_end = if refinement == 0 {
+        steps
+    } else {
+        closest(0, steps - refinement, base_vertices as f64)
+    };
     let mut bounds = vec![base_end];
     let (base, full) = (counts[base_end].max(1.0), counts[steps].max(1.0));
     for i in 1..=refinement {

@@ -32,7 +32,9 @@ pub struct EncodeOptions {
     pub bits: u8,
     /// Levels of detail including the base mesh (the paper uses 5).
     pub levels: usize,
-    /// Base mesh size; by default `vertices / 2^(levels - 1)`.
+    /// Base mesh size (level 0 ends at the round nearest to it); by default
+    /// `vertices / 2^(levels - 1)`. No effect with one level, which holds
+    /// the whole mesh.
     pub base_vertices: Option<usize>,
     pub position_mode: PositionMode,
     /// Maximum quadric error of any collapse (stops simplification early).

@@ -22,6 +22,7 @@ use super::levels::LevelPlan;
 use super::policies::{SplitResiduals, choose_policy, code_policies};
 use super::wings::WingCoding;
 use crate::corner_table::Fan;
+use crate::mesh::canonical_triangle;
 use crate::prefetch::prefetch;
 use crate::quantize::QuantizedMesh;
 use crate::simplify::{Collapse, NO_SPLIT, Simplification};
@@ -559,16 +560,16 @@ fn check_exact(
             )));
         }
     }
-    let canonical = |t: [u32; 3]| {
-        let r = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
-        [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
-    };
     let mut decoded: Vec<[u32; 3]> = state
         .triangles()
         .par_iter()
-        .map(|t| canonical(t.map(|v| dec2enc[v as usize])))
+        .map(|t| canonical_triangle(t.map(|v| dec2enc[v as usize])))
         .collect();
-    let mut input: Vec<[u32; 3]> = mesh.triangles.par_iter().map(|&t| canonical(t)).collect();
+    let mut input: Vec<[u32; 3]> = mesh
+        .triangles
+        .par_iter()
+        .map(|&t| canonical_triangle(t))
+        .collect();
     // Two sorts of every triangle: in parallel, each itself parallel.
     rayon::join(|| decoded.par_sort_unstable(), || input.par_sort_unstable());
     if decoded != input {
