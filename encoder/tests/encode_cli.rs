@@ -166,3 +166,29 @@ fn a_decoded_glb_encodes_back_to_the_same_stream() {
     let err = one_line_error(&splitstream(&["decode", s, "-o", "out.gltf"]));
     assert!(err.contains("must end in .ply, .obj or .glb"), "{err}");
 }
+
+/// One level holds the whole mesh: `--base-vertices` is then noted as
+/// having no effect, and the stream is the whole raster in level 0.
+#[test]
+fn one_level_notes_that_the_base_size_has_no_effect() {
+    let input = raster();
+    let stream = input.with_file_name("one-level.sps");
+    let out = splitstream(&[
+        "encode",
+        input.to_str().unwrap(),
+        "-o",
+        stream.to_str().unwrap(),
+        "--levels",
+        "1",
+        "--base-vertices",
+        "20",
+    ]);
+    let stdout = succeeded(&out);
+    assert!(stdout.contains("120 vertices"), "{stdout}");
+    assert!(stdout.contains(", 1 levels,"), "{stdout}");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("note: --base-vertices has no effect with --levels 1"),
+        "{stderr}"
+    );
+}

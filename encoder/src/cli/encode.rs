@@ -27,7 +27,8 @@ pub struct Args {
     /// Levels of detail, base mesh included.
     #[arg(long, default_value_t = 5)]
     pub levels: usize,
-    /// Base mesh vertex count (default: vertices / 2^(levels-1)).
+    /// Base mesh vertex count (default: vertices / 2^(levels-1); no effect
+    /// with one level).
     #[arg(long)]
     pub base_vertices: Option<usize>,
     #[arg(long, value_enum, default_value_t = Position::Auto)]
@@ -106,6 +107,11 @@ pub fn run(a: Args) -> CliResult {
         deficits: a.coding.deficits(),
     };
     options.check().map_err(|e| e.to_string())?;
+    if options.levels == 1 && options.base_vertices.is_some() {
+        eprintln!(
+            "note: --base-vertices has no effect with --levels 1: the one level holds the whole mesh"
+        );
+    }
     let started = Instant::now();
     let read = ReadOptions {
         npz_array: a.npz_array.clone(),
