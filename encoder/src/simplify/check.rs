@@ -174,16 +174,32 @@ pub fn check_walked(
 
 /// Whether every triangle around `v` not containing `other` keeps a
 /// non-degenerate normal within 90° of its old one when `v` moves to `target`.
+/// A triangle that was degenerate (no normal: coincident or collinear
+/// corners, as coarse quantization and sliver-ridden input make them) is
+/// held to the normal of `v`'s whole fan instead; without that, one such
+/// triangle refused every collapse of its corners for good.
 fn keeps_orientation(s: &State, v: u32, other: u32, target: [f64; 3], fan: &Fan) -> bool {
     let t = &s.table;
     let pv = s.geometry(v);
+    let mut fan_normal: Option<[f64; 3]> = None;
     fan.corners.iter().all(|&c| {
         let (n1, n2) = (t.v(next(c)), t.v(prev(c)));
         if n1 == other || n2 == other {
             return true;
         }
         let (q1, q2) = (s.geometry(n1), s.geometry(n2));
-        let old = cross(sub(q1, pv), sub(q2, pv));
+        let (d1, d2) = (sub(q1, pv), sub(q2, pv));
+        let mut old = cross(d1, d2);
+        let old_scale = dot(d1, d1) + dot(d2, d2);
+        if dot(old, old) <= 1e-24 * old_scale * old_scale {
+            old = *fan_normal.get_or_insert_with(|| {
+                fan.corners.iter().fold([0.0; 3], |n, &c| {
+                    let (a, b) = (s.geometry(t.v(next(c))), s.geometry(t.v(prev(c))));
+                    let x = cross(sub(a, pv), sub(b, pv));
+                    [n[0] + x[0], n[1] + x[1], n[2] + x[2]]
+                })
+            });
+        }
         let (e1, e2) = (sub(q1, target), sub(q2, target));
         let new = cross(e1, e2);
         let scale = dot(e1, e1) + dot(e2, e2);

@@ -61,6 +61,8 @@ Eval evaluate(Topo t, __global const float *quadric, __global const Params *P, u
     return out;
 }
 
+/* The WGSL kernel's test, stricter than the CPU's: a triangle that had no
+ * normal (zero area) refuses, where the CPU holds it to the fan's normal. */
 bool keeps_orientation(Topo t, uint v, uint other, float3 target, uint3 origin) {
     float3 pv = rel(t, v, origin);
     uint first = fan_first(t, v);
