@@ -16,6 +16,19 @@ pub fn canonical_triangle(t: [u32; 3]) -> [u32; 3] {
     [t[r], t[(r + 1) % 3], t[(r + 2) % 3]]
 }
 
+/// `triangles`, with vertex `v` renamed `rename[v]`, in canonical form
+/// ([`canonical_triangle`]) and sorted: equal for two lists exactly when
+/// they hold the same oriented triangles (the round trips compare
+/// decode(encode(M)) with M this way, through the stream's permutation).
+pub fn sorted_canonical(triangles: &[[u32; 3]], rename: Option<&[u32]>) -> Vec<[u32; 3]> {
+    let mut out: Vec<[u32; 3]> = triangles
+        .iter()
+        .map(|&t| canonical_triangle(rename.map_or(t, |r| t.map(|v| r[v as usize]))))
+        .collect();
+    out.sort_unstable();
+    out
+}
+
 /// An indexed triangle mesh as read from a file, before checking.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {

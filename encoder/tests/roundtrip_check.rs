@@ -4,7 +4,7 @@
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode, quantize_for};
-use splitstream_encoder::mesh::canonical_triangle as canonical;
+use splitstream_encoder::mesh::sorted_canonical;
 
 /// Encodes, decodes with decoder-core from the bytes alone, and compares.
 pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {
@@ -27,14 +27,8 @@ pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {
             );
         }
     }
-    let mut got: Vec<[u32; 3]> = decoded
-        .triangles
-        .iter()
-        .map(|t| canonical(t.map(|v| encoded.permutation[v as usize])))
-        .collect();
-    let mut want: Vec<[u32; 3]> = mesh.triangles.iter().map(|&t| canonical(t)).collect();
-    got.sort_unstable();
-    want.sort_unstable();
+    let got = sorted_canonical(&decoded.triangles, Some(&encoded.permutation));
+    let want = sorted_canonical(&mesh.triangles, None);
     assert_eq!(got, want);
     assert_eq!(decoded.levels as usize, encoded.level_vertex_counts.len());
     encoded.stream.len()
