@@ -1,6 +1,6 @@
 //! The library's encode functions check their mesh themselves: a mesh that
-//! `input::check_mesh` refuses gets that typed error from `encode`,
-//! `encode_auto_position` and `encode_quantized`, never a panic, a hang or
+//! `input::check_mesh` refuses gets that typed error from `encode` and
+//! `encode_quantized`, never a panic, a hang or
 //! a stream of garbage. Before the check, a triangle naming a missing
 //! vertex panicked in the corner table, a non-manifold or flipped
 //! icosphere panicked in the simplifier's checks, and a NaN coordinate was
@@ -8,18 +8,21 @@
 
 mod common;
 
+use splitstream_decoder_core::PositionMode;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{
-    EncodeError, EncodeOptions, encode, encode_auto_position, encode_quantized, quantize_for,
+    EncodeError, EncodeOptions, encode, encode_quantized, quantize_for,
 };
 use splitstream_encoder::input::MeshError;
 
 /// Every entry point refuses `mesh` with the error `matches` accepts.
 fn refused(name: &str, mesh: &Mesh, matches: fn(&MeshError) -> bool) {
-    let options = EncodeOptions::default();
-    let by_encode = encode(mesh, &options, |_| {}).map(|_| ());
-    let by_auto = encode_auto_position(mesh, &options, |_| {}).map(|_| ());
-    for result in [by_encode, by_auto] {
+    for mode in [PositionMode::Constrained, PositionMode::Optimal] {
+        let options = EncodeOptions {
+            position_mode: mode,
+            ..EncodeOptions::default()
+        };
+        let result = encode(mesh, &options, |_| {}).map(|_| ());
         match result {
             Err(EncodeError::Input(e)) => assert!(matches(&e), "{name}: {e}"),
             Err(e) => panic!("{name}: another error: {e}"),

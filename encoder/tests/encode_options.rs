@@ -7,7 +7,7 @@ mod common;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::emit::{
-    EncodeError, EncodeOptions, encode, encode_auto_position, encode_quantized, quantize_for,
+    EncodeError, EncodeOptions, encode, encode_quantized, quantize_for,
 };
 
 fn refused(options: EncodeOptions, says: &str) {
@@ -15,7 +15,6 @@ fn refused(options: EncodeOptions, says: &str) {
     let quantized = quantize_for(&mesh, &EncodeOptions::default());
     for result in [
         encode(&mesh, &options, |_| {}).map(|_| ()),
-        encode_auto_position(&mesh, &options, |_| {}).map(|_| ()),
         encode_quantized(&quantized, &options, |_| {}).map(|_| ()),
     ] {
         match result {

@@ -23,12 +23,16 @@ fn grid_with_boundary_roundtrips() {
     assert_roundtrip(&mesh, &EncodeOptions::default());
 }
 
+/// The default is constrained mode (since 2026-12-03): the same meshes
+/// in optimal mode.
 #[test]
-fn constrained_mode_roundtrips() {
+fn optimal_mode_roundtrips() {
     let options = EncodeOptions {
-        position_mode: PositionMode::Constrained,
+        position_mode: PositionMode::Optimal,
         ..EncodeOptions::default()
     };
+    assert_roundtrip(&common::icosphere(3), &options);
+    assert_roundtrip(&common::bumpy_grid(23, 17, 1), &options);
     assert_roundtrip(&common::icosphere(2), &options);
     assert_roundtrip(&common::bumpy_grid(15, 12, 2), &options);
 }
@@ -224,12 +228,15 @@ fn rasters_keep_their_lattice_exactly() {
     let encoded = splitstream_encoder::emit::encode(&mesh, &constrained, |_| {}).unwrap();
     assert_eq!(encoded.on_lattice, [true; 3]);
     // Optimal mode ignores lattices unless asked; forced, it keeps them.
-    let optimal = EncodeOptions::default();
+    let optimal = EncodeOptions {
+        position_mode: PositionMode::Optimal,
+        ..EncodeOptions::default()
+    };
     let encoded = splitstream_encoder::emit::encode(&mesh, &optimal, |_| {}).unwrap();
     assert_eq!(encoded.on_lattice, [false; 3]);
     let forced = EncodeOptions {
         lattice: Some(Lattice::Keep),
-        ..EncodeOptions::default()
+        ..optimal.clone()
     };
     assert_roundtrip(&mesh, &forced);
     // And constrained mode can be told to ignore them.
@@ -243,33 +250,34 @@ fn rasters_keep_their_lattice_exactly() {
 }
 
 #[test]
-fn the_automatic_position_mode_follows_the_lattice() {
-    use splitstream_encoder::emit::encode_auto_position;
+fn the_default_position_mode_is_constrained_and_keeps_a_lattice() {
+    // A raster with whole-unit heights: x, y and z on a lattice.
     let mut raster = common::bumpy_grid(19, 13, 5);
     for p in &mut raster.positions {
         p[2] = (p[2] * 4.0).round();
     }
-    let options = EncodeOptions::default();
-    let (encoded, mode) = encode_auto_position(&raster, &options, |_| {}).unwrap();
-    assert_eq!(mode, PositionMode::Constrained);
+    let defaults = EncodeOptions::default();
+    assert_eq!(defaults.position_mode, PositionMode::Constrained);
+    let encoded = splitstream_encoder::emit::encode(&raster, &defaults, |_| {}).unwrap();
     assert_eq!(encoded.on_lattice, [true; 3]);
-    // The same stream as asking for constrained mode.
-    let constrained = EncodeOptions {
-        position_mode: PositionMode::Constrained,
-        ..EncodeOptions::default()
+    let header = splitstream_decoder_core::Header::parse(&encoded.stream).unwrap();
+    assert_eq!(header.position_mode, PositionMode::Constrained);
+    assert_roundtrip(&raster, &defaults);
+    // A mesh without a lattice: constrained too, and smaller than in
+    // optimal mode (one vector per split instead of two).
+    let sphere = common::icosphere(3);
+    let constrained = splitstream_encoder::emit::encode(&sphere, &defaults, |_| {}).unwrap();
+    let optimal = EncodeOptions {
+        position_mode: PositionMode::Optimal,
+        ..defaults
     };
-    let bytes = splitstream_encoder::emit::encode(&raster, &constrained, |_| {})
-        .unwrap()
-        .stream;
-    assert_eq!(encoded.stream, bytes);
-    // A mesh without a lattice: optimal mode, the same stream as asked for.
-    let sphere = common::icosphere(2);
-    let (encoded, mode) = encode_auto_position(&sphere, &options, |_| {}).unwrap();
-    assert_eq!(mode, PositionMode::Optimal);
-    let bytes = splitstream_encoder::emit::encode(&sphere, &options, |_| {})
-        .unwrap()
-        .stream;
-    assert_eq!(encoded.stream, bytes);
+    let optimal = splitstream_encoder::emit::encode(&sphere, &optimal, |_| {}).unwrap();
+    assert!(
+        constrained.stream.len() < optimal.stream.len(),
+        "{} < {}",
+        constrained.stream.len(),
+        optimal.stream.len()
+    );
 }
 
 /// Format 3.4: `max_chunk_len` bounds stored and deflate chunks only

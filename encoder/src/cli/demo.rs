@@ -3,7 +3,7 @@
 use std::time::Instant;
 
 use splitstream_decoder_core::owned::OwnedWorkspace;
-use splitstream_encoder::emit::{EncodeOptions, encode_auto_position};
+use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::fractal_terrain;
 
 use super::CliResult;
@@ -20,14 +20,13 @@ pub fn run(side: usize, output: Option<&std::path::Path>) -> CliResult {
         mesh.triangles.len(),
         started.elapsed().as_secs_f64()
     );
-    // As `splitstream encode` does with a raster: the position mode that
-    // suits the mesh, here constrained with x and y kept exactly on the
-    // raster's lattice (15.9 bits per vertex at side 1000, where optimal
-    // mode, which this command used until 2026-12-02, took 32.3).
+    // As `splitstream encode` does by default: constrained positions, x and
+    // y kept exactly on the raster's lattice (15.9 bits per vertex at side
+    // 1000, where optimal mode, which this command used until 2026-12-02,
+    // took 32.3).
     let options = EncodeOptions::default();
     let started = Instant::now();
-    let (encoded, mode) =
-        encode_auto_position(&mesh, &options, |_| {}).map_err(|e| e.to_string())?;
+    let encoded = encode(&mesh, &options, |_| {}).map_err(|e| e.to_string())?;
     let seconds = started.elapsed().as_secs_f64();
     let stream = &encoded.stream;
     if let Some(path) = output {
@@ -47,7 +46,7 @@ pub fn run(side: usize, output: Option<&std::path::Path>) -> CliResult {
     );
     println!(
         "{}",
-        super::encode::positions_line(mode, encoded.on_lattice)
+        super::encode::positions_line(options.position_mode, encoded.on_lattice)
     );
     let fail = |e: splitstream_decoder_core::Error| format!("demo stream: {e}");
     let mut ws = OwnedWorkspace::for_stream(stream).map_err(fail)?;

@@ -6,9 +6,7 @@ use std::time::Instant;
 use indicatif::{ProgressBar, ProgressStyle};
 use splitstream_decoder_core::PositionMode;
 use splitstream_encoder::Mesh;
-use splitstream_encoder::emit::{
-    EncodeError, EncodeOptions, SEED_VERTICES, encode, encode_auto_position,
-};
+use splitstream_encoder::emit::{EncodeError, EncodeOptions, SEED_VERTICES, encode};
 use splitstream_encoder::input::{ReadOptions, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::{Quantization, Units};
 
@@ -31,7 +29,7 @@ pub struct Args {
     /// with one level).
     #[arg(long)]
     pub base_vertices: Option<usize>,
-    #[arg(long, value_enum, default_value_t = Position::Auto)]
+    #[arg(long, value_enum, default_value_t = Position::Constrained)]
     pub position: Position,
     /// Largest quadric error a collapse may have.
     #[arg(long)]
@@ -85,7 +83,7 @@ pub fn run(a: Args) -> CliResult {
         levels: a.levels,
         base_vertices: a.base_vertices,
         position_mode: match a.position {
-            Position::Optimal | Position::Auto => PositionMode::Optimal,
+            Position::Optimal => PositionMode::Optimal,
             Position::Constrained => PositionMode::Constrained,
         },
         max_error: a.max_error,
@@ -140,12 +138,9 @@ pub fn run(a: Args) -> CliResult {
     );
     bar.set_message("simplifying");
     let progress = |done| bar.set_position(done as u64);
-    let result = match a.position {
-        Position::Auto => encode_auto_position(&mesh, &options, progress),
-        _ => encode(&mesh, &options, progress).map(|e| (e, options.position_mode)),
-    };
+    let result = encode(&mesh, &options, progress);
     bar.finish_and_clear();
-    let (encoded, mode) = result.map_err(|e| match e {
+    let encoded = result.map_err(|e| match e {
         EncodeError::Input(e) => format!("{}: {e}", a.input.display()),
         e => e.to_string(),
     })?;
@@ -186,7 +181,10 @@ pub fn run(a: Args) -> CliResult {
         encoded.level_vertex_counts.len(),
         encoded.rounds,
     );
-    println!("{}", positions_line(mode, encoded.on_lattice));
+    println!(
+        "{}",
+        positions_line(options.position_mode, encoded.on_lattice)
+    );
     println!(
         "time: read+check {:.2} s, simplify {:.2} s, emit {:.2} s",
         read_seconds + encoded.check_seconds,

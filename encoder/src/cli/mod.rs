@@ -32,13 +32,14 @@ pub struct Cli {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Position {
-    /// Constrained when an axis lies on the input's own lattice (a raster's
-    /// x and y), which constrained mode keeps exactly; optimal otherwise.
-    Auto,
-    /// Two deltas per split: the merged vertex anywhere (QEM optimum).
-    Optimal,
-    /// One delta and a placement code: the merged vertex on P, C or midway.
+    /// One delta and a placement code: the merged vertex on P, C or midway;
+    /// axes on the input's own lattice (a raster's x and y) kept exactly.
+    /// The smaller stream: 35-37 % below optimal mode on scanned meshes.
     Constrained,
+    /// Two deltas per split: the merged vertex anywhere (QEM optimum), for
+    /// clients limited by vertex count rather than bytes (coarse levels
+    /// 1.3-2.2x more accurate at the same vertex count).
+    Optimal,
 }
 
 /// How positions are quantized (the stream format is the same either way).

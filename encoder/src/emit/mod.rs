@@ -36,6 +36,15 @@ pub struct EncodeOptions {
     /// `vertices / 2^(levels - 1)`. No effect with one level, which holds
     /// the whole mesh.
     pub base_vertices: Option<usize>,
+    /// Constrained by default: every merged vertex on P, C or their
+    /// midpoint, one vector per split. Whole streams are 35–37 % smaller
+    /// than in optimal mode on the scanned meshes; at equal bytes the
+    /// decoded prefixes are about as accurate, except the first two of
+    /// bunny00 (optimal 1.3–1.4x more accurate), and optimal mode is
+    /// 1.3–2.2x more accurate at equal vertex counts: it suits clients
+    /// bounded by vertices rather than bytes (encoder/BENCHMARKS.md,
+    /// "Position modes: error against bytes"). Axes on a lattice are kept
+    /// exactly in constrained mode ([`EncodeOptions::lattice`]).
     pub position_mode: PositionMode,
     /// Maximum quadric error of any collapse (stops simplification early).
     pub max_error: Option<f64>,
@@ -77,7 +86,7 @@ impl Default for EncodeOptions {
             bits: 14,
             levels: 5,
             base_vertices: None,
-            position_mode: PositionMode::Optimal,
+            position_mode: PositionMode::Constrained,
             max_error: None,
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
@@ -158,40 +167,6 @@ fn timed_check(mesh: &Mesh) -> Result<(MeshStats, f64), EncodeError> {
     let started = std::time::Instant::now();
     let stats = check_mesh(mesh).map_err(EncodeError::Input)?;
     Ok((stats, started.elapsed().as_secs_f64()))
-}
-
-/// Encodes like [`encode`] in the position mode that suits the mesh
-/// (`options.position_mode` is ignored): constrained when the quantization
-/// can keep an axis on the input's own lattice (a raster: constrained mode
-/// keeps it exactly, and its streams were a third to a half the size of
-/// optimal mode's on the Jacksboro DEM), optimal otherwise. Returns the
-/// mode chosen with the stream.
-pub fn encode_auto_position(
-    mesh: &Mesh,
-    options: &EncodeOptions,
-    progress: impl FnMut(usize),
-) -> Result<(Encoded, PositionMode), EncodeError> {
-    options.check()?;
-    let (input, check_seconds) = timed_check(mesh)?;
-    // Quantized as constrained mode would: when no axis is on a lattice,
-    // that is also optimal mode's quantization (a lattice is all that
-    // differs), so the mesh is quantized once either way.
-    let constrained = EncodeOptions {
-        position_mode: PositionMode::Constrained,
-        ..options.clone()
-    };
-    let quantized = quantize_for(mesh, &constrained);
-    let mode = if quantized.on_lattice.contains(&true) {
-        PositionMode::Constrained
-    } else {
-        PositionMode::Optimal
-    };
-    let options = EncodeOptions {
-        position_mode: mode,
-        ..options.clone()
-    };
-    let encoded = encode_checked(&quantized, &options, progress, input, check_seconds)?;
-    Ok((encoded, mode))
 }
 
 /// Largest number of levels [`EncodeOptions::levels`] may ask for: each
