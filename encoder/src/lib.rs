@@ -10,5 +10,6 @@ mod prefetch;
 pub mod quadric;
 pub mod quantize;
 pub mod simplify;
+pub mod spatial_order;
 
 pub use mesh::Mesh;

@@ -17,8 +17,10 @@ use crate::input::{MeshError, MeshStats, check_mesh};
 use crate::mesh::Mesh;
 use crate::quantize::{GridError, Lattice, Quantization, QuantizedMesh, Units, quantize_with};
 use crate::simplify::{Backend, Checked, GpuError, SimplifyOptions, simplify_on};
+use crate::spatial_order::spatially_ordered;
 pub use levels::plan_levels;
 pub use replay::{ReplayError, replay};
+use std::borrow::Cow;
 pub use transcode::{TranscodeError, TranscodeOptions, Transcoded, transcode};
 
 /// Vertices the simplification aims for below the base mesh: a seed just
@@ -159,7 +161,13 @@ pub fn encode(
     options.check()?;
     let (input, check_seconds) = timed_check(mesh)?;
     let quantized = quantize_for(mesh, options);
-    encode_checked(&quantized, options, progress, input, check_seconds)
+    encode_checked(
+        Cow::Owned(quantized),
+        options,
+        progress,
+        input,
+        check_seconds,
+    )
 }
 
 /// `check_mesh` of `mesh`, and how long it took.
@@ -260,12 +268,14 @@ pub fn encode_quantized(
         other => EncodeError::BadOption(other.to_string()),
     })?;
     let check_seconds = started.elapsed().as_secs_f64();
-    encode_checked(mesh, options, progress, input, check_seconds)
+    encode_checked(Cow::Borrowed(mesh), options, progress, input, check_seconds)
 }
 
-/// [`encode_quantized`] of a mesh whose check passed with `input`.
+/// [`encode_quantized`] of a mesh whose check passed with `input`; an
+/// owned mesh is dropped once renumbered (36 bytes per vertex less at the
+/// encoder's peak).
 fn encode_checked(
-    mesh: &QuantizedMesh,
+    mesh: Cow<'_, QuantizedMesh>,
     options: &EncodeOptions,
     progress: impl FnMut(usize),
     input: MeshStats,
@@ -289,6 +299,12 @@ fn encode_checked(
         ..SimplifyOptions::default()
     };
     let started = std::time::Instant::now();
+    // Simplified and replayed in a spatial order (`spatial_order`: the
+    // passes' neighbours then share cache lines); the permutation is mapped
+    // back to the input's ids at the end.
+    let (ordered, order) = spatially_ordered(&mesh);
+    drop(mesh);
+    let mesh = &ordered;
     let checked = Checked::already(mesh, input);
     let simplification = simplify_on(options.backend, &checked, &simplify_options, progress)
         .map_err(EncodeError::Backend)?;
@@ -325,7 +341,11 @@ fn encode_checked(
     let stream = assemble_stream(&params, &replayed.levels, replayed.framed);
     Ok(Encoded {
         stream,
-        permutation: replayed.permutation,
+        permutation: replayed
+            .permutation
+            .into_iter()
+            .map(|v| order[v as usize])
+            .collect(),
         level_vertex_counts,
         rounds,
         simplify_seconds,
