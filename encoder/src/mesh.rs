@@ -1,6 +1,8 @@
 //! The encoder's input mesh: positions in f64 (so geographic coordinates
 //! survive until quantization) and counter-clockwise triangles.
 
+use rayon::prelude::*;
+
 /// Triangle `t` rotated so that its smallest vertex comes first: the same
 /// oriented triangle, so two triangle lists describe the same oriented mesh
 /// when their canonical forms, sorted, are equal (how every round trip
@@ -18,15 +20,42 @@ pub fn canonical_triangle(t: [u32; 3]) -> [u32; 3] {
 
 /// `triangles`, with vertex `v` renamed `rename[v]`, in canonical form
 /// ([`canonical_triangle`]) and sorted: equal for two lists exactly when
-/// they hold the same oriented triangles (the round trips compare
-/// decode(encode(M)) with M this way, through the stream's permutation).
+/// they hold the same oriented triangles (the encoder's exactness check and
+/// the round trips compare decode(encode(M)) with M this way, through the
+/// stream's permutation; the encoder orders its triangles so).
+///
+/// A counting sort on the first vertex, then each vertex's few triangles
+/// sorted: linear in the mesh (one sort of all 2M triangles of the 1M
+/// terrain took most of the exactness check's 0.3 s).
 pub fn sorted_canonical(triangles: &[[u32; 3]], rename: Option<&[u32]>) -> Vec<[u32; 3]> {
-    let mut out: Vec<[u32; 3]> = triangles
-        .iter()
+    let canonical: Vec<[u32; 3]> = triangles
+        .par_iter()
         .map(|&t| canonical_triangle(rename.map_or(t, |r| t.map(|v| r[v as usize]))))
         .collect();
-    out.sort_unstable();
-    out
+    let buckets = canonical
+        .par_iter()
+        .map(|t| t[0] as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let mut start = vec![0u32; buckets + 1];
+    for t in &canonical {
+        start[t[0] as usize + 1] += 1;
+    }
+    for k in 1..start.len() {
+        start[k] += start[k - 1];
+    }
+    let mut fill = start.clone();
+    let mut sorted = vec![[0u32; 3]; canonical.len()];
+    for t in &canonical {
+        let slot = &mut fill[t[0] as usize];
+        sorted[*slot as usize] = *t;
+        *slot += 1;
+    }
+    drop(fill);
+    for w in start.windows(2) {
+        sorted[w[0] as usize..w[1] as usize].sort_unstable();
+    }
+    sorted
 }
 
 /// An indexed triangle mesh as read from a file, before checking.
@@ -69,5 +98,59 @@ impl Mesh {
                 (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
             })
             .unwrap_or(0.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sort every triangle would get: what the buckets must equal.
+    fn by_full_sort(triangles: &[[u32; 3]], rename: Option<&[u32]>) -> Vec<[u32; 3]> {
+        let mut out: Vec<[u32; 3]> = triangles
+            .iter()
+            .map(|&t| canonical_triangle(rename.map_or(t, |r| t.map(|v| r[v as usize]))))
+            .collect();
+        out.sort_unstable();
+        out
+    }
+
+    #[test]
+    fn sorted_canonical_is_the_full_sort_of_the_canonical_triangles() {
+        // Pseudo-random triangles over 50 vertices, repeats and both
+        // orientations included, and a renaming.
+        let mut x = 12345u64;
+        let mut next = |n: u64| {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((x >> 33) % n) as u32
+        };
+        let triangles: Vec<[u32; 3]> = (0..400).map(|_| [next(50), next(50), next(50)]).collect();
+        let rename: Vec<u32> = (0..50).map(|v| (v * 17 + 3) % 50).collect();
+        assert_eq!(
+            sorted_canonical(&triangles, None),
+            by_full_sort(&triangles, None)
+        );
+        assert_eq!(
+            sorted_canonical(&triangles, Some(&rename)),
+            by_full_sort(&triangles, Some(&rename))
+        );
+        assert!(sorted_canonical(&[], None).is_empty());
+    }
+
+    #[test]
+    fn sorted_canonical_tells_orientation_and_rotation_apart() {
+        let a = [[0, 1, 2], [2, 1, 3]];
+        // The same oriented triangles, listed and rotated otherwise.
+        assert_eq!(
+            sorted_canonical(&a, None),
+            sorted_canonical(&[[1, 3, 2], [1, 2, 0]], None)
+        );
+        // One of them flipped.
+        assert_ne!(
+            sorted_canonical(&a, None),
+            sorted_canonical(&[[0, 2, 1], [2, 1, 3]], None)
+        );
     }
 }

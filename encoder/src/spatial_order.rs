@@ -20,7 +20,7 @@
 
 use rayon::prelude::*;
 
-use crate::mesh::canonical_triangle;
+use crate::mesh::sorted_canonical;
 use crate::quantize::QuantizedMesh;
 
 /// Bits per axis of the curve's keys (3 × 21 bits fit in a `u64`).
@@ -43,7 +43,7 @@ pub fn spatially_ordered(mesh: &QuantizedMesh) -> (QuantizedMesh, Vec<u32>) {
         .par_iter()
         .map(|&old| mesh.positions[old as usize])
         .collect();
-    let triangles = triangles_by_first_vertex(&mesh.triangles, &rank);
+    let triangles = sorted_canonical(&mesh.triangles, Some(&rank));
     (
         QuantizedMesh {
             positions,
@@ -102,38 +102,10 @@ fn spread(x: u64) -> u64 {
     (x | x << 2) & 0x1249_2492_4924_9249
 }
 
-/// The triangles with their vertices renamed by `rank`, each rotated to
-/// start at its smallest vertex, in ascending order: a counting sort on the
-/// first vertex, then each vertex's few triangles sorted.
-fn triangles_by_first_vertex(triangles: &[[u32; 3]], rank: &[u32]) -> Vec<[u32; 3]> {
-    let renamed: Vec<[u32; 3]> = triangles
-        .par_iter()
-        .map(|t| canonical_triangle(t.map(|v| rank[v as usize])))
-        .collect();
-    let mut start = vec![0u32; rank.len() + 1];
-    for t in &renamed {
-        start[t[0] as usize + 1] += 1;
-    }
-    for k in 1..start.len() {
-        start[k] += start[k - 1];
-    }
-    let mut fill = start.clone();
-    let mut sorted = vec![[0u32; 3]; renamed.len()];
-    for t in &renamed {
-        let slot = &mut fill[t[0] as usize];
-        sorted[*slot as usize] = *t;
-        *slot += 1;
-    }
-    for w in start.windows(2) {
-        sorted[w[0] as usize..w[1] as usize].sort_unstable();
-    }
-    sorted
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mesh::sorted_canonical;
+    use crate::mesh::canonical_triangle;
     use crate::quantize::{Lattice, Quantization, Units, quantize_with};
 
     fn quantized(mesh: &crate::Mesh) -> QuantizedMesh {

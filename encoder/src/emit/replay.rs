@@ -22,7 +22,7 @@ use super::levels::LevelPlan;
 use super::policies::{SplitResiduals, choose_policy, code_policies};
 use super::wings::WingCoding;
 use crate::corner_table::Fan;
-use crate::mesh::canonical_triangle;
+use crate::mesh::sorted_canonical;
 use crate::prefetch::prefetch;
 use crate::quantize::QuantizedMesh;
 use crate::simplify::{Collapse, NO_SPLIT, Simplification};
@@ -560,18 +560,10 @@ fn check_exact(
             )));
         }
     }
-    let mut decoded: Vec<[u32; 3]> = state
-        .triangles()
-        .par_iter()
-        .map(|t| canonical_triangle(t.map(|v| dec2enc[v as usize])))
-        .collect();
-    let mut input: Vec<[u32; 3]> = mesh
-        .triangles
-        .par_iter()
-        .map(|&t| canonical_triangle(t))
-        .collect();
-    // Two sorts of every triangle: in parallel, each itself parallel.
-    rayon::join(|| decoded.par_sort_unstable(), || input.par_sort_unstable());
+    let (decoded, input) = rayon::join(
+        || sorted_canonical(state.triangles(), Some(dec2enc)),
+        || sorted_canonical(&mesh.triangles, None),
+    );
     if decoded != input {
         return Err(ReplayError(
             "decoded triangles differ from the input".into(),
