@@ -22,18 +22,21 @@ use rayon::prelude::*;
 
 use crate::mesh::sorted_canonical;
 use crate::quantize::QuantizedMesh;
+use crate::simplify::Checked;
 
 /// Bits per axis of the curve's keys (3 × 21 bits fit in a `u64`).
 const KEY_BITS: u32 = 21;
 
-/// `mesh` renumbered: vertices in Z-order of their metric positions (ties
+/// A checked mesh (its indices in range, so the renaming cannot fail)
+/// renumbered: vertices in Z-order of their metric positions (ties
 /// by input id), each triangle rotated to start at its smallest new vertex
 /// (the same orientation), triangles in ascending order of their three
 /// vertices. Returns the renumbered mesh and `order`, where `order[new] =
 /// old`. Apart from vertices at one position, the result does not depend
 /// on how the input orders its vertices and triangles, or on which corner
 /// each triangle starts at: the same stream comes from any such file.
-pub fn spatially_ordered(mesh: &QuantizedMesh) -> (QuantizedMesh, Vec<u32>) {
+pub fn spatially_ordered(checked: &Checked<'_>) -> (QuantizedMesh, Vec<u32>) {
+    let mesh = checked.mesh();
     let order = vertex_order(mesh);
     let mut rank = vec![0u32; order.len()];
     for (new, &old) in order.iter().enumerate() {
@@ -108,6 +111,10 @@ mod tests {
     use crate::mesh::canonical_triangle;
     use crate::quantize::{Lattice, Quantization, Units, quantize_with};
 
+    fn renumbered(q: &QuantizedMesh) -> (QuantizedMesh, Vec<u32>) {
+        spatially_ordered(&Checked::new(q).expect("a valid mesh"))
+    }
+
     fn quantized(mesh: &crate::Mesh) -> QuantizedMesh {
         quantize_with(
             mesh,
@@ -145,7 +152,7 @@ mod tests {
     #[test]
     fn the_same_mesh_renamed_with_its_orientation() {
         let q = quantized(&raster(9, 7));
-        let (ordered, order) = spatially_ordered(&q);
+        let (ordered, order) = renumbered(&q);
         let mut seen = order.clone();
         seen.sort_unstable();
         assert_eq!(seen, (0..q.positions.len() as u32).collect::<Vec<_>>());
@@ -173,7 +180,7 @@ mod tests {
         // 16 × 16 samples 10 m apart, heights within 1.25 m: the curve's
         // first four vertices are one 2 × 2 block of samples.
         let q = quantized(&raster(16, 16));
-        let (ordered, _) = spatially_ordered(&q);
+        let (ordered, _) = renumbered(&q);
         let cells: Vec<(u32, u32)> = ordered.positions[..4]
             .iter()
             .map(|p| (p[0] / 1093, p[1] / 1093))
@@ -195,7 +202,7 @@ mod tests {
         for (i, t) in shuffled.triangles.iter_mut().enumerate() {
             t.rotate_left(i % 3);
         }
-        let (again, _) = spatially_ordered(&quantized(&shuffled));
+        let (again, _) = renumbered(&quantized(&shuffled));
         assert_eq!(again, ordered);
     }
 
@@ -206,7 +213,7 @@ mod tests {
             triangles: vec![[0, 1, 2]],
         };
         let q = quantized(&mesh);
-        let (ordered, order) = spatially_ordered(&q);
+        let (ordered, order) = renumbered(&q);
         assert_eq!(order, vec![0, 1, 2]);
         assert_eq!(ordered.triangles, vec![[0, 1, 2]]);
     }

@@ -255,8 +255,9 @@ fn median_decode_ms(stream: &[u8]) -> Result<f64, String> {
 
 /// The input quantized and in the spatial order the encoder simplifies it
 /// in (`spatial_order`; 2-10 ms on these meshes, outside the timed spans).
-fn quantized(input: &Input, mesh: &Mesh) -> QuantizedMesh {
-    spatially_ordered(&quantize(mesh, 14, input.units)).0
+fn quantized(input: &Input, mesh: &Mesh) -> Result<QuantizedMesh, String> {
+    let q = quantize(mesh, 14, input.units);
+    Ok(spatially_ordered(&checked(&q)?).0)
 }
 
 /// The quantized input in metric units, the geometry both simplifiers see.
@@ -293,7 +294,7 @@ fn quality_row(
     options: OptionsFor<'_>,
     backend: Backend,
 ) -> CliResult {
-    let q = quantized(input, mesh);
+    let q = quantized(input, mesh)?;
     let metric = QuantizedMesh {
         origin: [0.0; 3],
         scale: q.metric,
@@ -340,7 +341,7 @@ fn equal_error_row(
     options: OptionsFor<'_>,
     backend: Backend,
 ) -> CliResult {
-    let q = quantized(input, mesh);
+    let q = quantized(input, mesh)?;
     let reference = metric_mesh(&q);
     let target = mesh.positions.len() / 16;
     let c = checked(&q)?;

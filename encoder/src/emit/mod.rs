@@ -272,8 +272,9 @@ pub fn encode_quantized(
 }
 
 /// [`encode_quantized`] of a mesh whose check passed with `input`; an
-/// owned mesh is dropped once renumbered (36 bytes per vertex less at the
-/// encoder's peak).
+/// owned mesh is dropped once renumbered (about 35 bytes per vertex less
+/// at the encoder's peak: 703,620 -> 668,936 KB encoding the 1M terrain
+/// from a PLY file).
 fn encode_checked(
     mesh: Cow<'_, QuantizedMesh>,
     options: &EncodeOptions,
@@ -302,7 +303,7 @@ fn encode_checked(
     // Simplified and replayed in a spatial order (`spatial_order`: the
     // passes' neighbours then share cache lines); the permutation is mapped
     // back to the input's ids at the end.
-    let (ordered, order) = spatially_ordered(&mesh);
+    let (ordered, order) = spatially_ordered(&Checked::already(&mesh, input));
     drop(mesh);
     let mesh = &ordered;
     let checked = Checked::already(mesh, input);
