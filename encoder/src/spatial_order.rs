@@ -51,7 +51,13 @@ pub fn spatially_ordered(checked: &Checked<'_>) -> (QuantizedMesh, Vec<u32>) {
         QuantizedMesh {
             positions,
             triangles,
-            ..mesh.clone()
+            // Field by field: `..mesh.clone()` copied the whole mesh only
+            // to keep these.
+            bits: mesh.bits,
+            origin: mesh.origin,
+            scale: mesh.scale,
+            metric: mesh.metric,
+            on_lattice: mesh.on_lattice,
         },
         order,
     )
