@@ -540,6 +540,95 @@ pub fn coded_len_in(
         .sum()
 }
 
+/// [`coded_len_in`] of a substream that is still being written, costed
+/// chunk by chunk as its chunks fill up: an encoder weighing alternatives
+/// costs them while it writes them, off its critical path, and only the
+/// last chunk is left when the substream is complete. Under every codec but
+/// `Rans`, whose deflate trial weighs the whole substream (and which
+/// [`GrowingCodedLen::advance`] therefore leaves to
+/// [`GrowingCodedLen::finish`]), each chunk is coded on its own, so the sum
+/// is the same number.
+#[derive(Clone, Debug, Default)]
+pub struct GrowingCodedLen {
+    /// Chunks costed so far (the first ones).
+    chunks: usize,
+    /// Their payloads and directory entries.
+    bytes: usize,
+}
+
+impl GrowingCodedLen {
+    /// Costs the chunks of `sub` that later values can no longer change.
+    pub fn advance(
+        &mut self,
+        sub: &SubstreamWriter,
+        id: u8,
+        deficits: DeficitContexts,
+        params: &StreamParams,
+    ) {
+        let (units, limit) = match params.codec {
+            ChunkCodec::Rans { .. } => return,
+            ChunkCodec::RansAlways { .. } => {
+                (sub.symbols.len(), params.rans_chunk_limit.max(1) as usize)
+            }
+            // A bit substream's last byte takes more bits.
+            ChunkCodec::Stored | ChunkCodec::Deflate(_) => (
+                sub.bytes.len() - usize::from(sub.bit_count != 0),
+                params.chunk_limit.max(1) as usize,
+            ),
+        };
+        let contexts = context::count(id, deficits);
+        while (self.chunks + 1) * limit <= units {
+            self.bytes += single_chunk(sub, self.chunks, contexts, params)
+                .stored
+                .len()
+                + CHUNK_ENTRY_LEN;
+            self.chunks += 1;
+        }
+    }
+
+    /// [`coded_len_in`] of the complete substream `sub`, the one advanced.
+    pub fn finish(
+        &self,
+        sub: &SubstreamWriter,
+        id: u8,
+        deficits: DeficitContexts,
+        params: &StreamParams,
+    ) -> usize {
+        let contexts = context::count(id, deficits);
+        let count = match params.codec {
+            ChunkCodec::Rans { .. } => return coded_len_in(sub, id, deficits, params),
+            ChunkCodec::RansAlways { .. } => sub
+                .symbols
+                .len()
+                .div_ceil(params.rans_chunk_limit.max(1) as usize),
+            ChunkCodec::Stored | ChunkCodec::Deflate(_) => {
+                sub.bytes.len().div_ceil(params.chunk_limit.max(1) as usize)
+            }
+        };
+        self.bytes
+            + (self.chunks..count)
+                .map(|i| single_chunk(sub, i, contexts, params).stored.len() + CHUNK_ENTRY_LEN)
+                .sum::<usize>()
+    }
+}
+
+/// Chunk `i` of `sub` under a codec that codes each chunk on its own (not
+/// `Rans`).
+fn single_chunk(sub: &SubstreamWriter, i: usize, contexts: usize, params: &StreamParams) -> Chunk {
+    let limit = params.chunk_limit.max(1) as usize;
+    match params.codec {
+        ChunkCodec::Stored => byte_chunk(&sub.bytes, limit, None, i),
+        ChunkCodec::Deflate(l) => byte_chunk(&sub.bytes, limit, Some(l), i),
+        ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } => rans_chunk(
+            &sub.symbols,
+            params.rans_chunk_limit.max(1) as usize,
+            contexts,
+            lanes as usize,
+            i,
+        ),
+    }
+}
+
 /// One coded chunk before framing.
 pub struct Chunk {
     codec: u8,
@@ -551,21 +640,26 @@ pub struct Chunk {
 /// that is smaller than storing.
 fn byte_chunks(bytes: &[u8], limit: usize, level: Option<u8>, map: ChunkMap<'_>) -> Vec<Chunk> {
     map(bytes.len().div_ceil(limit), &|i| {
-        let raw = &bytes[i * limit..bytes.len().min((i + 1) * limit)];
-        let packed = level.map(|l| miniz_oxide::deflate::compress_to_vec(raw, l));
-        match packed {
-            Some(p) if p.len() < raw.len() => Chunk {
-                codec: codec::DEFLATE,
-                raw_len: raw.len() as u32,
-                stored: p,
-            },
-            _ => Chunk {
-                codec: codec::STORED,
-                raw_len: raw.len() as u32,
-                stored: raw.to_vec(),
-            },
-        }
+        byte_chunk(bytes, limit, level, i)
     })
+}
+
+/// Chunk `i` of [`byte_chunks`].
+fn byte_chunk(bytes: &[u8], limit: usize, level: Option<u8>, i: usize) -> Chunk {
+    let raw = &bytes[i * limit..bytes.len().min((i + 1) * limit)];
+    let packed = level.map(|l| miniz_oxide::deflate::compress_to_vec(raw, l));
+    match packed {
+        Some(p) if p.len() < raw.len() => Chunk {
+            codec: codec::DEFLATE,
+            raw_len: raw.len() as u32,
+            stored: p,
+        },
+        _ => Chunk {
+            codec: codec::STORED,
+            raw_len: raw.len() as u32,
+            stored: raw.to_vec(),
+        },
+    }
 }
 
 /// rANS chunks of at most `limit` values each, `contexts` tables each
@@ -578,11 +672,16 @@ fn rans_chunks(
     map: ChunkMap<'_>,
 ) -> Vec<Chunk> {
     map(symbols.len().div_ceil(limit), &|i| {
-        let values = &symbols[i * limit..symbols.len().min((i + 1) * limit)];
-        Chunk {
-            codec: codec::RANS,
-            raw_len: values.len() as u32,
-            stored: encode_chunk(values, contexts, lanes),
-        }
+        rans_chunk(symbols, limit, contexts, lanes, i)
     })
+}
+
+/// Chunk `i` of [`rans_chunks`].
+fn rans_chunk(symbols: &[Symbol], limit: usize, contexts: usize, lanes: usize, i: usize) -> Chunk {
+    let values = &symbols[i * limit..symbols.len().min((i + 1) * limit)];
+    Chunk {
+        codec: codec::RANS,
+        raw_len: values.len() as u32,
+        stored: encode_chunk(values, contexts, lanes),
+    }
 }

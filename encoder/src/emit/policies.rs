@@ -11,8 +11,10 @@
 use std::sync::mpsc::Receiver;
 
 use splitstream_decoder_core::limits::substream;
-use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, SubstreamWriter, coded_len};
-use splitstream_decoder_core::{Plane, PlanePolicy, PositionMode};
+use splitstream_decoder_core::writer::{
+    ChunkCodec, GrowingCodedLen, StreamParams, SubstreamWriter,
+};
+use splitstream_decoder_core::{DeficitContexts, Plane, PlanePolicy, PositionMode};
 
 use rayon::prelude::*;
 
@@ -57,19 +59,62 @@ pub struct PolicyResiduals {
     pub placement: SubstreamWriter,
     /// Every coded value fits in 32 bits.
     pub usable: bool,
+    /// The costs of `edge` and `placement` under the ranking parameters
+    /// ([`ranking_params`]), chunk by chunk as they fill up: the last
+    /// level's choice, which follows its replay, then only costs the last
+    /// chunks.
+    costs: [GrowingCodedLen; 2],
+}
+
+impl PolicyResiduals {
+    /// Costs the chunks that are complete; `optimal`: the placement
+    /// substream holds residuals too.
+    fn advance_costs(&mut self, optimal: bool, ranking: &StreamParams) {
+        let [edge, placement] = &mut self.costs;
+        edge.advance(&self.edge, substream::EDGE, DeficitContexts::Plain, ranking);
+        if optimal {
+            placement.advance(
+                &self.placement,
+                substream::PLACEMENT,
+                DeficitContexts::Plain,
+                ranking,
+            );
+        }
+    }
+
+    /// The substreams' cost under `ranking`, the parameters they were
+    /// advanced under: `coded_len` of `edge`, plus that of `placement` in
+    /// optimal mode.
+    fn cost(&self, optimal: bool, ranking: &StreamParams) -> usize {
+        let [edge, placement] = &self.costs;
+        let edge = edge.finish(&self.edge, substream::EDGE, DeficitContexts::Plain, ranking);
+        let placement = if optimal {
+            placement.finish(
+                &self.placement,
+                substream::PLACEMENT,
+                DeficitContexts::Plain,
+                ranking,
+            )
+        } else {
+            0
+        };
+        edge + placement
+    }
 }
 
 /// Codes the batches arriving on `batches` (a level's `splits` splits in
-/// split order) under every policy, or only `forced`; returns the
-/// substreams in `PlanePolicy::ALL` order (unused policies stay empty and
-/// unusable).
+/// split order) under every policy, or only `forced`, and costs them for
+/// [`choose_policy`] under `params`' ranking parameters as they grow;
+/// returns the substreams in `PlanePolicy::ALL` order (unused policies stay
+/// empty and unusable).
 pub fn code_policies(
     batches: Receiver<Vec<SplitResiduals>>,
-    mode: PositionMode,
+    params: &StreamParams,
     forced: Option<PlanePolicy>,
     splits: usize,
 ) -> Result<Vec<PolicyResiduals>, String> {
-    let optimal = mode == PositionMode::Optimal;
+    let optimal = params.position_mode == PositionMode::Optimal;
+    let ranking = ranking_params(params);
     // Room for every value from the start: growing six policies' vectors
     // by doubling copied and faulted in about a quarter of the encoder's
     // fresh pages on the 1M terrain. A residual's varint is mostly 1 or 2
@@ -86,6 +131,7 @@ pub fn code_policies(
                 usable: used,
                 edge: writer(used, 1),
                 placement: writer(used && optimal, 1),
+                costs: Default::default(),
             }
         })
         .collect();
@@ -102,6 +148,10 @@ pub fn code_policies(
                     residuals.usable &=
                         write_vector(&mut residuals.placement, &plane, second, split)?;
                 }
+            }
+            // A forced policy is not weighed.
+            if forced.is_none() && residuals.usable {
+                residuals.advance_costs(optimal, &ranking);
             }
         }
     }
@@ -178,13 +228,7 @@ pub fn choose_policy(
                 if forced.is_some() {
                     return 0;
                 }
-                let edge = coded_len(&r.edge, substream::EDGE, params);
-                let placement = if optimal {
-                    coded_len(&r.placement, substream::PLACEMENT, params)
-                } else {
-                    0
-                };
-                edge + placement
+                r.cost(optimal, params)
             })
         })
         .collect();
@@ -229,8 +273,9 @@ mod tests {
     #[test]
     fn every_policy_codes_what_coding_each_split_on_the_spot_gives() {
         let splits = splits();
-        let coded =
-            code_policies(batches(&splits), PositionMode::Optimal, None, splits.len()).unwrap();
+        let params = StreamParams::default();
+        assert_eq!(params.position_mode, PositionMode::Optimal);
+        let coded = code_policies(batches(&splits), &params, None, splits.len()).unwrap();
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(&coded) {
             assert!(residuals.usable);
             let (mut edge, mut placement) =
@@ -251,16 +296,41 @@ mod tests {
         }
     }
 
+    /// The costs kept while the batches arrive are what costing the whole
+    /// substreams gives (so the choice, and the stream, are the same).
+    #[test]
+    fn the_costs_kept_on_the_way_are_the_whole_costs() {
+        use splitstream_decoder_core::writer::coded_len;
+        for codec in [
+            ChunkCodec::Rans { lanes: 4 },
+            ChunkCodec::Deflate(10),
+            ChunkCodec::Stored,
+        ] {
+            let params = StreamParams {
+                codec,
+                chunk_limit: 9,
+                rans_chunk_limit: 7,
+                ..StreamParams::default()
+            };
+            let ranking = ranking_params(&params);
+            let splits = splits();
+            let coded = code_policies(batches(&splits), &params, None, splits.len()).unwrap();
+            for residuals in &coded {
+                let whole = coded_len(&residuals.edge, substream::EDGE, &ranking)
+                    + coded_len(&residuals.placement, substream::PLACEMENT, &ranking);
+                assert_eq!(residuals.cost(true, &ranking), whole, "{codec:?}");
+            }
+        }
+    }
+
     #[test]
     fn a_forced_policy_is_the_only_one_coded() {
         let forced = PlanePolicy::ALL[2];
-        let coded = code_policies(
-            batches(&splits()),
-            PositionMode::Constrained,
-            Some(forced),
-            40,
-        )
-        .unwrap();
+        let params = StreamParams {
+            position_mode: PositionMode::Constrained,
+            ..StreamParams::default()
+        };
+        let coded = code_policies(batches(&splits()), &params, Some(forced), 40).unwrap();
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(&coded) {
             assert_eq!(residuals.usable, *policy == forced);
             assert_eq!(residuals.edge.as_bytes().is_empty(), *policy != forced);

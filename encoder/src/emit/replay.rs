@@ -437,7 +437,7 @@ pub fn replay(
             // codes them under every plane policy.
             let (batches, coded_batches) = mpsc::channel();
             let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
-            let coder = scope.spawn(move || code_policies(coded_batches, mode, plane, splits));
+            let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
             let mut residuals = Vec::new();
             let mut round_splits = Vec::with_capacity(steps.len());
             for &k in steps {
