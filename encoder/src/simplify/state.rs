@@ -1886,6 +1886,15 @@ fn refresh_edges(
     choosers: &mut Vec<u32>,
     chunks: &mut Vec<RefreshChunk>,
 ) {
+    // The slots are written from the parallel part: each merged vertex
+    // writes the slots of its own edges, and the merged vertices of one
+    // step are never adjacent (their collapses' fans were disjoint), so no
+    // slot is written twice. Nothing in the parallel part reads the slots
+    // (the refreshed ones are computed, and rankings take them as
+    // arguments), so they are taken out of the state meanwhile. Debug
+    // builds check that the written slots are distinct.
+    let mut edges = std::mem::take(&mut s.edges);
+    let slots = Raw::new(&mut edges);
     let s_now: &State = s;
     let size = chunk_size(merged.len());
     let count = merged.len().div_ceil(size);
@@ -1915,14 +1924,20 @@ fn refresh_edges(
                 });
                 // The neighbours' quadrics are the evaluations' cache misses:
                 // ask for them all at once.
-                for &(x, _) in &edges {
+                for &(x, facing) in &edges {
                     prefetch(&s_now.quadrics, x as usize);
                     prefetch(&s_now.positions, x as usize);
+                    slots.prefetch(s_now.slot_index(facing));
                 }
                 let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
                 for &(x, facing) in &edges {
                     let slot = edge_slot(s_now, facing);
-                    out.updates.push((s_now.slot_index(facing) as u32, slot));
+                    let index = s_now.slot_index(facing);
+                    #[cfg(debug_assertions)]
+                    out.updates.push((index as u32, slot));
+                    // SAFETY: no other task writes or reads slot `index`
+                    // (see above).
+                    unsafe { slots.set(index, slot) };
                     out.offers.push(Offer { x, r, facing });
                     if let Some(ranking) = &mut ranking {
                         ranking.consider(x, facing, &slot);
@@ -1934,12 +1949,20 @@ fn refresh_edges(
             }
             out.measure_span();
         });
-    let mut chosen = chunks.iter().flat_map(|chunk| chunk.choices.iter());
-    for chunk in chunks.iter() {
-        for &(c, slot) in &chunk.updates {
-            s.edges[c as usize] = slot;
-        }
+    s.edges = edges;
+    #[cfg(debug_assertions)]
+    {
+        let mut written: Vec<u32> = chunks
+            .iter()
+            .flat_map(|c| c.updates.iter().map(|u| u.0))
+            .collect();
+        written.sort_unstable();
+        assert!(
+            written.windows(2).all(|w| w[0] != w[1]),
+            "a refreshed slot is written by two merged vertices"
+        );
     }
+    let mut chosen = chunks.iter().flat_map(|chunk| chunk.choices.iter());
     for &r in merged {
         let v = r as usize;
         t.changed[v] = next_state;
@@ -1963,8 +1986,9 @@ fn refresh_edges(
 }
 
 /// One chunk's part of a refresh, kept from step to step for its capacity:
-/// the refreshed slots (index, slot), the offers to the other ends, and the
-/// merged vertices' choices. The offers stay until the next step takes them.
+/// the refreshed slots (index, slot; debug builds only, to check that no two
+/// vertices write one slot), the offers to the other ends, and the merged
+/// vertices' choices. The offers stay until the next step takes them.
 #[derive(Default)]
 struct RefreshChunk {
     updates: Vec<(u32, EdgeSlot)>,
