@@ -349,6 +349,11 @@ struct Tracking {
     /// Pair key of each vertex's admitted request in the current pass,
     /// `u64::MAX` otherwise (reset after each pass, so never swept whole).
     keys: Vec<AtomicU64>,
+    /// `== pass`: the vertex was claimed by a task of [`choose`]'s pass
+    /// `pass` (a list of choosers may name a vertex twice).
+    claimed: Vec<AtomicU32>,
+    /// The last pass of [`choose`].
+    passes: u32,
 }
 
 impl Tracking {
@@ -367,6 +372,8 @@ impl Tracking {
             listed: vec![1; n],
             sorted: vec![0; n],
             keys: (0..n).map(|_| AtomicU64::new(u64::MAX)).collect(),
+            claimed: (0..n).map(|_| AtomicU32::new(0)).collect(),
+            passes: 0,
         }
     }
 
@@ -484,6 +491,7 @@ pub(crate) fn simplify(
                     t.second[v as usize] = None;
                 }
             }
+
             if debug {
                 eprintln!("rescale: {chose} of {} requests choose again", live.len());
             }
@@ -818,6 +826,8 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
             for key in &t.keys {
                 key.store(u64::MAX, Relaxed);
             }
+            // Older passes' claims: whatever they say, no pass claims again.
+            t.claimed.truncate(m);
         });
     });
     for v in choosers.iter_mut() {
@@ -1084,17 +1094,47 @@ fn part_size(n: usize) -> usize {
 
 /// §2 step a for `vertices`, in parallel: their requests are replaced.
 /// Returns the neighbours whose refused edges the choosers found reopened.
+///
+/// The requests are written from the parallel part, each by the task that
+/// picks it: a vertex listed twice (an end of an edge refused in the last
+/// step that a rescale lists again, or that a renumbering merged into
+/// another chooser) is claimed by one task, and a pick reads neither
+/// requests nor bounds. Its picks are the same whichever task makes them,
+/// and the reopened neighbours are the same set.
 fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u32) -> Vec<u32> {
-    let mut reopened = Vec::new();
-    for (picks, chunk_reopened) in pick_all(s, t, vertices, scale, state) {
-        for (v, choices) in picks {
-            t.best[v as usize] = choices.best;
-            t.second[v as usize] = choices.second;
-            t.bound[v as usize] = choices.bound;
+    t.passes += 1;
+    let pass = t.passes;
+    let known = Known {
+        state,
+        changed: &t.changed,
+        blocked: &t.blocked,
+    };
+    let claimed: &[AtomicU32] = &t.claimed;
+    let (best, second, bound) = (
+        Raw::new(&mut t.best),
+        Raw::new(&mut t.second),
+        Raw::new(&mut t.bound),
+    );
+    let reopened = par_chunks_map(vertices, |chunk| {
+        let mut reopened = Vec::new();
+        for (i, &v) in chunk.iter().enumerate() {
+            if claimed[v as usize].swap(pass, Relaxed) == pass {
+                continue;
+            }
+            prefetch_ahead(s, chunk, i);
+            let choices = pick_edge(s, v, scale, known, &mut reopened);
+            let v = v as usize;
+            // SAFETY: this task claimed vertex `v` in this pass, and no
+            // other code reads or writes requests and bounds meanwhile.
+            unsafe {
+                best.set(v, choices.best);
+                second.set(v, choices.second);
+                bound.set(v, choices.bound);
+            }
         }
-        reopened.extend(chunk_reopened);
-    }
-    reopened
+        reopened
+    });
+    reopened.concat()
 }
 
 /// Checks the requests of `vertices` that are not known to be valid and
