@@ -30,6 +30,7 @@
 mod backend;
 mod check;
 mod gpu;
+mod quantile;
 mod select;
 mod state;
 

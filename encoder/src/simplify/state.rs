@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicU32, AtomicU64};
 use rayon::prelude::*;
 
 use super::check::{CheckScratch, Plan, check_collapse, check_walked};
+use super::quantile::admission;
 use super::select::{
     Best, Choices, EdgeSlot, Known, Ranking, Scale, edge_slot, error_key, evaluate, offer,
     pair_key, pick_edge,
@@ -522,30 +523,21 @@ pub(crate) fn simplify(
         // lazy refusals.
         let validating = refusals.0 > VALIDATE_ABOVE * refusals.1;
         // Raise S to the admitted quantile of the current candidate errors.
-        let errors = &mut buffers.errors;
-        errors.clear();
-        errors.extend(
-            live.iter()
-                .map(|&v| &t.best[v as usize])
-                .filter(|b| b.other != NONE)
-                .map(|b| b.error),
-        );
-        if errors.is_empty() {
+        let tr: &Tracking = &t;
+        let candidate = |v: u32| {
+            let b = &tr.best[v as usize];
+            (b.other != NONE).then_some(b.error)
+        };
+        let Some(admission) = admission(&live, candidate, options.admit_quantile) else {
             break;
-        }
-        let q = ((errors.len() - 1) as f64 * options.admit_quantile.clamp(0.0, 1.0)) as usize;
-        let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
-        threshold = threshold.max(*quantile).min(limit);
-        let largest = errors.iter().copied().fold(0.0f64, f64::max);
+        };
+        threshold = threshold.max(admission.quantile).min(limit);
+        let largest = admission.largest;
         // Raising S starts from the smallest error above 0: errors of 0 pass
         // any S, and doubling up from the smallest positive float took about
         // a thousand empty steps (15 s on a DEM whose triangles were all
         // degenerate, where every candidate was refused).
-        let smallest = errors
-            .iter()
-            .copied()
-            .filter(|&e| e > 0.0)
-            .fold(f64::INFINITY, f64::min);
+        let smallest = admission.smallest_positive;
         let t_select = std::time::Instant::now();
         phases.lap("quantile");
         choosers.clear();
@@ -1274,7 +1266,6 @@ fn par_filter_into<T: Sync, U: Send>(
 /// Lists a step rebuilds, kept between steps for their capacity.
 #[derive(Default)]
 struct Buffers {
-    errors: Vec<f64>,
     players: Vec<u32>,
     spare: Vec<u32>,
     again: Vec<u32>,
