@@ -599,15 +599,7 @@ pub(crate) fn simplify(
         // The merged vertices choose under this step's scale; should the
         // next step measure edges again, its rescale sorts them like the
         // other requests.
-        refresh_edges(
-            &mut s,
-            &mut t,
-            &merged,
-            state + 1,
-            Some(scale),
-            &mut choosers,
-            &mut offers,
-        );
+        refresh_edges(&mut s, &mut t, &merged, state + 1, scale, &mut offers);
         phases.lap("refresh");
         live.retain(|&v| s.alive[v as usize]);
         phases.lap("retain");
@@ -1600,7 +1592,8 @@ fn step_winners(
         std::mem::swap(players, spare);
         phases.lap("retain players");
     }
-    winners.sort_unstable_by_key(|w| w.p);
+    // Survivor ids are distinct: any sort gives the one order.
+    winners.par_sort_unstable_by_key(|w| w.p);
     winners
 }
 
@@ -1904,17 +1897,16 @@ impl CornerAccess for TableView {
 /// refreshed edges as offers (into `offers`, see `take_offers`): no other
 /// vertex's request can change.
 ///
-/// The merged vertices choose here, from the slots just evaluated, when
-/// `scale` is the next step's (a pick then would see the same fresh slots,
-/// no refusal and nothing blocked); otherwise they are appended to
-/// `choosers`.
+/// The merged vertices choose here under `scale`, from the slots just
+/// evaluated (a pick at the next step would see the same fresh slots, no
+/// refusal and nothing blocked; should the next step measure edges again,
+/// its rescale sorts these requests like the others).
 fn refresh_edges(
     s: &mut State,
     t: &mut Tracking,
     merged: &[u32],
     next_state: u32,
-    scale: Option<Scale>,
-    choosers: &mut Vec<u32>,
+    scale: Scale,
     chunks: &mut Vec<RefreshChunk>,
 ) {
     // The slots are written from the parallel part: each merged vertex
@@ -1926,6 +1918,16 @@ fn refresh_edges(
     // builds check that the written slots are distinct.
     let mut edges = std::mem::take(&mut s.edges);
     let slots = Raw::new(&mut edges);
+    // So is each merged vertex's bookkeeping, by the task that refreshes it.
+    let mine = MergedView {
+        changed: Raw::new(&mut t.changed),
+        merged: Raw::new(&mut t.merged),
+        listed: Raw::new(&mut t.listed),
+        best: Raw::new(&mut t.best),
+        second: Raw::new(&mut t.second),
+        bound: Raw::new(&mut t.bound),
+        refusals: Raw::new(&mut t.refusals),
+    };
     let s_now: &State = s;
     let size = chunk_size(merged.len());
     let count = merged.len().div_ceil(size);
@@ -1960,7 +1962,7 @@ fn refresh_edges(
                     prefetch(&s_now.positions, x as usize);
                     slots.prefetch(s_now.slot_index(facing));
                 }
-                let mut ranking = scale.map(|scale| Ranking::new(s_now, r, scale));
+                let mut ranking = Ranking::new(s_now, r, scale);
                 for &(x, facing) in &edges {
                     let slot = edge_slot(s_now, facing);
                     let index = s_now.slot_index(facing);
@@ -1970,13 +1972,11 @@ fn refresh_edges(
                     // (see above).
                     unsafe { slots.set(index, slot) };
                     out.offers.push(Offer { x, r, facing });
-                    if let Some(ranking) = &mut ranking {
-                        ranking.consider(x, facing, &slot);
-                    }
+                    ranking.consider(x, facing, &slot);
                 }
-                if let Some(ranking) = ranking {
-                    out.choices.push(ranking.choices());
-                }
+                // SAFETY: merged vertices are distinct; only this task
+                // touches vertex `r`'s bookkeeping.
+                unsafe { mine.refreshed(r, next_state, ranking.choices()) };
             }
             out.measure_span();
         });
@@ -1993,38 +1993,54 @@ fn refresh_edges(
             "a refreshed slot is written by two merged vertices"
         );
     }
-    let mut chosen = chunks.iter().flat_map(|chunk| chunk.choices.iter());
-    for &r in merged {
-        let v = r as usize;
-        t.changed[v] = next_state;
-        t.merged[v] = next_state;
-        // Never listed already: merged vertices are not refused ends.
-        t.listed[v] = next_state;
-        match chosen.next() {
-            Some(choices) => {
-                t.best[v] = choices.best;
-                t.second[v] = choices.second;
-                t.bound[v] = choices.bound;
-                // Its edges are all fresh: nothing refused to forget.
-                t.refusals[v] = 0;
-            }
-            None => choosers.push(r),
-        }
-    }
     for o in chunks.iter().flat_map(|chunk| chunk.offers.iter()) {
         t.changed[o.x as usize] = next_state;
     }
 }
 
+/// The bookkeeping of the merged vertices, written by the refresh's tasks.
+#[derive(Clone, Copy)]
+struct MergedView {
+    changed: Raw<u32>,
+    merged: Raw<u32>,
+    listed: Raw<u32>,
+    best: Raw<Best>,
+    second: Raw<Option<Best>>,
+    bound: Raw<u32>,
+    refusals: Raw<u32>,
+}
+
+impl MergedView {
+    /// Merged vertex `r` is new in `next_state` (its 1-ring changed), and
+    /// its request is `choices`.
+    ///
+    /// # Safety
+    /// No other task reads or writes vertex `r`'s entries meanwhile.
+    unsafe fn refreshed(self, r: u32, next_state: u32, choices: Choices) {
+        let v = r as usize;
+        // SAFETY: the caller's promise.
+        unsafe {
+            self.changed.set(v, next_state);
+            self.merged.set(v, next_state);
+            // Never listed already: merged vertices are not refused ends.
+            self.listed.set(v, next_state);
+            self.best.set(v, choices.best);
+            self.second.set(v, choices.second);
+            self.bound.set(v, choices.bound);
+            // Its edges are all fresh: nothing refused to forget.
+            self.refusals.set(v, 0);
+        }
+    }
+}
+
 /// One chunk's part of a refresh, kept from step to step for its capacity:
 /// the refreshed slots (index, slot; debug builds only, to check that no two
-/// vertices write one slot), the offers to the other ends, and the merged
-/// vertices' choices. The offers stay until the next step takes them.
+/// vertices write one slot) and the offers to the other ends. The offers
+/// stay until the next step takes them.
 #[derive(Default)]
 struct RefreshChunk {
     updates: Vec<(u32, EdgeSlot)>,
     offers: Vec<Offer>,
-    choices: Vec<Choices>,
     /// The smallest and largest vertex the offers go to (`take_offers`
     /// skips the chunk in the parts of the vertex range it misses).
     span: (u32, u32),
@@ -2034,7 +2050,6 @@ impl RefreshChunk {
     fn clear(&mut self) {
         self.updates.clear();
         self.offers.clear();
-        self.choices.clear();
         self.span = (u32::MAX, 0);
     }
 
