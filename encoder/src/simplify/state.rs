@@ -1121,6 +1121,55 @@ fn choose(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u3
     reopened.concat()
 }
 
+/// Re-picks, within the step, the request of each of `vertices` whose
+/// partner a winner blocked: a vertex still on its unconstrained request
+/// whose runner-up is free takes it (everything else ranks after the
+/// runner-up); the others walk their fans again. In parallel, each task
+/// writing the re-picks it makes: a vertex listed twice (a refused end
+/// whose partner is also blocked) is claimed by one task, and its re-pick
+/// is the same whichever task makes it (a re-pick reads no re-pick).
+fn repick(s: &State, t: &mut Tracking, vertices: &[u32], scale: Scale, state: u32) {
+    t.passes += 1;
+    let pass = t.passes;
+    let known = Known {
+        state,
+        changed: &t.changed,
+        blocked: &t.blocked,
+    };
+    let (claimed, second): (&[AtomicU32], &[Option<Best>]) = (&t.claimed, &t.second);
+    let (repick, repick_at) = (Raw::new(&mut t.repick), Raw::new(&mut t.repick_at));
+    vertices
+        .par_chunks(chunk_size(vertices.len()))
+        .for_each(|chunk| {
+            let mut reopened = Vec::new();
+            for (i, &v) in chunk.iter().enumerate() {
+                if claimed[v as usize].swap(pass, Relaxed) == pass {
+                    continue;
+                }
+                let free = |b: &Best| {
+                    b.other == NONE
+                        || (known.blocked[b.other as usize].load(Relaxed) != state
+                            && !known.refused(s.slot(b.corner), v, b.other))
+                };
+                let v = v as usize;
+                // SAFETY (here and below): this task claimed vertex `v` in
+                // this pass; no other code reads or writes re-picks meanwhile.
+                let repicked = unsafe { repick_at.get(v) } == state;
+                let b = match second[v] {
+                    Some(b) if !repicked && free(&b) => b,
+                    _ => {
+                        prefetch_ahead(s, chunk, i);
+                        pick_edge(s, v as u32, scale, known, &mut reopened).best
+                    }
+                };
+                unsafe {
+                    repick.set(v, b);
+                    repick_at.set(v, state);
+                }
+            }
+        });
+}
+
 /// Checks the requests of `vertices` that are not known to be valid and
 /// stamps their slots; a vertex whose request is invalid chooses again
 /// (its request, or its overlay within the step), until every request is
@@ -1395,28 +1444,7 @@ fn step_winners(
             // minima.
             again.append(&mut refused_now);
             phases.lap("repick scan");
-            // A vertex still on its unconstrained request whose runner-up is
-            // free takes it: everything else ranks after the runner-up.
-            let known = t.known(state);
-            let mut walk = Vec::new();
-            let mut quick = Vec::new();
-            for &v in again.iter() {
-                let free = |b: &Best| {
-                    b.other == NONE
-                        || (t.blocked[b.other as usize].load(Relaxed) != state
-                            && !known.refused(s.slot(b.corner), v, b.other))
-                };
-                match t.second[v as usize] {
-                    Some(b) if t.repick_at[v as usize] != state && free(&b) => quick.push((v, b)),
-                    _ => walk.push(v),
-                }
-            }
-            let walked = pick_all(s, t, &walk, scale, state);
-            let walked = walked.into_iter().flat_map(|(picks, _)| picks);
-            for (v, b) in quick.into_iter().chain(walked.map(|(v, c)| (v, c.best))) {
-                t.repick[v as usize] = b;
-                t.repick_at[v as usize] = state;
-            }
+            repick(s, t, again, scale, state);
             phases.lap("repick");
             if validating {
                 validate(s, t, again, scale, state, refused_ends, tally);
