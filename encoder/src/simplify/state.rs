@@ -358,22 +358,31 @@ struct Tracking {
 }
 
 impl Tracking {
+    /// Arrays of zeros come zeroed from the allocator (their pages are
+    /// touched by the passes); the others are filled in parallel, which
+    /// also spreads their first page faults over the threads.
     fn new(n: usize) -> Tracking {
+        fn filled<T: Clone + Send + Sync>(n: usize, x: T) -> Vec<T> {
+            rayon::iter::repeat_n(x, n).collect()
+        }
+        fn atomics<T: Send>(n: usize, make: impl Fn() -> T + Sync + Send) -> Vec<T> {
+            (0..n).into_par_iter().map(|_| make()).collect()
+        }
         Tracking {
-            best: vec![Best::NONE; n],
-            second: vec![None; n],
-            bound: vec![u32::MAX; n],
-            repick: vec![Best::NONE; n],
+            best: filled(n, Best::NONE),
+            second: filled(n, None),
+            bound: filled(n, u32::MAX),
+            repick: filled(n, Best::NONE),
             repick_at: vec![0; n],
             changed: vec![0; n],
             merged: vec![0; n],
             refusals: vec![0; n],
-            blocked: (0..n).map(|_| AtomicU32::new(0)).collect(),
+            blocked: atomics(n, || AtomicU32::new(0)),
             // Every vertex is on the first step's list.
-            listed: vec![1; n],
+            listed: filled(n, 1),
             sorted: vec![0; n],
-            keys: (0..n).map(|_| AtomicU64::new(u64::MAX)).collect(),
-            claimed: (0..n).map(|_| AtomicU32::new(0)).collect(),
+            keys: atomics(n, || AtomicU64::new(u64::MAX)),
+            claimed: atomics(n, || AtomicU32::new(0)),
             passes: 0,
         }
     }
