@@ -735,23 +735,31 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
         meter,
         input,
     } = r;
-    input.save(s);
     let n = s.positions.len();
-    let mut vmap = vec![NONE; n];
-    for (i, &v) in live.iter().enumerate() {
-        vmap[v as usize] = i as u32;
-    }
-    for &(p, c) in pairs {
-        vmap[c as usize] = vmap[p as usize];
-    }
-    let mut tmap = vec![NONE; s.table.vertex.len() / 3];
-    let mut triangles = Vec::with_capacity(2 * live.len());
-    for (k, slot) in tmap.iter_mut().enumerate() {
-        if s.table.vertex[3 * k] != NONE {
-            *slot = triangles.len() as u32;
-            triangles.push(k as u32);
-        }
-    }
+    // The input arrays are saved beside the maps' serial scans (both only
+    // read the state).
+    let s_now: &State = s;
+    let ((), (vmap, (tmap, triangles))) = rayon::join(
+        || input.save(s_now),
+        || {
+            let mut vmap = vec![NONE; n];
+            for (i, &v) in live.iter().enumerate() {
+                vmap[v as usize] = i as u32;
+            }
+            for &(p, c) in pairs {
+                vmap[c as usize] = vmap[p as usize];
+            }
+            let mut tmap = vec![NONE; s_now.table.vertex.len() / 3];
+            let mut triangles = Vec::with_capacity(2 * live.len());
+            for (k, slot) in tmap.iter_mut().enumerate() {
+                if s_now.table.vertex[3 * k] != NONE {
+                    *slot = triangles.len() as u32;
+                    triangles.push(k as u32);
+                }
+            }
+            (vmap, (tmap, triangles))
+        },
+    );
     let cmap = |c: u32| {
         if c == NONE || tmap[(c / 3) as usize] == NONE {
             NONE
@@ -823,10 +831,8 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
             t.claimed.truncate(m);
         });
     });
-    for v in choosers.iter_mut() {
-        *v = vmap[*v as usize];
-    }
-    for chunk in offers.iter_mut() {
+    choosers.par_iter_mut().for_each(|v| *v = vmap[*v as usize]);
+    offers.par_iter_mut().for_each(|chunk| {
         for o in chunk.offers.iter_mut() {
             *o = Offer {
                 x: vmap[o.x as usize],
@@ -835,10 +841,10 @@ fn compact(s: &mut State, t: &mut Tracking, r: Renumbered<'_>) {
             };
         }
         chunk.measure_span();
-    }
+    });
     meter.triangles = meter
         .triangles
-        .iter()
+        .par_iter()
         .filter_map(|&k| Some(tmap[k as usize]).filter(|&k| k != NONE))
         .collect();
     *live = (0..m as u32).collect();
