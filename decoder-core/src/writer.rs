@@ -471,7 +471,8 @@ pub fn frame_level_with(
 /// smaller kept; the level-10 trial is skipped when a level-1 deflate is at
 /// least this ratio (3/2) of the rANS size. Measured on 2026-12-04 over the
 /// real meshes, the DEM and the 1M demo terrain (encoder/BENCHMARKS.md,
-/// Speed): level 10 was at most 1.34 times smaller than level 1, and it beat
+/// "Serial work off the critical path"): level 10 was at most 1.34 times
+/// smaller than level 1, and it beat
 /// rANS only where level 1 came within 1.07 of the rANS size (the seed's
 /// substreams, incompressible flags). At 5/3 the trial still ran on the
 /// last level's largest substreams, after its replay, on the emission's
