@@ -1959,8 +1959,8 @@ fn refresh_edges(
     // (the refreshed ones are computed, and rankings take them as
     // arguments), so they are taken out of the state meanwhile. Debug
     // builds check that the written slots are distinct.
-    let mut edges = std::mem::take(&mut s.edges);
-    let slots = Raw::new(&mut edges);
+    let mut taken_slots = std::mem::take(&mut s.edges);
+    let slots = Raw::new(&mut taken_slots);
     // So is each merged vertex's bookkeeping, by the task that refreshes it.
     let mine = MergedView {
         changed: Raw::new(&mut t.changed),
@@ -2023,7 +2023,7 @@ fn refresh_edges(
             }
             out.measure_span();
         });
-    s.edges = edges;
+    s.edges = taken_slots;
     #[cfg(debug_assertions)]
     {
         let mut written: Vec<u32> = chunks
