@@ -1347,7 +1347,10 @@ type Prepared = ([u32; 3], (u32, u32, u32));
 /// targets and their fans (offsets into `corners`).
 #[derive(Default)]
 struct Checked {
-    results: Vec<(u32, Result<Plan, ()>)>,
+    /// Each checked pair's survivor and request (read here, in the
+    /// parallel pass: the serial loop over the results then touches no
+    /// per-vertex array, which on the 4M terrain was a cache miss a pair).
+    results: Vec<(u32, Best, Result<Plan, ()>)>,
     prepared: Vec<Prepared>,
     corners: Vec<u32>,
 }
@@ -1562,7 +1565,7 @@ fn step_winners(
                         ),
                     ));
                 }
-                out.results.push((v, result));
+                out.results.push((v, *b, result));
             }
             out
         });
@@ -1581,8 +1584,7 @@ fn step_winners(
             let base = fans.len() as u32;
             fans.extend_from_slice(&out.corners);
             let mut prepared = out.prepared.iter();
-            for &(p, result) in &out.results {
-                let b = *t.request(p, state);
+            for &(p, b, result) in &out.results {
                 tally.checks += 1;
                 match result {
                     Ok(plan) => {
