@@ -78,12 +78,24 @@ impl Ring {
     /// A ring of the given neighbours, without corners (unit tests).
     #[cfg(test)]
     pub(crate) fn of_vertices(vertices: &[u32]) -> Ring {
-        let mut ring = Ring {
-            len: vertices.len(),
-            ..Ring::default()
-        };
-        ring.vertices[..vertices.len()].copy_from_slice(vertices);
+        let mut ring = Ring::default();
+        assert!(ring.set_vertices(vertices));
         ring
+    }
+
+    /// Makes this the ring of the given neighbours in ring order ([`NONE`]
+    /// for the ghost), without corners: for computations on a split's
+    /// entries away from the mesh state, with the entries renumbered (an
+    /// encoder hands them to another thread). `false`, and nothing changed,
+    /// when there are more than [`MAX_SPLIT_VALENCE`].
+    pub fn set_vertices(&mut self, vertices: &[u32]) -> bool {
+        let Some(slots) = self.vertices.get_mut(..vertices.len()) else {
+            return false;
+        };
+        slots.copy_from_slice(vertices);
+        self.corners[..vertices.len()].fill(NONE);
+        self.len = vertices.len();
+        true
     }
 
     /// Valence: ring length, the ghost counted (SPEC §6.1).

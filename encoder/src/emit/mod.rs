@@ -3,6 +3,7 @@
 //! split record is written exactly as that procedure asks for it.
 
 mod deficits;
+mod geometry;
 mod levels;
 mod policies;
 mod replay;

@@ -8,18 +8,18 @@ use splitstream_decoder_core::writer::{
     Chunk, FramedLevel, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level_with,
 };
 use splitstream_decoder_core::{
-    CornerRefs, DeficitContexts, Error, MeshState, Plane, PlanePolicy, PositionMode, RecordSource,
-    Ring, SplitFan, SplitOutcome, SplitRecord, StateMemory, Target, WingPolicy, add_residual,
-    arc_means, constrained_positions, context, predict, residual,
+    CornerRefs, DeficitContexts, Error, MeshState, PlanePolicy, PositionMode, RecordSource, Ring,
+    SplitOutcome, SplitRecord, StateMemory, WingPolicy, context,
 };
 
-use std::sync::mpsc;
+use std::sync::mpsc::{self, SyncSender};
 
 use rayon::prelude::*;
 
 use super::deficits::DeficitCoding;
+use super::geometry::{GeometryBatch, LevelGeometry, SplitGeometry, code_geometry};
 use super::levels::LevelPlan;
-use super::policies::{SplitResiduals, choose_policy, code_policies};
+use super::policies::{choose_policy, code_policies};
 use super::wings::WingCoding;
 use crate::corner_table::Fan;
 use crate::mesh::sorted_canonical;
@@ -117,21 +117,31 @@ struct StepSource<'a> {
     enc2dec: &'a mut [u32],
     dec2enc: &'a mut Vec<u32>,
     subs: &'a mut [SubstreamWriter],
-    /// The level's wings under every wing policy that may be chosen.
-    wing_coding: &'a mut WingCoding,
     /// The level's split-valence symbols in every choice of contexts.
     deficit_coding: &'a mut DeficitCoding,
-    /// The round's residual vectors, coded under every plane policy on
-    /// another thread (`policies`).
-    residuals: &'a mut Vec<SplitResiduals>,
-    mode: PositionMode,
-    /// Whether the policy `height` may be chosen: only then are the
-    /// height residuals worth computing (a surface search per vector).
-    heights: bool,
+    /// What the records take from the state for their wing ranks,
+    /// placement codes and residual vectors, gathered for another thread
+    /// (`geometry`) and sent to it by [`GEOMETRY_BATCH`] splits.
+    geometry: &'a mut GeometryBatch,
+    geometry_out: &'a SyncSender<GeometryBatch>,
     pending: Option<usize>,
     /// Whether the pending split gives the collapse's C index R (SPEC §7.4).
     swapped: bool,
     problem: Option<String>,
+}
+
+/// Splits sent to the geometry thread at once: small enough that the
+/// thread starts on a round while it is still replayed, and that little is
+/// held in flight (whole rounds took the 1M terrain's peak RSS from
+/// 707-727 MB to 735-765 MB).
+const GEOMETRY_BATCH: usize = 4096;
+
+/// Sends the splits gathered in `batch` to the geometry thread. A closed
+/// channel means that thread failed: its error is reported when it is joined.
+fn send_geometry(batch: &mut GeometryBatch, out: &SyncSender<GeometryBatch>) {
+    if !batch.splits.is_empty() {
+        let _ = out.send(std::mem::take(batch));
+    }
 }
 
 fn slot(id: u8) -> usize {
@@ -223,13 +233,6 @@ impl RecordSource for StepSource<'_> {
         if parent != col.position_r {
             return Err(self.fail(format!("position of {id} differs from its collapse")));
         }
-        // SPEC §7.4: the wings as ranks among the entries that may be
-        // wings, in ring order or in the near order of a wing policy.
-        if !self.wing_coding.write(state, ring, o, d) {
-            return Err(self.fail(format!(
-                "a wing of the collapse of {id} was a candidate at the start of its round"
-            )));
-        }
         self.deficit_coding.write(
             split_valence_symbol(dp, valence_p),
             split_valence_symbol(dc, valence_c),
@@ -237,73 +240,28 @@ impl RecordSource for StepSource<'_> {
             valence_p,
             valence_c,
         );
-        let s = &mut *self.subs;
-        let means = arc_means(state.positions(), parent, ring, o, d);
-        let wide = |x: [u32; 3]| x.map(|v| v as i64);
-        let sub = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] - b[i]) };
-        let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] + b[i]) };
-        let (origin, p_wide, c_wide) = (wide(parent), wide(p), wide(c));
-        let mode = self.mode;
-        let consistent;
-        let (first, second, height) = match mode {
-            PositionMode::Optimal => {
-                let p_hat = predict(&means, mode, Target::P);
-                let c_hat = predict(&means, mode, Target::C);
-                let rs = residual(sub(p_wide, origin), p_hat);
-                let rt = residual(sub(c_wide, origin), c_hat);
-                // What the decoder will compute from the residuals (each
-                // plane policy's coding is checked to give them back).
-                consistent = add(origin, add_residual(p_hat, rs)) == p_wide
-                    && add(origin, add_residual(c_hat, rt)) == c_wide;
-                let height = if self.heights {
-                    [
-                        height_residual(state, parent, ring, Target::P, p_hat, sub(p_wide, origin)),
-                        height_residual(state, parent, ring, Target::C, c_hat, sub(c_wide, origin)),
-                    ]
-                } else {
-                    [0; 2]
-                };
-                (rs, rt, height)
-            }
-            PositionMode::Constrained => {
-                let e = sub(c_wide, p_wide);
-                let mid: [u32; 3] = std::array::from_fn(|i| (p_wide[i] + (e[i] >> 1)) as u32);
-                let (code, x) = if parent == p {
-                    (0, sub(c_wide, origin))
-                } else if parent == c {
-                    (1, sub(p_wide, origin))
-                } else if parent == mid {
-                    (2, e)
-                } else {
-                    return Err(self.fail(format!(
-                        "constrained position of {id} off P, C and midpoint"
-                    )));
-                };
-                s[slot(substream::PLACEMENT)].byte_in(context::placement(&means), code);
-                let target = Target::of_code(code).expect("codes 0..=2");
-                let prediction = predict(&means, mode, target);
-                let r = residual(x, prediction);
-                consistent = constrained_positions(parent, code, add_residual(prediction, r))
-                    == (p_wide, c_wide);
-                let height = if self.heights {
-                    height_residual(state, parent, ring, target, prediction, x)
-                } else {
-                    0
-                };
-                (r, [0; 3], [height, 0])
-            }
-        };
-        self.residuals.push(SplitResiduals {
-            normal: Plane::new(PlanePolicy::Dominant, &means).normal,
-            first,
-            second,
-            height,
+        // The rest of the record comes from the ring as it is now, at the
+        // start of the round: copied out for the geometry thread.
+        let positions = state.positions();
+        let batch = &mut *self.geometry;
+        batch.ring_positions.extend(
+            ring.vertices()
+                .iter()
+                .map(|&v| positions.get(v as usize).copied().unwrap_or_default()),
+        );
+        batch.splits.push(SplitGeometry {
             id,
+            o: o as u8,
+            d: d as u8,
+            k: k as u8,
+            boundary: ring.is_boundary(),
+            eligible: state.wing_candidates(ring),
+            parent,
+            p,
+            c,
         });
-        if !consistent {
-            return Err(self.fail(format!(
-                "the residuals of {id} do not decode to its positions"
-            )));
+        if batch.splits.len() == GEOMETRY_BATCH {
+            send_geometry(batch, self.geometry_out);
         }
         Ok(SplitRecord {
             wing_offset: o as u8,
@@ -330,24 +288,6 @@ impl RecordSource for StepSource<'_> {
             self.dec2enc.push(new);
         }
     }
-}
-
-/// The z of the residual of vector `x` under the plane policy `height`
-/// (SPEC §7.4, format 3.1).
-fn height_residual(
-    state: &MeshState<'_>,
-    parent: [u32; 3],
-    ring: &Ring,
-    target: Target,
-    prediction: [i64; 3],
-    x: [i64; 3],
-) -> i64 {
-    let fan = SplitFan {
-        positions: state.positions(),
-        parent,
-        ring,
-    };
-    fan.residual(PlanePolicy::Height, target, prediction, x)[2]
 }
 
 /// A level's payload and its framed bytes with its largest chunks
@@ -431,18 +371,22 @@ pub fn replay(
         let mut choosing = Vec::with_capacity(plan.rounds.len());
         for (l, steps) in plan.rounds.iter().enumerate() {
             let mut subs = vec![SubstreamWriter::default(); 7];
-            let mut wing_coding = WingCoding::new(wing_policy);
             let mut deficit_coding = DeficitCoding::new(deficit_contexts);
-            // The level's residuals go round by round to a thread that
-            // codes them under every plane policy.
+            // The level's split geometry goes round by round to a thread
+            // that codes the wings and computes the residual vectors, and
+            // they on to a thread that codes them under every plane policy.
             let (batches, coded_batches) = mpsc::channel();
             let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
             let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
-            let mut residuals = Vec::new();
+            let (geometry_batches, geometry_in) = mpsc::sync_channel(2);
+            let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
+            let wing_coding = WingCoding::new(wing_policy);
+            let geometry_coder = scope
+                .spawn(move || code_geometry(geometry_in, batches, wing_coding, mode, heights));
+            let mut geometry = GeometryBatch::default();
             let mut round_splits = Vec::with_capacity(steps.len());
             for &k in steps {
                 let collapses = &s.steps[k];
-                residuals.reserve_exact(collapses.len());
                 flagged.clear();
                 wings.clear();
                 let dec = |enc: u32| {
@@ -465,11 +409,9 @@ pub fn replay(
                     enc2dec: &mut enc2dec,
                     dec2enc: &mut dec2enc,
                     subs: &mut subs,
-                    wing_coding: &mut wing_coding,
                     deficit_coding: &mut deficit_coding,
-                    residuals: &mut residuals,
-                    mode,
-                    heights: plane.is_none_or(|p| p == PlanePolicy::Height),
+                    geometry: &mut geometry,
+                    geometry_out: &geometry_batches,
                     pending: None,
                     swapped: false,
                     problem: None,
@@ -483,15 +425,23 @@ pub fn replay(
                     current[r as usize] = NONE;
                 }
                 round_splits.push(collapses.len() as u32);
-                // A closed channel means the coder failed: its error is
-                // reported when it is joined.
-                let _ = batches.send(std::mem::take(&mut residuals));
             }
             let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
             let geometric_error = plan.errors[l];
-            drop(batches);
+            send_geometry(&mut geometry, &geometry_batches);
+            drop(geometry_batches);
             choosing.push(scope.spawn(move || {
                 let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
+                let LevelGeometry {
+                    wings: wing_coding,
+                    placement,
+                } = geometry_coder
+                    .join()
+                    .expect("coding the split geometry does not panic")
+                    .map_err(level_error)?;
+                if mode == PositionMode::Constrained {
+                    subs[slot(substream::PLACEMENT)] = placement;
+                }
                 let residuals = coder
                     .join()
                     .expect("coding residuals does not panic")
@@ -591,9 +541,9 @@ mod tests {
             current[d] = i as u32;
         }
         let mut subs = vec![SubstreamWriter::default(); 7];
-        let mut wing_coding = WingCoding::new(None);
         let mut deficit_coding = DeficitCoding::new(None);
-        let mut residuals = Vec::new();
+        let mut geometry = GeometryBatch::default();
+        let (geometry_out, _geometry_in) = mpsc::sync_channel(1);
         let mut source = StepSource {
             collapses: &[],
             wings: &[],
@@ -601,11 +551,9 @@ mod tests {
             enc2dec: &mut enc2dec,
             dec2enc: &mut dec2enc,
             subs: &mut subs,
-            wing_coding: &mut wing_coding,
             deficit_coding: &mut deficit_coding,
-            residuals: &mut residuals,
-            mode: PositionMode::Optimal,
-            heights: true,
+            geometry: &mut geometry,
+            geometry_out: &geometry_out,
             pending: None,
             swapped: false,
             problem: None,

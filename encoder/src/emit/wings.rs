@@ -7,7 +7,7 @@ use splitstream_decoder_core::wing_order::{NearKeys, near_keys, near_keys_both, 
 use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter, coded_len};
 
 use super::policies::ranking_params;
-use splitstream_decoder_core::{MeshState, Ring, WingCandidates, WingPolicy, context};
+use splitstream_decoder_core::{Ring, WingCandidates, WingPolicy, context};
 
 /// One level's wing ranks under every wing policy that may be chosen.
 #[derive(Clone)]
@@ -30,26 +30,25 @@ impl WingCoding {
     }
 
     /// Records the wings at ring positions `o` and `o + d` of the split of
-    /// `ring`, under each policy; `false` when they are not both eligible.
-    pub fn write(&mut self, state: &MeshState<'_>, ring: &Ring, o: usize, d: usize) -> bool {
-        let eligible: WingCandidates = state.wing_candidates(ring);
+    /// `ring`, whose entries `eligible` may be wings (the round-start rule,
+    /// `MeshState::wing_candidates`) and whose vertices have `positions`,
+    /// under each policy; `false` when they are not both eligible.
+    pub fn write(
+        &mut self,
+        positions: &[[u32; 3]],
+        ring: &Ring,
+        eligible: &WingCandidates,
+        o: usize,
+        d: usize,
+    ) -> bool {
         let ctx = context::wing(eligible.count());
         let k = ring.len();
-        // The near keys of both near policies in one pass over the ring
-        // (this runs on the replay's thread, the emission's critical path).
+        // The near keys of both near policies in one pass over the ring.
         let [near, near_xy] = &mut self.keys;
         let m = match (&self.coded[1], &self.coded[2]) {
-            (Some(_), Some(_)) => near_keys_both(state.positions(), ring, &eligible, near, near_xy),
-            (Some(_), None) => {
-                near_keys(state.positions(), ring, &eligible, WingPolicy::Near, near)
-            }
-            (None, Some(_)) => near_keys(
-                state.positions(),
-                ring,
-                &eligible,
-                WingPolicy::NearXy,
-                near_xy,
-            ),
+            (Some(_), Some(_)) => near_keys_both(positions, ring, eligible, near, near_xy),
+            (Some(_), None) => near_keys(positions, ring, eligible, WingPolicy::Near, near),
+            (None, Some(_)) => near_keys(positions, ring, eligible, WingPolicy::NearXy, near_xy),
             (None, None) => 0,
         };
         for (index, coded) in self.coded.iter_mut().enumerate() {

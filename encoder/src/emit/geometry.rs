@@ -1,0 +1,196 @@
+//! The geometry of a level's split records, coded on a thread of its own
+//! while the replay goes on: the wing ranks under every wing policy, the
+//! placement codes and the residual vectors (SPEC §7.4).
+//!
+//! All of it depends only on the split's ring as it is at the start of its
+//! round, which the replay copies out ([`SplitGeometry`]: the ring entries'
+//! positions, which of them may be wings, R's position, P's and C's): the
+//! replay's thread, the emission's critical path, then keeps only the
+//! decoder's own work and what the record's connectivity needs. The values
+//! written are those the replay wrote itself before (same streams): each
+//! computation runs on the copied entries, renumbered 0.. in ring order.
+
+use std::sync::mpsc::{Receiver, Sender};
+
+use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, NONE};
+use splitstream_decoder_core::writer::SubstreamWriter;
+use splitstream_decoder_core::{
+    Plane, PlanePolicy, PositionMode, Ring, SplitFan, Target, WingCandidates, add_residual,
+    arc_means, constrained_positions, context, predict, residual,
+};
+
+use super::policies::SplitResiduals;
+use super::wings::WingCoding;
+
+/// What a split's record takes from the state at the start of its round.
+#[derive(Clone, Copy, Debug)]
+pub struct SplitGeometry {
+    /// The collapse's vertex, for error messages.
+    pub id: u32,
+    /// The wings' ring positions (SPEC §7.4 `o`, `d`).
+    pub o: u8,
+    pub d: u8,
+    /// Ring length `k`; its entries' positions are the batch's next `k`.
+    pub k: u8,
+    /// Whether entry 0 is the ghost (a boundary vertex, SPEC §7.1).
+    pub boundary: bool,
+    /// The ring entries that may be wings.
+    pub eligible: WingCandidates,
+    /// Positions of R, P and C.
+    pub parent: [u32; 3],
+    pub p: [u32; 3],
+    pub c: [u32; 3],
+}
+
+/// One round's splits, in split order, and their rings' positions back to
+/// back (the ghost's slot holds anything).
+#[derive(Default)]
+pub struct GeometryBatch {
+    pub splits: Vec<SplitGeometry>,
+    pub ring_positions: Vec<[u32; 3]>,
+}
+
+/// A level's coded geometry: the wing ranks under every wing policy, and in
+/// constrained mode the placement substream.
+pub struct LevelGeometry {
+    pub wings: WingCoding,
+    pub placement: SubstreamWriter,
+}
+
+/// Codes the batches arriving on `batches` for one level and passes each
+/// round's residual vectors on to `residuals` (the plane policies' coder);
+/// `heights`: whether the residuals under `height` are worth computing.
+/// An error names the first split whose record does not give back its
+/// positions or whose wings may not be wings: an encoder bug.
+pub fn code_geometry(
+    batches: Receiver<GeometryBatch>,
+    residuals: Sender<Vec<SplitResiduals>>,
+    mut wings: WingCoding,
+    mode: PositionMode,
+    heights: bool,
+) -> Result<LevelGeometry, String> {
+    let mut placement = SubstreamWriter::default();
+    let mut ring = Ring::default();
+    // Local ids 0.. of the ring entries (the ghost is NONE).
+    let mut ids = [0u32; MAX_SPLIT_VALENCE];
+    for (i, id) in ids.iter_mut().enumerate() {
+        *id = i as u32;
+    }
+    for batch in batches {
+        let mut out = Vec::with_capacity(batch.splits.len());
+        let mut start = 0;
+        for g in &batch.splits {
+            let k = g.k as usize;
+            let positions = &batch.ring_positions[start..start + k];
+            start += k;
+            ids[0] = if g.boundary { NONE } else { 0 };
+            if !ring.set_vertices(&ids[..k]) {
+                return Err(format!("the ring of {} is too long", g.id));
+            }
+            let (o, d) = (g.o as usize, g.d as usize);
+            if !wings.write(positions, &ring, &g.eligible, o, d) {
+                return Err(format!(
+                    "a wing of the collapse of {} was a candidate at the start of its round",
+                    g.id
+                ));
+            }
+            out.push(split_residuals(
+                g,
+                positions,
+                &ring,
+                mode,
+                heights,
+                &mut placement,
+            )?);
+        }
+        // A closed channel means the coder failed: its error is reported
+        // when it is joined.
+        let _ = residuals.send(out);
+    }
+    Ok(LevelGeometry { wings, placement })
+}
+
+/// The residual vectors of split `g` (and in constrained mode its placement
+/// code, written to `placement`), from its ring's `positions`.
+fn split_residuals(
+    g: &SplitGeometry,
+    positions: &[[u32; 3]],
+    ring: &Ring,
+    mode: PositionMode,
+    heights: bool,
+    placement: &mut SubstreamWriter,
+) -> Result<SplitResiduals, String> {
+    let (parent, p, c) = (g.parent, g.p, g.c);
+    let means = arc_means(positions, parent, ring, g.o as usize, g.d as usize);
+    let wide = |x: [u32; 3]| x.map(|v| v as i64);
+    let sub = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] - b[i]) };
+    let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] + b[i]) };
+    let (origin, p_wide, c_wide) = (wide(parent), wide(p), wide(c));
+    let fan = SplitFan {
+        positions,
+        parent,
+        ring,
+    };
+    // The z of the residual of vector `x` under `height` (format 3.1).
+    let height = |target: Target, prediction: [i64; 3], x: [i64; 3]| -> i64 {
+        if heights {
+            fan.residual(PlanePolicy::Height, target, prediction, x)[2]
+        } else {
+            0
+        }
+    };
+    let consistent;
+    let (first, second, heights) = match mode {
+        PositionMode::Optimal => {
+            let p_hat = predict(&means, mode, Target::P);
+            let c_hat = predict(&means, mode, Target::C);
+            let rs = residual(sub(p_wide, origin), p_hat);
+            let rt = residual(sub(c_wide, origin), c_hat);
+            // What the decoder will compute from the residuals (each plane
+            // policy's coding is checked to give them back).
+            consistent = add(origin, add_residual(p_hat, rs)) == p_wide
+                && add(origin, add_residual(c_hat, rt)) == c_wide;
+            let h = [
+                height(Target::P, p_hat, sub(p_wide, origin)),
+                height(Target::C, c_hat, sub(c_wide, origin)),
+            ];
+            (rs, rt, h)
+        }
+        PositionMode::Constrained => {
+            let e = sub(c_wide, p_wide);
+            let mid: [u32; 3] = std::array::from_fn(|i| (p_wide[i] + (e[i] >> 1)) as u32);
+            let (code, x) = if parent == p {
+                (0, sub(c_wide, origin))
+            } else if parent == c {
+                (1, sub(p_wide, origin))
+            } else if parent == mid {
+                (2, e)
+            } else {
+                return Err(format!(
+                    "constrained position of {} off P, C and midpoint",
+                    g.id
+                ));
+            };
+            placement.byte_in(context::placement(&means), code);
+            let target = Target::of_code(code).expect("codes 0..=2");
+            let prediction = predict(&means, mode, target);
+            let r = residual(x, prediction);
+            consistent = constrained_positions(parent, code, add_residual(prediction, r))
+                == (p_wide, c_wide);
+            (r, [0; 3], [height(target, prediction, x), 0])
+        }
+    };
+    if !consistent {
+        return Err(format!(
+            "the residuals of {} do not decode to its positions",
+            g.id
+        ));
+    }
+    Ok(SplitResiduals {
+        normal: Plane::new(PlanePolicy::Dominant, &means).normal,
+        first,
+        second,
+        height: heights,
+        id: g.id,
+    })
+}
