@@ -10,7 +10,7 @@
 //! written are those the replay wrote itself before (same streams): each
 //! computation runs on the copied entries, renumbered 0.. in ring order.
 
-use std::sync::mpsc::{Receiver, Sender};
+use std::sync::mpsc::{self, Receiver, Sender, SyncSender};
 
 use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, NONE};
 use splitstream_decoder_core::writer::SubstreamWriter;
@@ -42,12 +42,80 @@ pub struct SplitGeometry {
     pub c: [u32; 3],
 }
 
-/// One round's splits, in split order, and their rings' positions back to
-/// back (the ghost's slot holds anything).
+/// Consecutive splits of a level, in split order, and their rings'
+/// positions back to back (the ghost's slot holds anything).
 #[derive(Default)]
 pub struct GeometryBatch {
     pub splits: Vec<SplitGeometry>,
     pub ring_positions: Vec<[u32; 3]>,
+}
+
+/// Splits sent to the geometry thread at once: small enough that the
+/// thread starts on a round while it is still replayed, and that little is
+/// held in flight (whole rounds took the 1M terrain's peak RSS from
+/// 707-727 MB to 735-765 MB).
+const GEOMETRY_BATCH: usize = 4096;
+
+impl GeometryBatch {
+    pub fn new() -> GeometryBatch {
+        GeometryBatch {
+            splits: Vec::with_capacity(GEOMETRY_BATCH),
+            // Valence 6 mostly, 7 or 8 for boundaries and irregular meshes.
+            ring_positions: Vec::with_capacity(8 * GEOMETRY_BATCH),
+        }
+    }
+
+    /// Whether the batch is due to be sent.
+    pub fn is_full(&self) -> bool {
+        self.splits.len() >= GEOMETRY_BATCH
+    }
+}
+
+/// The replay's end of the geometry thread's channels: full batches go,
+/// and come back emptied to be filled again (fresh ones, allocated and
+/// their pages faulted in every few thousand splits, cost the replay's
+/// thread more than the copies themselves).
+pub struct GeometrySender {
+    full: SyncSender<GeometryBatch>,
+    spent: Receiver<GeometryBatch>,
+}
+
+/// The geometry thread's end ([`code_geometry`]).
+pub struct GeometryReceiver {
+    full: Receiver<GeometryBatch>,
+    spent: Sender<GeometryBatch>,
+}
+
+/// The two ends of a level's geometry channels.
+pub fn geometry_channels() -> (GeometrySender, GeometryReceiver) {
+    let (full_out, full_in) = mpsc::sync_channel(2);
+    let (spent_out, spent_in) = mpsc::channel();
+    (
+        GeometrySender {
+            full: full_out,
+            spent: spent_in,
+        },
+        GeometryReceiver {
+            full: full_in,
+            spent: spent_out,
+        },
+    )
+}
+
+impl GeometrySender {
+    /// Sends the splits gathered in `batch` (if any), leaving an empty
+    /// batch in its place. A closed channel means the geometry thread
+    /// failed: its error is reported when it is joined.
+    pub fn send(&self, batch: &mut GeometryBatch) {
+        if batch.splits.is_empty() {
+            return;
+        }
+        let next = self
+            .spent
+            .try_recv()
+            .unwrap_or_else(|_| GeometryBatch::new());
+        let _ = self.full.send(std::mem::replace(batch, next));
+    }
 }
 
 /// A level's coded geometry: the wing ranks under every wing policy, and in
@@ -63,7 +131,7 @@ pub struct LevelGeometry {
 /// An error names the first split whose record does not give back its
 /// positions or whose wings may not be wings: an encoder bug.
 pub fn code_geometry(
-    batches: Receiver<GeometryBatch>,
+    batches: GeometryReceiver,
     residuals: Sender<Vec<SplitResiduals>>,
     mut wings: WingCoding,
     mode: PositionMode,
@@ -76,7 +144,7 @@ pub fn code_geometry(
     for (i, id) in ids.iter_mut().enumerate() {
         *id = i as u32;
     }
-    for batch in batches {
+    for mut batch in batches.full {
         let mut out = Vec::with_capacity(batch.splits.len());
         let mut start = 0;
         for g in &batch.splits {
@@ -106,6 +174,9 @@ pub fn code_geometry(
         // A closed channel means the coder failed: its error is reported
         // when it is joined.
         let _ = residuals.send(out);
+        batch.splits.clear();
+        batch.ring_positions.clear();
+        let _ = batches.spent.send(batch);
     }
     Ok(LevelGeometry { wings, placement })
 }

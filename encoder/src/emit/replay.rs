@@ -12,12 +12,14 @@ use splitstream_decoder_core::{
     SplitOutcome, SplitRecord, StateMemory, WingPolicy, context,
 };
 
-use std::sync::mpsc::{self, SyncSender};
+use std::sync::mpsc;
 
 use rayon::prelude::*;
 
 use super::deficits::DeficitCoding;
-use super::geometry::{GeometryBatch, LevelGeometry, SplitGeometry, code_geometry};
+use super::geometry::{
+    GeometryBatch, GeometrySender, LevelGeometry, SplitGeometry, code_geometry, geometry_channels,
+};
 use super::levels::LevelPlan;
 use super::policies::{choose_policy, code_policies};
 use super::wings::WingCoding;
@@ -123,25 +125,11 @@ struct StepSource<'a> {
     /// placement codes and residual vectors, gathered for another thread
     /// (`geometry`) and sent to it by [`GEOMETRY_BATCH`] splits.
     geometry: &'a mut GeometryBatch,
-    geometry_out: &'a SyncSender<GeometryBatch>,
+    geometry_out: &'a GeometrySender,
     pending: Option<usize>,
     /// Whether the pending split gives the collapse's C index R (SPEC §7.4).
     swapped: bool,
     problem: Option<String>,
-}
-
-/// Splits sent to the geometry thread at once: small enough that the
-/// thread starts on a round while it is still replayed, and that little is
-/// held in flight (whole rounds took the 1M terrain's peak RSS from
-/// 707-727 MB to 735-765 MB).
-const GEOMETRY_BATCH: usize = 4096;
-
-/// Sends the splits gathered in `batch` to the geometry thread. A closed
-/// channel means that thread failed: its error is reported when it is joined.
-fn send_geometry(batch: &mut GeometryBatch, out: &SyncSender<GeometryBatch>) {
-    if !batch.splits.is_empty() {
-        let _ = out.send(std::mem::take(batch));
-    }
 }
 
 fn slot(id: u8) -> usize {
@@ -260,8 +248,8 @@ impl RecordSource for StepSource<'_> {
             p,
             c,
         });
-        if batch.splits.len() == GEOMETRY_BATCH {
-            send_geometry(batch, self.geometry_out);
+        if batch.is_full() {
+            self.geometry_out.send(batch);
         }
         Ok(SplitRecord {
             wing_offset: o as u8,
@@ -378,12 +366,12 @@ pub fn replay(
             let (batches, coded_batches) = mpsc::channel();
             let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
             let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
-            let (geometry_batches, geometry_in) = mpsc::sync_channel(2);
+            let (geometry_batches, geometry_in) = geometry_channels();
             let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
             let wing_coding = WingCoding::new(wing_policy);
             let geometry_coder = scope
                 .spawn(move || code_geometry(geometry_in, batches, wing_coding, mode, heights));
-            let mut geometry = GeometryBatch::default();
+            let mut geometry = GeometryBatch::new();
             let mut round_splits = Vec::with_capacity(steps.len());
             for &k in steps {
                 let collapses = &s.steps[k];
@@ -428,7 +416,7 @@ pub fn replay(
             }
             let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
             let geometric_error = plan.errors[l];
-            send_geometry(&mut geometry, &geometry_batches);
+            geometry_batches.send(&mut geometry);
             drop(geometry_batches);
             choosing.push(scope.spawn(move || {
                 let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
@@ -543,7 +531,7 @@ mod tests {
         let mut subs = vec![SubstreamWriter::default(); 7];
         let mut deficit_coding = DeficitCoding::new(None);
         let mut geometry = GeometryBatch::default();
-        let (geometry_out, _geometry_in) = mpsc::sync_channel(1);
+        let (geometry_out, _geometry_in) = geometry_channels();
         let mut source = StepSource {
             collapses: &[],
             wings: &[],
