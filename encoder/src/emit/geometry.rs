@@ -13,13 +13,13 @@
 use std::sync::mpsc::{self, Receiver, Sender, SyncSender};
 
 use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, NONE};
-use splitstream_decoder_core::writer::SubstreamWriter;
+use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter};
 use splitstream_decoder_core::{
     Plane, PlanePolicy, PositionMode, Ring, SplitFan, Target, WingCandidates, add_residual,
     arc_means, constrained_positions, context, predict, residual,
 };
 
-use super::policies::SplitResiduals;
+use super::policies::{SplitResiduals, early_choice_at};
 use super::wings::WingCoding;
 
 /// What a split's record takes from the state at the start of its round.
@@ -134,9 +134,15 @@ pub fn code_geometry(
     batches: GeometryReceiver,
     residuals: Sender<Vec<SplitResiduals>>,
     mut wings: WingCoding,
-    mode: PositionMode,
+    params: &StreamParams,
+    splits: usize,
     heights: bool,
 ) -> Result<LevelGeometry, String> {
+    let mode = params.position_mode;
+    // A large level's wing policy is chosen on its first eighth (unless
+    // forced: then there is nothing to choose).
+    let mut early = early_choice_at(splits);
+    let mut seen = 0;
     let mut placement = SubstreamWriter::default();
     let mut ring = Ring::default();
     // Local ids 0.. of the ring entries (the ghost is NONE).
@@ -174,6 +180,11 @@ pub fn code_geometry(
         // A closed channel means the coder failed: its error is reported
         // when it is joined.
         let _ = residuals.send(out);
+        seen += batch.splits.len();
+        if early.is_some_and(|at| seen >= at) {
+            early = None;
+            wings.choose_early(params);
+        }
         batch.splits.clear();
         batch.ring_positions.clear();
         let _ = batches.spent.send(batch);

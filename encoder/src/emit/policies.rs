@@ -102,11 +102,29 @@ impl PolicyResiduals {
     }
 }
 
+/// Levels of at least this many splits choose their plane policy, and
+/// their wing policy (`geometry.rs`), on their first eighth
+/// ([`early_choice_at`]) and code the rest under the chosen one only:
+/// weighing every alternative over every split was a fifth of the
+/// emission's work on the 1M terrain, and on large levels the first eighth
+/// (8,192 splits or more) ranks them as the whole level does (on every
+/// level of the 1M and 4M demo terrains and of the Jacksboro DEM, the
+/// choices and the streams stayed the same; BENCHMARKS.md). Smaller levels,
+/// where margins can be narrow and the work is small, weigh every split.
+pub const EARLY_CHOICE_SPLITS: usize = 65_536;
+
+/// After how many of its `splits` splits a level makes its early choice
+/// (see [`EARLY_CHOICE_SPLITS`]), if it makes one.
+pub fn early_choice_at(splits: usize) -> Option<usize> {
+    (splits >= EARLY_CHOICE_SPLITS).then_some(splits / 8)
+}
+
 /// Codes the batches arriving on `batches` (a level's `splits` splits in
 /// split order) under every policy, or only `forced`, and costs them for
 /// [`choose_policy`] under `params`' ranking parameters as they grow;
 /// returns the substreams in `PlanePolicy::ALL` order (unused policies stay
-/// empty and unusable).
+/// empty and unusable). A large level keeps only the cheapest policy once
+/// its first eighth is coded ([`EARLY_CHOICE_SPLITS`]).
 pub fn code_policies(
     batches: Receiver<Vec<SplitResiduals>>,
     params: &StreamParams,
@@ -135,9 +153,13 @@ pub fn code_policies(
             }
         })
         .collect();
+    // The policies still coded: all, or one once forced or chosen early.
+    let mut only = forced;
+    let mut early = forced.is_none().then(|| early_choice_at(splits)).flatten();
+    let mut seen = 0;
     for batch in batches {
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(out.iter_mut()) {
-            if forced.is_some_and(|f| f != *policy) {
+            if only.is_some_and(|f| f != *policy) {
                 continue;
             }
             for split in &batch {
@@ -149,9 +171,28 @@ pub fn code_policies(
                         write_vector(&mut residuals.placement, &plane, second, split)?;
                 }
             }
-            // A forced policy is not weighed.
-            if forced.is_none() && residuals.usable {
+            // A forced or chosen policy is not weighed.
+            if only.is_none() && residuals.usable {
                 residuals.advance_costs(optimal, &ranking);
+            }
+        }
+        seen += batch.len();
+        if early.is_some_and(|at| seen >= at) {
+            early = None;
+            // The cheapest so far, ties to the earlier policy (as
+            // `choose_policy`). Coded values fit in 32 bits by
+            // construction (both additions wrap, SPEC §7.4), so the
+            // policy kept stays usable.
+            let best = (0..out.len())
+                .filter(|&i| out[i].usable)
+                .min_by_key(|&i| (out[i].cost(optimal, &ranking), i));
+            if let Some(best) = best {
+                only = Some(PlanePolicy::ALL[best]);
+                for (i, residuals) in out.iter_mut().enumerate() {
+                    if i != best {
+                        *residuals = PolicyResiduals::default();
+                    }
+                }
             }
         }
     }
@@ -217,6 +258,8 @@ pub fn choose_policy(
     let optimal = params.position_mode == PositionMode::Optimal;
     let ranking = ranking_params(params);
     let params = &ranking;
+    // A single usable policy (forced, or chosen early) is not weighed.
+    let single = residuals.iter().filter(|r| r.usable).count() == 1;
     let costs: Vec<Option<usize>> = residuals
         .par_iter()
         .zip(PlanePolicy::ALL)
@@ -225,7 +268,7 @@ pub fn choose_policy(
                 return None;
             }
             r.usable.then(|| {
-                if forced.is_some() {
+                if forced.is_some() || single {
                     return 0;
                 }
                 r.cost(optimal, params)
@@ -321,6 +364,76 @@ mod tests {
                 assert_eq!(residuals.cost(true, &ranking), whole, "{codec:?}");
             }
         }
+    }
+
+    /// A level of `EARLY_CHOICE_SPLITS` splits or more keeps one policy
+    /// after its first eighth, codes it as forcing it would, and on
+    /// residuals whose statistics do not drift picks the policy the whole
+    /// level would.
+    #[test]
+    fn a_large_level_keeps_its_early_choice() {
+        use splitstream_decoder_core::writer::coded_len;
+        let n = EARLY_CHOICE_SPLITS + 1000;
+        // Residuals small along z after the plane's prediction for normals
+        // facing z: `z` should win (and under `off` z costs its full size).
+        let mut x = 0x9e37_79b9u64;
+        let mut next = |m: i64| {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((x >> 33) as i64 % (2 * m + 1)) - m
+        };
+        let splits: Vec<SplitResiduals> = (0..n)
+            .map(|i| {
+                let (a, b) = (next(60), next(60));
+                SplitResiduals {
+                    normal: [next(3), next(3), 4000],
+                    first: [a, b, next(2) + 300],
+                    second: [next(9), next(9), next(400)],
+                    height: [next(50), next(50)],
+                    id: i as u32,
+                }
+            })
+            .collect();
+        let params = StreamParams {
+            position_mode: PositionMode::Constrained,
+            ..StreamParams::default()
+        };
+        let ranking = ranking_params(&params);
+        let send = |splits: &[SplitResiduals]| {
+            let (tx, rx) = mpsc::channel();
+            for batch in splits.chunks(4096) {
+                tx.send(batch.to_vec()).unwrap();
+            }
+            rx
+        };
+        let early = code_policies(send(&splits), &params, None, n).unwrap();
+        assert_eq!(early.iter().filter(|r| r.usable).count(), 1);
+        let kept = early.iter().position(|r| r.usable).unwrap();
+        // Every policy forced, over the whole level.
+        let whole: Vec<(usize, Vec<u8>)> = PlanePolicy::ALL
+            .iter()
+            .map(|&p| {
+                let coded = code_policies(send(&splits), &params, Some(p), n).unwrap();
+                let r = coded.into_iter().find(|r| r.usable).unwrap();
+                (
+                    coded_len(&r.edge, substream::EDGE, &ranking),
+                    r.edge.as_bytes().to_vec(),
+                )
+            })
+            .collect();
+        let best = (0..whole.len()).min_by_key(|&i| (whole[i].0, i)).unwrap();
+        assert_eq!(
+            kept,
+            best,
+            "costs {:?}",
+            whole.iter().map(|w| w.0).collect::<Vec<_>>()
+        );
+        assert_eq!(early[kept].edge.as_bytes(), &whole[kept].1[..]);
+        // choose_policy takes it without weighing it again.
+        let mut subs = vec![SubstreamWriter::default(); 7];
+        let chosen = choose_policy(&mut subs, early, &params, None).unwrap();
+        assert_eq!(chosen, PlanePolicy::ALL[best]);
     }
 
     #[test]

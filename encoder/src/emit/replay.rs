@@ -369,8 +369,9 @@ pub fn replay(
             let (geometry_batches, geometry_in) = geometry_channels();
             let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
             let wing_coding = WingCoding::new(wing_policy);
-            let geometry_coder = scope
-                .spawn(move || code_geometry(geometry_in, batches, wing_coding, mode, heights));
+            let geometry_coder = scope.spawn(move || {
+                code_geometry(geometry_in, batches, wing_coding, params, splits, heights)
+            });
             let mut geometry = GeometryBatch::new();
             let mut round_splits = Vec::with_capacity(steps.len());
             for &k in steps {

@@ -68,6 +68,29 @@ impl WingCoding {
         true
     }
 
+    /// Keeps only the policy whose wing substreams code smallest so far,
+    /// ties to the earlier policy (a large level's early choice, see
+    /// `policies::EARLY_CHOICE_SPLITS`): later splits are written under it
+    /// alone.
+    pub fn choose_early(&mut self, params: &StreamParams) {
+        let ranking = ranking_params(params);
+        let best = (0..self.coded.len())
+            .filter_map(|i| {
+                let [offset, distance] = self.coded[i].as_ref()?;
+                let cost = coded_len(offset, substream::WING_OFFSET, &ranking)
+                    + coded_len(distance, substream::WING_DISTANCE, &ranking);
+                Some((cost, i))
+            })
+            .min();
+        if let Some((_, best)) = best {
+            for (i, coded) in self.coded.iter_mut().enumerate() {
+                if i != best {
+                    *coded = None;
+                }
+            }
+        }
+    }
+
     /// Puts the cheapest policy's wing substreams into `subs` (ids 1..=7 at
     /// 0..=6) and returns it; ties go to the earlier policy, so `ranks`
     /// (readable by 3.0 and 3.1 decoders) wins when nothing is gained.
