@@ -125,11 +125,13 @@ pub struct LevelGeometry {
     pub placement: SubstreamWriter,
 }
 
-/// Codes the batches arriving on `batches` for one level and passes each
-/// round's residual vectors on to `residuals` (the plane policies' coder);
-/// `heights`: whether the residuals under `height` are worth computing.
-/// An error names the first split whose record does not give back its
-/// positions or whose wings may not be wings: an encoder bug.
+/// Codes the batches arriving on `batches` for one level of `splits` splits
+/// and passes each batch's residual vectors on to `residuals` (the plane
+/// policies' coder); `heights`: whether the residuals under `height` are
+/// worth computing. A large level keeps one wing policy once its first
+/// eighth is coded (`policies::EARLY_CHOICE_SPLITS`). An error names the
+/// first split whose record does not give back its positions or whose
+/// wings may not be wings: an encoder bug.
 pub fn code_geometry(
     batches: GeometryReceiver,
     residuals: Sender<Vec<SplitResiduals>>,
@@ -222,7 +224,7 @@ fn split_residuals(
         }
     };
     let consistent;
-    let (first, second, heights) = match mode {
+    let (first, second, height_residuals) = match mode {
         PositionMode::Optimal => {
             let p_hat = predict(&means, mode, Target::P);
             let c_hat = predict(&means, mode, Target::C);
@@ -272,7 +274,7 @@ fn split_residuals(
         normal: Plane::new(PlanePolicy::Dominant, &means).normal,
         first,
         second,
-        height: heights,
+        height: height_residuals,
         id: g.id,
     })
 }

@@ -123,7 +123,7 @@ struct StepSource<'a> {
     deficit_coding: &'a mut DeficitCoding,
     /// What the records take from the state for their wing ranks,
     /// placement codes and residual vectors, gathered for another thread
-    /// (`geometry`) and sent to it by [`GEOMETRY_BATCH`] splits.
+    /// (`geometry`) and sent to it a batch at a time.
     geometry: &'a mut GeometryBatch,
     geometry_out: &'a GeometrySender,
     pending: Option<usize>,

@@ -75,12 +75,7 @@ impl WingCoding {
     pub fn choose_early(&mut self, params: &StreamParams) {
         let ranking = ranking_params(params);
         let best = (0..self.coded.len())
-            .filter_map(|i| {
-                let [offset, distance] = self.coded[i].as_ref()?;
-                let cost = coded_len(offset, substream::WING_OFFSET, &ranking)
-                    + coded_len(distance, substream::WING_DISTANCE, &ranking);
-                Some((cost, i))
-            })
+            .filter_map(|i| Some((cost(self.coded[i].as_ref()?, &ranking), i)))
             .min();
         if let Some((_, best)) = best {
             for (i, coded) in self.coded.iter_mut().enumerate() {
@@ -101,18 +96,17 @@ impl WingCoding {
             .into_iter()
             .zip(self.coded)
             .filter_map(|(p, c)| c.map(|c| (p, c)))
-            .min_by_key(|(p, [offset, distance])| {
-                let cost = if single {
-                    0
-                } else {
-                    coded_len(offset, substream::WING_OFFSET, &ranking)
-                        + coded_len(distance, substream::WING_DISTANCE, &ranking)
-                };
-                (cost, p.to_byte())
-            })
+            .min_by_key(|(p, coded)| (if single { 0 } else { cost(coded, &ranking) }, p.to_byte()))
             .expect("at least one wing policy is a choice");
         subs[(substream::WING_OFFSET - substream::FLAGS) as usize] = offset;
         subs[(substream::WING_DISTANCE - substream::FLAGS) as usize] = distance;
         policy
     }
+}
+
+/// Bytes a policy's wing-offset and wing-distance substreams take under the
+/// ranking parameters.
+fn cost([offset, distance]: &[SubstreamWriter; 2], ranking: &StreamParams) -> usize {
+    coded_len(offset, substream::WING_OFFSET, ranking)
+        + coded_len(distance, substream::WING_DISTANCE, ranking)
 }
