@@ -105,11 +105,12 @@ impl PolicyResiduals {
 /// Levels of at least this many splits choose their plane policy, and
 /// their wing policy (`geometry.rs`), on their first eighth
 /// ([`early_choice_at`]) and code the rest under the chosen one only:
-/// weighing every alternative over every split was a fifth of the
-/// emission's work on the 1M terrain, and on large levels the first eighth
-/// (8,192 splits or more) ranks them as the whole level does (on every
-/// level of the 1M and 4M demo terrains and of the Jacksboro DEM, the
-/// choices and the streams stayed the same; BENCHMARKS.md). Smaller levels,
+/// on the 1M terrain, forcing every policy instead of weighing them over
+/// every split took the emission from 1.02 to 0.89 s, and on large levels
+/// the first eighth (8,192 splits or more) ranks them as the whole level
+/// does (on every level of the 1M and 4M demo terrains and of the
+/// Jacksboro DEM, the choices and the streams stayed the same;
+/// BENCHMARKS.md). Smaller levels,
 /// where margins can be narrow and the work is small, weigh every split.
 pub const EARLY_CHOICE_SPLITS: usize = 65_536;
 

@@ -393,9 +393,9 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
     }
     // The three tables are independent and built at once (the whole check
     // of the 1M terrain 0.16 -> 0.13-0.14 s, BENCHMARKS.md 2026-12-04; the
-    // tables, about 150 MB there, are freed long before the encoder's
-    // peak). The checks still read them in the order of the rules, so the
-    // first fault reported is the same.
+    // tables, about 150 MB there by their element sizes, are freed long
+    // before the encoder's peak). The checks still read them in the order
+    // of the rules, so the first fault reported is the same.
     let ((vertex_sets, edges), links) = rayon::join(
         || rayon::join(|| sorted_vertex_sets(tris, nv), || edge_table(tris, nv)),
         || link_table(tris, nv),
