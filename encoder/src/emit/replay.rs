@@ -357,7 +357,15 @@ pub fn replay(
     let seed_ref = &seed;
     let done = std::thread::scope(|scope| -> Result<(Vec<LevelAndFrame>, u64), ReplayError> {
         let mut choosing = Vec::with_capacity(plan.rounds.len());
+        let mut input_sorted = None;
         for (l, steps) in plan.rounds.iter().enumerate() {
+            if l + 1 == plan.rounds.len() {
+                // The input's side of the exactness check needs nothing
+                // from the replay: it is sorted beside the last level,
+                // whose replay leaves the other core mostly idle once the
+                // level's policies are chosen.
+                input_sorted = Some(scope.spawn(|| sorted_canonical(&mesh.triangles, None)));
+            }
             let mut subs = vec![SubstreamWriter::default(); 7];
             let mut deficit_coding = DeficitCoding::new(deficit_contexts);
             // The level's split geometry goes round by round to a thread
@@ -460,7 +468,13 @@ pub fn replay(
         }
         // The replay is over: check it and hash it while the last levels
         // are still being chosen and framed.
-        let checked = check_exact(mesh, &state, &dec2enc).map(|()| state.state_hash());
+        let input_sorted =
+            input_sorted.map(|h| h.join().expect("sorting triangles does not panic"));
+        let (checked, hash) = rayon::join(
+            || check_exact(mesh, &state, &dec2enc, input_sorted),
+            || state.state_hash(),
+        );
+        let checked = checked.map(|()| hash);
         let levels = choosing
             .into_iter()
             .map(|h| h.join().expect("choosing a plane policy does not panic"))
@@ -480,10 +494,13 @@ pub fn replay(
 
 /// decode(encode(M)) == M: the refined state, mapped back to input ids, has
 /// exactly the input's oriented triangles and quantized positions.
+/// `input_sorted` is [`sorted_canonical`] of the input's triangles when
+/// the caller already has it.
 fn check_exact(
     mesh: &QuantizedMesh,
     state: &MeshState<'_>,
     dec2enc: &[u32],
+    input_sorted: Option<Vec<[u32; 3]>>,
 ) -> Result<(), ReplayError> {
     if state.vertex_count() as usize != mesh.positions.len() {
         return Err(ReplayError(format!(
@@ -501,7 +518,7 @@ fn check_exact(
     }
     let (decoded, input) = rayon::join(
         || sorted_canonical(state.triangles(), Some(dec2enc)),
-        || sorted_canonical(&mesh.triangles, None),
+        || input_sorted.unwrap_or_else(|| sorted_canonical(&mesh.triangles, None)),
     );
     if decoded != input {
         return Err(ReplayError(

@@ -396,9 +396,17 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
     // tables, about 150 MB there by their element sizes, are freed long
     // before the encoder's peak). The checks still read them in the order
     // of the rules, so the first fault reported is the same.
-    let ((vertex_sets, edges), links) = rayon::join(
-        || rayon::join(|| sorted_vertex_sets(tris, nv), || edge_table(tris, nv)),
-        || link_table(tris, nv),
+    // The components' union-find is serial; it runs beside the tables
+    // instead of after every check (its result is only reported once every
+    // rule holds).
+    let (((vertex_sets, edges), links), components) = rayon::join(
+        || {
+            rayon::join(
+                || rayon::join(|| sorted_vertex_sets(tris, nv), || edge_table(tris, nv)),
+                || link_table(tris, nv),
+            )
+        },
+        || count_components(tris, nv),
     );
     if let Some((t, earlier)) = first_duplicate(&vertex_sets, nv) {
         return Err(MeshError::DuplicateTriangle {
@@ -480,7 +488,6 @@ pub fn check_mesh(mesh: &Mesh) -> Result<MeshStats, MeshError> {
     drop(links);
 
     let boundary_loops = count_loops(&boundary_next);
-    let components = count_components(tris, nv);
     let euler = nv as i64 - edge_count as i64 + tris.len() as i64;
     Ok(MeshStats {
         vertices: nv,
