@@ -1,7 +1,8 @@
 //! The deficit contexts of a level (SPEC §5.1, §5.5.5, format 3.3): the
 //! replay writes each split's split-valence symbols in the contexts of
 //! every choice, and the level keeps the choice whose two substreams code
-//! smallest. The symbols are the same under both; only their contexts, and
+//! smallest (a large level on its first eighth, as it does its plane and
+//! wing policies). The symbols are the same under both; only their contexts, and
 //! so the number of frequency tables, differ: on a small level the tables of
 //! `valence` can cost more than its contexts save.
 
@@ -41,6 +42,26 @@ impl DeficitCoding {
         }
     }
 
+    /// Keeps only the cheapest choice so far (a large level's early
+    /// choice, `policies::EARLY_CHOICE_SPLITS`): the rest of the level is
+    /// written in its contexts only, and [`Self::choose`] has nothing left
+    /// to weigh.
+    pub fn choose_early(&mut self, params: &StreamParams) {
+        let ranking = ranking_params(params);
+        let best = DeficitContexts::ALL
+            .into_iter()
+            .zip(&self.coded)
+            .filter_map(|(d, coded)| Some((cost(coded.as_ref()?, d, &ranking), d.to_byte())))
+            .min();
+        if let Some((_, best)) = best {
+            for (d, coded) in DeficitContexts::ALL.into_iter().zip(&mut self.coded) {
+                if d.to_byte() != best {
+                    *coded = None;
+                }
+            }
+        }
+    }
+
     /// Puts the cheapest choice's substreams into `subs` (ids 1..=7 at
     /// 0..=6) and returns it; ties go to `plain`, which 3.2 decoders read.
     pub fn choose(self, subs: &mut [SubstreamWriter], params: &StreamParams) -> DeficitContexts {
@@ -50,20 +71,24 @@ impl DeficitCoding {
             .into_iter()
             .zip(self.coded)
             .filter_map(|(d, c)| c.map(|c| (d, c)))
-            .min_by_key(|(d, [p, c])| {
-                let cost = if single {
-                    0
-                } else {
-                    coded_len_in(p, substream::DEFICIT_P, *d, &ranking)
-                        + coded_len_in(c, substream::DEFICIT_C, *d, &ranking)
-                };
-                (cost, d.to_byte())
+            .min_by_key(|(d, coded)| {
+                (
+                    if single { 0 } else { cost(coded, *d, &ranking) },
+                    d.to_byte(),
+                )
             })
             .expect("at least one choice of deficit contexts");
         subs[(substream::DEFICIT_P - substream::FLAGS) as usize] = p;
         subs[(substream::DEFICIT_C - substream::FLAGS) as usize] = c;
         contexts
     }
+}
+
+/// Bytes a choice's deficit-p and deficit-c substreams take under the
+/// ranking parameters.
+fn cost([p, c]: &[SubstreamWriter; 2], contexts: DeficitContexts, ranking: &StreamParams) -> usize {
+    coded_len_in(p, substream::DEFICIT_P, contexts, ranking)
+        + coded_len_in(c, substream::DEFICIT_C, contexts, ranking)
 }
 
 #[cfg(test)]
@@ -88,6 +113,39 @@ mod tests {
         };
         assert_eq!(pick(5), DeficitContexts::Plain);
         assert_eq!(pick(5000), DeficitContexts::Valence);
+    }
+
+    /// An early choice keeps the cheaper contexts of the symbols so far, and
+    /// the level's substreams are then those that forcing it from the start
+    /// writes.
+    #[test]
+    fn an_early_choice_codes_as_forcing_it() {
+        let params = StreamParams::default();
+        let symbols = |i: usize| {
+            let valence = 4 + i % 5;
+            ((valence - 2 + (i / 5) % 2) as u8, valence)
+        };
+        let (n, early_at) = (20_000, 2_500);
+        let mut early = DeficitCoding::new(None);
+        let mut forced = DeficitCoding::new(Some(DeficitContexts::Valence));
+        for i in 0..n {
+            if i == early_at {
+                early.choose_early(&params);
+                assert_eq!(early.coded.iter().filter(|c| c.is_some()).count(), 1);
+            }
+            let (symbol, valence) = symbols(i);
+            early.write(symbol, symbol, 1, valence, valence);
+            forced.write(symbol, symbol, 1, valence, valence);
+        }
+        let (mut a, mut b) = (
+            vec![SubstreamWriter::default(); 7],
+            vec![SubstreamWriter::default(); 7],
+        );
+        assert_eq!(early.choose(&mut a, &params), DeficitContexts::Valence);
+        forced.choose(&mut b, &params);
+        for k in [3, 4] {
+            assert_eq!(a[k].symbols(), b[k].symbols());
+        }
     }
 
     #[test]

@@ -102,8 +102,9 @@ impl PolicyResiduals {
     }
 }
 
-/// Levels of at least this many splits choose their plane policy, and
-/// their wing policy (`geometry.rs`), on their first eighth
+/// Levels of at least this many splits choose their plane policy, their
+/// wing policy (`geometry.rs`) and their deficit contexts (`replay.rs`, after
+/// the round that completes the eighth), on their first eighth
 /// ([`early_choice_at`]) and code the rest under the chosen one only:
 /// on the 1M terrain, forcing every policy instead of weighing them over
 /// every split took the emission from 1.02 to 0.89 s, and on large levels
@@ -261,21 +262,29 @@ pub fn choose_policy(
     let params = &ranking;
     // A single usable policy (forced, or chosen early) is not weighed.
     let single = residuals.iter().filter(|r| r.usable).count() == 1;
-    let costs: Vec<Option<usize>> = residuals
-        .par_iter()
-        .zip(PlanePolicy::ALL)
-        .map(|(r, policy)| {
-            if forced.is_some_and(|f| f != policy) {
-                return None;
+    let cost = |(r, policy): (&PolicyResiduals, PlanePolicy)| {
+        if forced.is_some_and(|f| f != policy) {
+            return None;
+        }
+        r.usable.then(|| {
+            if forced.is_some() || single {
+                return 0;
             }
-            r.usable.then(|| {
-                if forced.is_some() || single {
-                    return 0;
-                }
-                r.cost(optimal, params)
-            })
+            r.cost(optimal, params)
         })
-        .collect();
+    };
+    // Nothing to weigh is not sent to the thread pool: at the last level
+    // the pool is busy with the exactness check, and this level's framing
+    // waited about 40 ms behind it for the answer (1M terrain).
+    let costs: Vec<Option<usize>> = if forced.is_some() || single {
+        residuals.iter().zip(PlanePolicy::ALL).map(cost).collect()
+    } else {
+        residuals
+            .par_iter()
+            .zip(PlanePolicy::ALL)
+            .map(cost)
+            .collect()
+    };
     let best = (0..costs.len())
         .filter(|&i| costs[i].is_some())
         .min_by_key(|&i| (costs[i], i))

@@ -21,7 +21,7 @@ use super::geometry::{
     GeometryBatch, GeometrySender, LevelGeometry, SplitGeometry, code_geometry, geometry_channels,
 };
 use super::levels::LevelPlan;
-use super::policies::{choose_policy, code_policies};
+use super::policies::{choose_policy, code_policies, early_choice_at};
 use super::wings::WingCoding;
 use crate::corner_table::Fan;
 use crate::mesh::sorted_canonical;
@@ -382,6 +382,11 @@ pub fn replay(
             });
             let mut geometry = GeometryBatch::new();
             let mut round_splits = Vec::with_capacity(steps.len());
+            // A large level chooses its deficit contexts after the round
+            // that completes its first eighth, as it chooses its plane and
+            // wing policies (`policies::EARLY_CHOICE_SPLITS`); the symbols
+            // after it are written in the chosen contexts only.
+            let (mut early, mut seen) = (early_choice_at(splits), 0);
             for &k in steps {
                 let collapses = &s.steps[k];
                 flagged.clear();
@@ -422,6 +427,11 @@ pub fn replay(
                     current[r as usize] = NONE;
                 }
                 round_splits.push(collapses.len() as u32);
+                seen += collapses.len();
+                if early.is_some_and(|at| seen >= at) {
+                    early = None;
+                    deficit_coding.choose_early(params);
+                }
             }
             let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
             let geometric_error = plan.errors[l];
