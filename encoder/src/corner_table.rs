@@ -104,7 +104,10 @@ impl CornerTable {
             );
             (a.min(b), a.max(b))
         };
-        let runs = rayon::current_num_threads().clamp(1, 16);
+        // Each run counts into an array of 4 bytes a vertex: at most 8 of
+        // them, so that a many-core machine adds at most 32 bytes a vertex,
+        // briefly, to an encoder that needs about 620.
+        let runs = rayon::current_num_threads().clamp(1, 8);
         let run_of = |r: usize| corners * r / runs..corners * (r + 1) / runs;
         let mut counts: Vec<Vec<u32>> = (0..runs)
             .into_par_iter()
