@@ -501,16 +501,17 @@ mod tests {
         // triangles), then the same with duplicated, flipped and degenerate
         // triangles and unused vertices: non-manifold edges, edges run the
         // same way twice, corners facing an edge from one vertex to itself.
-        let side = 40u32;
-        let mut tris = Vec::new();
-        for y in 0..side - 1 {
-            for x in 0..side - 1 {
-                let v = y * side + x;
-                tris.push([v, v + 1, v + side + 1]);
-                tris.push([v, v + side + 1, v + side]);
-            }
-        }
-        let n = (side * side + 7) as usize;
+        let side = 40;
+        let tris = crate::input::grid_to_mesh(&crate::input::Grid {
+            rows: side,
+            cols: side,
+            elevations: vec![0.0; side * side],
+            origin: [0.0; 2],
+            spacing: [1.0; 2],
+            nodata: None,
+        })
+        .triangles;
+        let n = side * side + 7;
         let mut soup = tris.clone();
         soup.extend([
             [0, 1, 41],
