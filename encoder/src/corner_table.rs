@@ -88,120 +88,15 @@ impl CornerTable {
     /// triangle only: then exactly the edges used once are left unmatched.
     pub fn build(vertex_count: usize, triangles: &[[u32; 3]]) -> (CornerTable, bool) {
         let vertex: Vec<u32> = bytemuck::cast_slice::<[u32; 3], u32>(triangles).to_vec();
-        let corners = vertex.len();
-        // Group the corners by the undirected edge they face; the corner's
-        // own direction (from `next` to `prev`) tells the two sides apart.
-        // A counting sort on the edge's lower vertex, then each short run
-        // sorted by (upper vertex, corner): the order `by_undirected_edge`
-        // gives, in 8 bytes an entry instead of 16. Counted and filled in
-        // parallel over runs of corners, each with its own counts, placed in
-        // the order one pass over all corners gives (a serial 85 ms of the
-        // 1M terrain's set-up before).
-        let lower = |c: usize| {
-            let (a, b) = (
-                vertex[next(c as u32) as usize],
-                vertex[prev(c as u32) as usize],
-            );
-            (a.min(b), a.max(b))
-        };
-        // Each run counts into an array of 4 bytes a vertex: at most 8 of
-        // them, so that a many-core machine adds at most 32 bytes a vertex,
-        // briefly, to an encoder that needs about 620.
+        // Each counting run takes an array of 4 bytes a vertex: at most 8
+        // of them, so that a many-core machine adds at most 32 bytes a
+        // vertex, briefly, to an encoder that needs about 620. (Built
+        // serially, the table was 85 ms of the 1M terrain's set-up.)
         let runs = rayon::current_num_threads().clamp(1, 8);
-        let run_of = |r: usize| corners * r / runs..corners * (r + 1) / runs;
-        let mut counts: Vec<Vec<u32>> = (0..runs)
-            .into_par_iter()
-            .map(|r| {
-                let mut count = vec![0u32; vertex_count];
-                for c in run_of(r) {
-                    count[lower(c).0 as usize] += 1;
-                }
-                count
-            })
-            .collect();
-        // Each run's first slot in each bucket: the buckets in vertex order,
-        // and within one the runs in corner order.
-        let mut start = vec![0u32; vertex_count + 1];
-        let mut at = 0u32;
-        for v in 0..vertex_count {
-            start[v] = at;
-            for count in counts.iter_mut() {
-                let k = count[v];
-                count[v] = at;
-                at += k;
-            }
-        }
-        start[vertex_count] = at;
-        let order: Vec<AtomicU64> = (0..corners)
-            .into_par_iter()
-            .map(|_| AtomicU64::new(0))
-            .collect();
-        counts.par_iter_mut().enumerate().for_each(|(r, slot)| {
-            for c in run_of(r) {
-                let (lo, hi) = lower(c);
-                let at = &mut slot[lo as usize];
-                order[*at as usize].store((u64::from(hi) << 32) | c as u64, Relaxed);
-                *at += 1;
-            }
-        });
-        drop(counts);
-        let opposite: Vec<AtomicU32> = (0..corners)
-            .into_par_iter()
-            .map(|_| AtomicU32::new(NONE))
-            .collect();
-        let from = |c: u32| vertex[next(c) as usize];
-        const BUCKETS: usize = 1 << 14;
-        let clean = (0..vertex_count.div_ceil(BUCKETS))
-            .into_par_iter()
-            .map(|i| {
-                let mut clean = true;
-                let mut bucket = Vec::new();
-                for v in i * BUCKETS..vertex_count.min((i + 1) * BUCKETS) {
-                    bucket.clear();
-                    bucket.extend(
-                        order[start[v] as usize..start[v + 1] as usize]
-                            .iter()
-                            .map(|e| e.load(Relaxed)),
-                    );
-                    bucket.sort_unstable();
-                    for run in bucket.chunk_by(|x, y| x >> 32 == y >> 32) {
-                        if let [e0, e1] = *run {
-                            let (c0, c1) = (e0 as u32, e1 as u32);
-                            if from(c0) != from(c1) {
-                                opposite[c0 as usize].store(c1, Relaxed);
-                                opposite[c1 as usize].store(c0, Relaxed);
-                                continue;
-                            }
-                        }
-                        if run.len() != 1 {
-                            clean = false;
-                        }
-                    }
-                }
-                clean
-            })
-            .reduce(|| true, |a, b| a && b);
-        drop(order);
-        let opposite = opposite
-            .into_par_iter()
-            .map(AtomicU32::into_inner)
-            .collect();
-        // Each vertex's last corner, in parallel over a few runs of
-        // vertices (each reads every corner).
-        let mut corner_of = vec![NONE; vertex_count];
-        let share_len = vertex_count.div_ceil(runs).max(1);
-        corner_of
-            .par_chunks_mut(share_len)
-            .enumerate()
-            .for_each(|(i, share)| {
-                let v0 = i * share_len;
-                for (c, &v) in vertex.iter().enumerate() {
-                    if let Some(slot) = (v as usize).checked_sub(v0).and_then(|k| share.get_mut(k))
-                    {
-                        *slot = c as u32;
-                    }
-                }
-            });
+        let (start, order) = corners_by_lower_end(&vertex, vertex_count, runs);
+        let (opposite, clean) = pair_opposites(&vertex, &start, &order);
+        drop((start, order));
+        let corner_of = last_corners(&vertex, vertex_count, runs);
         let table = CornerTable {
             vertex,
             opposite,
@@ -448,6 +343,135 @@ pub fn collapse_in<A: CornerAccess + ?Sized>(
     t.set_corner_of(keep, start);
     t.set_corner_of(gone, NONE);
     anchors
+}
+
+/// The corners grouped by the undirected edge they face (the corner's own
+/// direction, from `next` to `prev`, tells the two sides apart): a counting
+/// sort on the edge's lower vertex, each entry `upper << 32 | corner`, in
+/// the order `by_undirected_edge` gives before its runs are sorted (8 bytes
+/// an entry instead of 16). Counted and filled in parallel over `runs` runs
+/// of corners, each with its own counts, placed where one pass over all
+/// corners puts them. Returns the buckets' starts (one more than vertices)
+/// and the entries.
+fn corners_by_lower_end(
+    vertex: &[u32],
+    vertex_count: usize,
+    runs: usize,
+) -> (Vec<u32>, Vec<AtomicU64>) {
+    let corners = vertex.len();
+    let lower = |c: usize| {
+        let (a, b) = (
+            vertex[next(c as u32) as usize],
+            vertex[prev(c as u32) as usize],
+        );
+        (a.min(b), a.max(b))
+    };
+    let run_of = |r: usize| corners * r / runs..corners * (r + 1) / runs;
+    let mut counts: Vec<Vec<u32>> = (0..runs)
+        .into_par_iter()
+        .map(|r| {
+            let mut count = vec![0u32; vertex_count];
+            for c in run_of(r) {
+                count[lower(c).0 as usize] += 1;
+            }
+            count
+        })
+        .collect();
+    // Each run's first slot in each bucket: the buckets in vertex order,
+    // and within one the runs in corner order.
+    let mut start = vec![0u32; vertex_count + 1];
+    let mut at = 0u32;
+    for v in 0..vertex_count {
+        start[v] = at;
+        for count in counts.iter_mut() {
+            let k = count[v];
+            count[v] = at;
+            at += k;
+        }
+    }
+    start[vertex_count] = at;
+    let order: Vec<AtomicU64> = (0..corners)
+        .into_par_iter()
+        .map(|_| AtomicU64::new(0))
+        .collect();
+    counts.par_iter_mut().enumerate().for_each(|(r, slot)| {
+        for c in run_of(r) {
+            let (lo, hi) = lower(c);
+            let at = &mut slot[lo as usize];
+            order[*at as usize].store((u64::from(hi) << 32) | c as u64, Relaxed);
+            *at += 1;
+        }
+    });
+    (start, order)
+}
+
+/// The opposite of each corner from the buckets of [`corners_by_lower_end`]
+/// (each sorted, in parallel over runs of vertices): the two corners of an
+/// edge faced from its two sides pair up, every other edge is left
+/// unmatched. Also whether every edge paired up or is used by one triangle
+/// only.
+fn pair_opposites(vertex: &[u32], start: &[u32], order: &[AtomicU64]) -> (Vec<u32>, bool) {
+    const BUCKETS: usize = 1 << 14;
+    let vertex_count = start.len() - 1;
+    let opposite: Vec<AtomicU32> = (0..vertex.len())
+        .into_par_iter()
+        .map(|_| AtomicU32::new(NONE))
+        .collect();
+    let from = |c: u32| vertex[next(c) as usize];
+    let clean = (0..vertex_count.div_ceil(BUCKETS))
+        .into_par_iter()
+        .map(|i| {
+            let mut clean = true;
+            let mut bucket = Vec::new();
+            for v in i * BUCKETS..vertex_count.min((i + 1) * BUCKETS) {
+                bucket.clear();
+                bucket.extend(
+                    order[start[v] as usize..start[v + 1] as usize]
+                        .iter()
+                        .map(|e| e.load(Relaxed)),
+                );
+                bucket.sort_unstable();
+                for run in bucket.chunk_by(|x, y| x >> 32 == y >> 32) {
+                    if let [e0, e1] = *run {
+                        let (c0, c1) = (e0 as u32, e1 as u32);
+                        if from(c0) != from(c1) {
+                            opposite[c0 as usize].store(c1, Relaxed);
+                            opposite[c1 as usize].store(c0, Relaxed);
+                            continue;
+                        }
+                    }
+                    if run.len() != 1 {
+                        clean = false;
+                    }
+                }
+            }
+            clean
+        })
+        .reduce(|| true, |a, b| a && b);
+    let opposite = opposite
+        .into_par_iter()
+        .map(AtomicU32::into_inner)
+        .collect();
+    (opposite, clean)
+}
+
+/// Each vertex's last corner ([`NONE`] for a vertex without one), in
+/// parallel over `runs` runs of vertices, each reading every corner.
+fn last_corners(vertex: &[u32], vertex_count: usize, runs: usize) -> Vec<u32> {
+    let mut corner_of = vec![NONE; vertex_count];
+    let share_len = vertex_count.div_ceil(runs).max(1);
+    corner_of
+        .par_chunks_mut(share_len)
+        .enumerate()
+        .for_each(|(i, share)| {
+            let v0 = i * share_len;
+            for (c, &v) in vertex.iter().enumerate() {
+                if let Some(slot) = (v as usize).checked_sub(v0).and_then(|k| share.get_mut(k)) {
+                    *slot = c as u32;
+                }
+            }
+        });
+    corner_of
 }
 
 #[cfg(test)]

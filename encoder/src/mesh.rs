@@ -41,8 +41,8 @@ pub fn sorted_canonical(triangles: &[[u32; 3]], rename: Option<&[u32]>) -> Vec<[
     // over parts of the vertex range in parallel: each part owns the
     // stretch of the output its first vertices fill, and reads every
     // triangle (a serial 40 ms of the 1M terrain's set-up and as much of
-    // its exactness check before).
-    // Each run counts into an array of 4 bytes a vertex: at most 8 runs.
+    // its exactness check before). Each run counts into an array of 4
+    // bytes a vertex: at most 8 runs.
     let parts = rayon::current_num_threads().clamp(1, 8);
     let counts = canonical
         .par_chunks(canonical.len().div_ceil(parts).max(1))

@@ -255,7 +255,9 @@ pub fn lattice_step(
     // without sorting every value. (A sample of one distinct value, a
     // raster's first row seen along y, has no gap and decides nothing.)
     let smallest_gap = |offsets: &mut Vec<f64>| {
-        offsets.sort_unstable_by(f64::total_cmp);
+        // In parallel: every value of a raster's axis (the same order,
+        // so the same gap).
+        offsets.par_sort_unstable_by(f64::total_cmp);
         offsets.dedup();
         offsets
             .windows(2)
@@ -273,8 +275,6 @@ pub fn lattice_step(
         return None;
     }
     let mut offsets: Vec<f64> = values.map(|x| x - lo).collect();
-    // All of them: sorted in parallel (the same order, so the same gap).
-    offsets.par_sort_unstable_by(f64::total_cmp);
     let gap = smallest_gap(&mut offsets);
     if !fits(gap) {
         return None;
