@@ -20,7 +20,7 @@ use crate::quantize::{GridError, Lattice, Quantization, QuantizedMesh, Units, qu
 use crate::simplify::{Backend, Checked, GpuError, SimplifyOptions, simplify_on};
 use crate::spatial_order::spatially_ordered;
 pub use levels::plan_levels;
-pub use replay::{ReplayError, replay};
+pub use replay::{ReplayError, ReplayOptions, replay};
 use std::borrow::Cow;
 pub use transcode::{TranscodeError, TranscodeOptions, Transcoded, transcode};
 
@@ -327,9 +327,12 @@ fn encode_checked(
         &simplification,
         &plan,
         &params,
-        options.plane,
-        options.wings,
-        options.deficits,
+        ReplayOptions {
+            plane: options.plane,
+            wings: options.wings,
+            deficits: options.deficits,
+            final_hash: false,
+        },
     )
     .map_err(EncodeError::Replay)?;
     let level_vertex_counts = replayed

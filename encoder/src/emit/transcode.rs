@@ -21,7 +21,7 @@ use splitstream_decoder_core::{
 
 use super::check_coding;
 use super::levels::LevelPlan;
-use super::replay::{ReplayError, replay};
+use super::replay::{ReplayError, ReplayOptions, replay};
 use crate::corner_table::{CornerTable, Fan};
 use crate::quantize::QuantizedMesh;
 use crate::simplify::{Collapse, NO_SPLIT, Simplification};
@@ -117,22 +117,26 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
         &simplification,
         &refinement.plan,
         &params,
-        options.plane,
-        options.wings,
-        options.deficits,
+        ReplayOptions {
+            plane: options.plane,
+            wings: options.wings,
+            deficits: options.deficits,
+            final_hash: true,
+        },
     )
     .map_err(TranscodeError::Replay)?;
-    if replayed.final_hash != refinement.final_hash {
+    let final_hash = replayed.final_hash.expect("asked for");
+    if final_hash != refinement.final_hash {
         return Err(TranscodeError::Replay(ReplayError(format!(
-            "the transcoded stream ends in state {:016x}, the input in {:016x}",
-            replayed.final_hash, refinement.final_hash
+            "the transcoded stream ends in state {final_hash:016x}, the input in {:016x}",
+            refinement.final_hash
         ))));
     }
     let rounds = replayed.levels.iter().map(|l| l.round_splits.len()).sum();
     let levels = replayed.levels.len();
     Ok(Transcoded {
         stream: assemble_stream(&params, &replayed.levels, replayed.framed),
-        final_hash: replayed.final_hash,
+        final_hash,
         levels,
         rounds,
     })
