@@ -298,6 +298,10 @@ impl RecordSource for StepSource<'_> {
 /// (`writer::frame_level`).
 type LevelAndFrame = (LevelPayload, FramedLevel);
 
+/// The replay's levels, and the final state's hash when asked for
+/// ([`ReplayOptions::final_hash`]).
+type LevelsAndHash = Result<(Vec<LevelAndFrame>, Option<u64>), ReplayError>;
+
 /// Replays `s` level by level as planned, returning the level payloads,
 /// each with the plane policy, the wing policy and the deficit contexts of
 /// `options`, or by default the ones whose residuals, wing ranks and split
@@ -375,145 +379,142 @@ pub fn replay(
     // level run on another while the next level replays (same bytes: the
     // replay itself is sequential).
     let seed_ref = &seed;
-    let done = std::thread::scope(
-        |scope| -> Result<(Vec<LevelAndFrame>, Option<u64>), ReplayError> {
-            let mut choosing = Vec::with_capacity(plan.rounds.len());
-            let mut input_sorted = None;
-            for (l, steps) in plan.rounds.iter().enumerate() {
-                if l + 1 == plan.rounds.len() {
-                    // The input's side of the exactness check needs nothing
-                    // from the replay: it is sorted beside the last level,
-                    // whose replay leaves the other core mostly idle once the
-                    // level's policies are chosen.
-                    input_sorted = Some(scope.spawn(|| sorted_canonical(&mesh.triangles, None)));
-                }
-                let mut subs = vec![SubstreamWriter::default(); 7];
-                let mut deficit_coding = DeficitCoding::new(deficit_contexts);
-                // The level's split geometry goes round by round to a thread
-                // that codes the wings and computes the residual vectors, and
-                // they on to a thread that codes them under every plane policy.
-                let (batches, coded_batches) = mpsc::channel();
-                let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
-                let coder =
-                    scope.spawn(move || code_policies(coded_batches, params, plane, splits));
-                let (geometry_batches, geometry_in) = geometry_channels();
-                let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
-                let wing_coding = WingCoding::new(wing_policy);
-                let geometry_coder = scope.spawn(move || {
-                    code_geometry(geometry_in, batches, wing_coding, params, splits, heights)
-                });
-                let mut geometry = GeometryBatch::new();
-                let mut round_splits = Vec::with_capacity(steps.len());
-                // A large level chooses its deficit contexts after the round
-                // that completes its first eighth, as it chooses its plane and
-                // wing policies (`policies::EARLY_CHOICE_SPLITS`); the symbols
-                // after it are written in the chosen contexts only.
-                let (mut early, mut seen) = (early_choice_at(splits), 0);
-                for &k in steps {
-                    let collapses = &s.steps[k];
-                    flagged.clear();
-                    wings.clear();
-                    let dec = |enc: u32| {
-                        if enc == NONE {
-                            NONE
-                        } else {
-                            enc2dec[enc as usize]
-                        }
-                    };
-                    for (i, col) in collapses.iter().enumerate() {
-                        let r = enc2dec[col.p as usize];
-                        current[r as usize] = i as u32;
-                        flagged.push(r);
-                        wings.push([dec(col.wing_a), dec(col.wing_b)]);
-                    }
-                    let mut source = StepSource {
-                        collapses,
-                        wings: &wings,
-                        current: &mut current,
-                        enc2dec: &mut enc2dec,
-                        dec2enc: &mut dec2enc,
-                        subs: &mut subs,
-                        deficit_coding: &mut deficit_coding,
-                        geometry: &mut geometry,
-                        geometry_out: &geometry_batches,
-                        pending: None,
-                        swapped: false,
-                        problem: None,
-                    };
-                    let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
-                    if let Err(e) = result {
-                        let why = source.problem.take().unwrap_or_else(|| e.to_string());
-                        return Err(ReplayError(format!("step {k}: {why}")));
-                    }
-                    for &r in &flagged {
-                        current[r as usize] = NONE;
-                    }
-                    round_splits.push(collapses.len() as u32);
-                    seen += collapses.len();
-                    if early.is_some_and(|at| seen >= at) {
-                        early = None;
-                        deficit_coding.choose_early(params);
-                    }
-                }
-                let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
-                let geometric_error = plan.errors[l];
-                geometry_batches.send(&mut geometry);
-                drop(geometry_batches);
-                choosing.push(scope.spawn(move || {
-                    let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
-                    let LevelGeometry {
-                        wings: wing_coding,
-                        placement,
-                    } = geometry_coder
-                        .join()
-                        .expect("coding the split geometry does not panic")
-                        .map_err(level_error)?;
-                    if mode == PositionMode::Constrained {
-                        subs[slot(substream::PLACEMENT)] = placement;
-                    }
-                    let residuals = coder
-                        .join()
-                        .expect("coding residuals does not panic")
-                        .map_err(level_error)?;
-                    let plane = choose_policy(&mut subs, residuals, params, plane)
-                        .map_err(|why| level_error(why.to_string()))?;
-                    let wings = wing_coding.choose(&mut subs, params);
-                    let deficits = deficit_coding.choose(&mut subs, params);
-                    let level = LevelPayload {
-                        round_splits,
-                        plane,
-                        wings,
-                        deficits,
-                        substreams: subs,
-                        vertex_count,
-                        triangle_count,
-                        geometric_error,
-                    };
-                    // The level's chunks are coded in parallel (same bytes).
-                    let parallel = |n: usize, job: &(dyn Fn(usize) -> Chunk + Sync)| {
-                        (0..n).into_par_iter().map(job).collect()
-                    };
-                    let framed =
-                        frame_level_with(&level, (l == 0).then_some(seed_ref), params, &parallel);
-                    Ok((level, framed))
-                }));
+    let done = std::thread::scope(|scope| -> LevelsAndHash {
+        let mut choosing = Vec::with_capacity(plan.rounds.len());
+        let mut input_sorted = None;
+        for (l, steps) in plan.rounds.iter().enumerate() {
+            if l + 1 == plan.rounds.len() {
+                // The input's side of the exactness check needs nothing
+                // from the replay: it is sorted beside the last level,
+                // whose replay leaves the other core mostly idle once the
+                // level's policies are chosen.
+                input_sorted = Some(scope.spawn(|| sorted_canonical(&mesh.triangles, None)));
             }
-            // The replay is over: check it and hash it while the last levels
-            // are still being chosen and framed.
-            let input_sorted =
-                input_sorted.map(|h| h.join().expect("sorting triangles does not panic"));
-            let (checked, hash) = rayon::join(
-                || check_exact(mesh, &state, &dec2enc, input_sorted),
-                || final_hash.then(|| state.state_hash()),
-            );
-            let checked = checked.map(|()| hash);
-            let levels = choosing
-                .into_iter()
-                .map(|h| h.join().expect("choosing a plane policy does not panic"))
-                .collect::<Result<Vec<_>, _>>()?;
-            Ok((levels, checked?))
-        },
-    )?;
+            let mut subs = vec![SubstreamWriter::default(); 7];
+            let mut deficit_coding = DeficitCoding::new(deficit_contexts);
+            // The level's split geometry goes round by round to a thread
+            // that codes the wings and computes the residual vectors, and
+            // they on to a thread that codes them under every plane policy.
+            let (batches, coded_batches) = mpsc::channel();
+            let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
+            let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
+            let (geometry_batches, geometry_in) = geometry_channels();
+            let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
+            let wing_coding = WingCoding::new(wing_policy);
+            let geometry_coder = scope.spawn(move || {
+                code_geometry(geometry_in, batches, wing_coding, params, splits, heights)
+            });
+            let mut geometry = GeometryBatch::new();
+            let mut round_splits = Vec::with_capacity(steps.len());
+            // A large level chooses its deficit contexts after the round
+            // that completes its first eighth, as it chooses its plane and
+            // wing policies (`policies::EARLY_CHOICE_SPLITS`); the symbols
+            // after it are written in the chosen contexts only.
+            let (mut early, mut seen) = (early_choice_at(splits), 0);
+            for &k in steps {
+                let collapses = &s.steps[k];
+                flagged.clear();
+                wings.clear();
+                let dec = |enc: u32| {
+                    if enc == NONE {
+                        NONE
+                    } else {
+                        enc2dec[enc as usize]
+                    }
+                };
+                for (i, col) in collapses.iter().enumerate() {
+                    let r = enc2dec[col.p as usize];
+                    current[r as usize] = i as u32;
+                    flagged.push(r);
+                    wings.push([dec(col.wing_a), dec(col.wing_b)]);
+                }
+                let mut source = StepSource {
+                    collapses,
+                    wings: &wings,
+                    current: &mut current,
+                    enc2dec: &mut enc2dec,
+                    dec2enc: &mut dec2enc,
+                    subs: &mut subs,
+                    deficit_coding: &mut deficit_coding,
+                    geometry: &mut geometry,
+                    geometry_out: &geometry_batches,
+                    pending: None,
+                    swapped: false,
+                    problem: None,
+                };
+                let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
+                if let Err(e) = result {
+                    let why = source.problem.take().unwrap_or_else(|| e.to_string());
+                    return Err(ReplayError(format!("step {k}: {why}")));
+                }
+                for &r in &flagged {
+                    current[r as usize] = NONE;
+                }
+                round_splits.push(collapses.len() as u32);
+                seen += collapses.len();
+                if early.is_some_and(|at| seen >= at) {
+                    early = None;
+                    deficit_coding.choose_early(params);
+                }
+            }
+            let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
+            let geometric_error = plan.errors[l];
+            geometry_batches.send(&mut geometry);
+            drop(geometry_batches);
+            choosing.push(scope.spawn(move || {
+                let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
+                let LevelGeometry {
+                    wings: wing_coding,
+                    placement,
+                } = geometry_coder
+                    .join()
+                    .expect("coding the split geometry does not panic")
+                    .map_err(level_error)?;
+                if mode == PositionMode::Constrained {
+                    subs[slot(substream::PLACEMENT)] = placement;
+                }
+                let residuals = coder
+                    .join()
+                    .expect("coding residuals does not panic")
+                    .map_err(level_error)?;
+                let plane = choose_policy(&mut subs, residuals, params, plane)
+                    .map_err(|why| level_error(why.to_string()))?;
+                let wings = wing_coding.choose(&mut subs, params);
+                let deficits = deficit_coding.choose(&mut subs, params);
+                let level = LevelPayload {
+                    round_splits,
+                    plane,
+                    wings,
+                    deficits,
+                    substreams: subs,
+                    vertex_count,
+                    triangle_count,
+                    geometric_error,
+                };
+                // The level's chunks are coded in parallel (same bytes).
+                let parallel = |n: usize, job: &(dyn Fn(usize) -> Chunk + Sync)| {
+                    (0..n).into_par_iter().map(job).collect()
+                };
+                let framed =
+                    frame_level_with(&level, (l == 0).then_some(seed_ref), params, &parallel);
+                Ok((level, framed))
+            }));
+        }
+        // The replay is over: check it (and hash it, if asked) while the last levels
+        // are still being chosen and framed.
+        let input_sorted =
+            input_sorted.map(|h| h.join().expect("sorting triangles does not panic"));
+        let (checked, hash) = rayon::join(
+            || check_exact(mesh, &state, &dec2enc, input_sorted),
+            || final_hash.then(|| state.state_hash()),
+        );
+        let checked = checked.map(|()| hash);
+        let levels = choosing
+            .into_iter()
+            .map(|h| h.join().expect("choosing a plane policy does not panic"))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((levels, checked?))
+    })?;
     let (done, final_hash) = done;
     let (levels, framed) = done.into_iter().unzip();
     Ok(Replayed {
