@@ -6,27 +6,33 @@
 //! | corner table, boundary flags | CPU, once |
 //! | quadric init (per-vertex gather) | device, once; read back to f64 |
 //! | best edge per dirty vertex: error, optimal position with fallback, validity | device |
-//! | threshold S (quantile of the candidate errors) | CPU, from the read-back errors |
+//! | threshold S (quantile of the candidate errors) | CPU, from the live vertices' errors (`live_errors`, 4 bytes a live vertex) |
 //! | reciprocity + local minimum with index priority, 3 passes with re-picks | device |
-//! | applying the collapses (corner-table surgery, records), re-checked in f64 | CPU |
-//! | 2-ring dirty marking; upload of changed triangles and vertices | CPU → device |
+//! | applying the collapses (corner-table surgery, records), re-checked in f64 | CPU, in parallel |
+//! | 2-ring dirty marking; upload of changed triangles and vertices | CPU (in parallel) → device |
 //!
 //! The device works in f32 in frames local to each vertex, so its errors and
 //! positions differ from the CPU's by rounding; the CPU re-checks every
 //! winner with `check_collapse` in f64 before applying it and skips the
-//! rare one it rejects. The emitted stream is then checked by the replay
-//! like any other (`emit`), so it decodes exactly whatever the device did.
+//! rare one it rejects ([`apply_winners`]). The emitted stream is then
+//! checked by the replay like any other (`emit`), so it decodes exactly
+//! whatever the device did.
 
+use std::sync::atomic::AtomicU32;
+use std::sync::atomic::Ordering::Relaxed;
+
+use rayon::prelude::*;
 use splitstream_kernels::encode::Engine;
 use splitstream_kernels::encode::layout::{
     self, ALIVE, BOUNDARY, CONSTRAINED, LOCKED, Params, TriangleUpdate, VertexUpdate,
 };
 use splitstream_kernels::gpu::{Api, GpuError};
 
+use super::check::{CheckScratch, check_collapse};
 use super::select::{Best, pair_key};
 use super::state::{
-    Collapse, EdgeMeter, MAX_VALENCE, Simplification, SimplifyOptions, State, mark_two_rings,
-    try_apply_collapse,
+    Collapse, EdgeMeter, MAX_VALENCE, Phases, Simplification, SimplifyOptions, State, Winner,
+    apply_collapses, chunk_size, mark_two_rings, par_chunks_map,
 };
 use crate::corner_table::{Fan, NONE};
 use crate::quadric::Quadric;
@@ -43,7 +49,10 @@ pub fn simplify_gpu(
     mut progress: impl FnMut(usize),
 ) -> Result<Simplification, GpuError> {
     let n = mesh.positions.len();
+    let mut phases = Phases::default();
+    phases.lap("");
     let mut s = State::new(mesh, options);
+    phases.lap("state");
     let corners: Vec<[u32; 2]> = s
         .table
         .vertex
@@ -76,6 +85,7 @@ pub fn simplify_gpu(
         boundary_weight: options.boundary_weight as f32,
         ..Params::default()
     };
+    phases.lap("open");
     let local = engine.quadric_init(&base)?;
     s.quadrics = local
         .iter()
@@ -89,12 +99,16 @@ pub fn simplify_gpu(
     let mut threshold = 0.0f64;
     let mut live: Vec<u32> = (0..n as u32).filter(|&v| s.alive[v as usize]).collect();
     let mut dirty_list = live.clone();
-    let mut dirty = vec![false; n];
+    // Per vertex, the last step that found it in a merged vertex's 2-ring.
+    let dirty: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(0)).collect();
     let limit = options.max_error.unwrap_or(f64::INFINITY);
     let mut meter = EdgeMeter::new(&s);
     let (mut edge, mut edge_measured_at) = (meter.measure(&s), alive_count);
     let mut rejected_total = 0usize;
+    // Per vertex, the last step whose kept winners' neighbourhoods hold it.
+    let mut claims = vec![0u32; n];
     let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
+    phases.lap("quadrics");
     while alive_count > options.target_vertices {
         if alive_count * 5 < edge_measured_at * 4 {
             edge = meter.measure(&s);
@@ -104,20 +118,18 @@ pub fn simplify_gpu(
         // f32 errors carry ~1e-7 relative noise of terms ~ edge^4: below
         // 1e-6 edge^4 they are flat (the CPU uses 1e-8 in f64).
         base.flat_error = (1e-6 * edge.powi(4)) as f32;
-        let best = engine.best_edges(&base, &dirty_list)?;
-        let mut errors: Vec<f64> = live
-            .iter()
-            .map(|&v| &best[v as usize])
-            .filter(|b| b.other != layout::NONE)
-            .map(|b| b.error as f64)
-            .collect();
+        phases.lap("measure");
+        engine.best_edges(&base, &dirty_list)?;
+        engine.set_live(&live)?;
+        let mut errors = engine.live_errors(&base)?;
+        phases.lap("best edges");
         if errors.is_empty() {
             break;
         }
         let q = ((errors.len() - 1) as f64 * options.admit_quantile.clamp(0.0, 1.0)) as usize;
         let (_, quantile, _) = errors.select_nth_unstable_by(q, f64::total_cmp);
         threshold = threshold.max(*quantile).min(limit);
-        engine.set_live(&live)?;
+        phases.lap("quantile");
         let select = |engine: &mut Engine, threshold: f64| {
             let params = Params {
                 threshold: threshold as f32,
@@ -138,53 +150,56 @@ pub fn simplify_gpu(
         if winners.is_empty() {
             break;
         }
-        let as_best = |w: &layout::Winner| Best {
-            other: w.other,
-            error: w.error as f64,
-            error_key: w.key,
-            corner: NONE,
-        };
+        phases.lap("select");
         let room = alive_count - options.target_vertices;
         if winners.len() > room {
             winners.sort_by_key(|w| pair_key(&as_best(w), w.v));
             winners.truncate(room);
+            // Back in ascending survivor id, the order `Engine::select`
+            // returns and `apply_winners` keeps the first of overlapping
+            // winners in.
             winners.sort_unstable_by_key(|w| w.v);
         }
-        let mut collapses: Vec<Collapse> = Vec::with_capacity(winners.len());
-        let mut merged = Vec::with_capacity(winners.len());
-        let mut removed = Vec::new();
-        let mut fans = [Fan::default(), Fan::default()];
-        let mut step_error = 0.0f64;
-        let mut rejected = 0usize;
-        for w in &winners {
-            let b = as_best(w);
-            match try_apply_collapse(&mut s, w.v, b, w.target, &mut fans) {
-                Some((collapse, plan)) => {
-                    step_error = step_error.max(b.error);
-                    merged.push(w.v);
-                    removed.extend([plan.left, plan.right].into_iter().filter(|&c| c != NONE));
-                    collapses.push(collapse);
-                }
-                None => rejected += 1,
-            }
-        }
+        let stamp = steps.len() as u32 + 1;
+        let applied = apply_winners(&mut s, &winners, &mut claims, stamp);
+        let rejected = applied.refused + applied.overlapping;
         rejected_total += rejected;
-        if collapses.is_empty() {
+        if applied.collapses.is_empty() {
             // Every winner failed the f64 check: the device would choose
             // them again, so stop here rather than spin.
             break;
         }
-        let (triangles, vertices) = changes(&s, &collapses, &removed);
+        phases.lap("apply");
+        let (triangles, vertices) = changes(&s, &applied);
+        phases.lap("changes");
         engine.update(&base, &triangles, &vertices)?;
-        live.retain(|&v| s.alive[v as usize]);
-        mark_two_rings(&s, &merged, &mut dirty);
-        dirty_list.clear();
-        dirty_list.extend(live.iter().copied().filter(|&v| dirty[v as usize]));
+        phases.lap("update");
+        let merged: Vec<u32> = applied.winners.iter().map(|w| w.p).collect();
+        live = live
+            .par_iter()
+            .copied()
+            .filter(|&v| s.alive[v as usize])
+            .collect();
+        mark_two_rings(&s, &merged, &dirty, stamp);
+        dirty_list = live
+            .par_iter()
+            .copied()
+            .filter(|&v| dirty[v as usize].load(Relaxed) == stamp)
+            .collect();
+        phases.lap("dirty");
+        let collapses = applied.collapses;
+        let step_error = applied
+            .winners
+            .iter()
+            .map(|w| w.best.error)
+            .fold(0.0f64, f64::max);
         if debug {
             eprintln!(
-                "{api} step {}: alive {alive_count}, collapses {}, rejected by the f64 check {rejected}, dirty {}",
+                "{api} step {}: alive {alive_count}, collapses {}, refused by the f64 check {}, overlapping {}, dirty {}",
                 steps.len(),
                 collapses.len(),
+                applied.refused,
+                applied.overlapping,
                 dirty_list.len()
             );
         }
@@ -194,7 +209,10 @@ pub fn simplify_gpu(
         progress(n - alive_count);
     }
     if debug {
-        eprintln!("{api}: {rejected_total} device winners rejected by the f64 check");
+        eprintln!(
+            "{api}: {rejected_total} device winners refused by the f64 check or overlapping a kept one"
+        );
+        eprintln!("{api} {}", phases.report());
     }
     Ok(Simplification {
         steps,
@@ -239,33 +257,159 @@ fn to_local(q: &Quadric, o: [f64; 3]) -> [f32; 10] {
     [c[0], c[1], c[2], nb[0], c[4], c[5], nb[1], c[7], nb[2], d].map(|x| x as f32)
 }
 
+/// The device's winners of one step that the CPU kept and applied.
+struct Applied {
+    winners: Vec<Winner>,
+    collapses: Vec<Collapse>,
+    /// Winners the f64 check refused.
+    refused: usize,
+    /// Winners dropped because a kept winner's neighbourhood held one of
+    /// their endpoints.
+    overlapping: usize,
+}
+
+/// One chunk of [`apply_winners`]' parallel checks: the valid winners with
+/// their fans (offsets into `corners`) and their neighbourhoods (ranges of
+/// `hood`).
+#[derive(Default)]
+struct CheckedChunk {
+    valid: Vec<(Winner, (u32, u32))>,
+    corners: Vec<u32>,
+    hood: Vec<u32>,
+    refused: usize,
+}
+
+/// Checks the device's winners again in f64, keeps those that touch
+/// disjoint neighbourhoods, and applies them in parallel.
+///
+/// The device chooses in f32 and its output is not trusted: each winner is
+/// checked (`check_collapse`) against the mesh as the step found it, as
+/// the CPU backend checks its own, then, in ascending survivor id, kept
+/// only if no kept winner's neighbourhood (its endpoints and their
+/// neighbours, `claims` stamped with `stamp`) holds one of its endpoints.
+/// That is the CPU backend's blocking rule, and what `apply_collapses`'
+/// parallel writes need: kept collapses share no endpoint and no triangle.
+fn apply_winners(
+    s: &mut State,
+    winners: &[layout::Winner],
+    claims: &mut [u32],
+    stamp: u32,
+) -> Applied {
+    let s_now: &State = s;
+    let chunks: Vec<CheckedChunk> = par_chunks_map(winners, |chunk| {
+        let mut scratch = CheckScratch::default();
+        let mut out = CheckedChunk::default();
+        for w in chunk {
+            if !names_a_live_edge(s_now, w) {
+                out.refused += 1;
+                continue;
+            }
+            let target = s_now.to_metric(w.target);
+            let Ok(plan) = check_collapse(s_now, w.v, w.other, target, &mut scratch) else {
+                out.refused += 1;
+                continue;
+            };
+            let (fan_p, fan_c) = scratch.fans();
+            let start = out.corners.len() as u32;
+            out.corners.extend_from_slice(&fan_p.corners);
+            out.corners.extend_from_slice(&fan_c.corners);
+            let hood_start = out.hood.len() as u32;
+            out.hood.extend(scratch.neighbourhood());
+            let winner = Winner {
+                p: w.v,
+                best: as_best(w),
+                target: w.target,
+                plan,
+                fans: (
+                    start,
+                    fan_p.corners.len() as u32,
+                    fan_c.corners.len() as u32,
+                ),
+            };
+            out.valid
+                .push((winner, (hood_start, out.hood.len() as u32)));
+        }
+        out
+    });
+    let mut kept = Vec::with_capacity(winners.len());
+    let mut fans = Vec::new();
+    let (mut refused, mut overlapping) = (0, 0);
+    for chunk in chunks {
+        refused += chunk.refused;
+        let base = fans.len() as u32;
+        fans.extend_from_slice(&chunk.corners);
+        for (mut winner, (from, to)) in chunk.valid {
+            let ends = [winner.p, winner.best.other];
+            if ends.iter().any(|&x| claims[x as usize] == stamp) {
+                overlapping += 1;
+                continue;
+            }
+            for &x in &chunk.hood[from as usize..to as usize] {
+                claims[x as usize] = stamp;
+            }
+            winner.fans.0 += base;
+            kept.push(winner);
+        }
+    }
+    let collapses = apply_collapses(s, &kept, &fans);
+    Applied {
+        winners: kept,
+        collapses,
+        refused,
+        overlapping,
+    }
+}
+
+/// Whether a device winner names two distinct live vertices and a target on
+/// the quantization grid: what must hold before `check_collapse` walks
+/// their fans (it then refuses a pair that is not an edge).
+fn names_a_live_edge(s: &State, w: &layout::Winner) -> bool {
+    let live = |v: u32| s.alive.get(v as usize).copied().unwrap_or(false);
+    let top = (1u64 << s.bits) - 1;
+    w.v != w.other && live(w.v) && live(w.other) && w.target.iter().all(|&x| u64::from(x) <= top)
+}
+
+/// A device winner as the CPU's request of P.
+fn as_best(w: &layout::Winner) -> Best {
+    Best {
+        other: w.other,
+        error: w.error as f64,
+        error_key: w.key,
+        corner: NONE,
+    }
+}
+
 /// The triangles and vertices a step's collapses rewrote: every triangle
 /// around each merged vertex (their corners moved to it, their opposites
 /// across the folded edges changed), the removed triangles, and the merged,
 /// removed and wing vertices (corners re-anchored).
-fn changes(
-    s: &State,
-    collapses: &[Collapse],
-    removed: &[u32],
-) -> (Vec<TriangleUpdate>, Vec<VertexUpdate>) {
-    let mut triangles: Vec<u32> = removed.iter().map(|&c| c / 3).collect();
-    let mut vertices = Vec::with_capacity(4 * collapses.len());
-    let mut fan = Fan::default();
-    for c in collapses {
-        s.table.fan(c.p, &mut fan);
-        triangles.extend(fan.corners.iter().map(|&k| k / 3));
-        vertices.extend(
-            [c.p, c.c, c.wing_a, c.wing_b]
-                .into_iter()
-                .filter(|&v| v != NONE),
-        );
-    }
-    triangles.sort_unstable();
+fn changes(s: &State, applied: &Applied) -> (Vec<TriangleUpdate>, Vec<VertexUpdate>) {
+    let kept = &applied.winners;
+    let mut triangles: Vec<u32> = kept
+        .par_chunks(chunk_size(kept.len()))
+        .flat_map_iter(|chunk| {
+            let mut fan = Fan::default();
+            let mut out = Vec::new();
+            for w in chunk {
+                s.table.fan(w.p, &mut fan);
+                out.extend(fan.corners.iter().map(|&k| k / 3));
+                let removed = [w.plan.left, w.plan.right].into_iter();
+                out.extend(removed.filter(|&c| c != NONE).map(|c| c / 3));
+            }
+            out
+        })
+        .collect();
+    let mut vertices: Vec<u32> = kept
+        .par_iter()
+        .flat_map_iter(|w| [w.p, w.best.other, w.plan.wing_a, w.plan.wing_b])
+        .filter(|&v| v != NONE)
+        .collect();
+    triangles.par_sort_unstable();
     triangles.dedup();
-    vertices.sort_unstable();
+    vertices.par_sort_unstable();
     vertices.dedup();
     let triangles = triangles
-        .into_iter()
+        .into_par_iter()
         .map(|t| {
             let k = 3 * t as usize;
             TriangleUpdate {
@@ -276,7 +420,7 @@ fn changes(
         })
         .collect();
     let vertices = vertices
-        .into_iter()
+        .into_par_iter()
         .map(|v| {
             let words = vertex_words(s, v as usize);
             VertexUpdate {
@@ -294,6 +438,115 @@ fn changes(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::corner_table::next;
+    use crate::input::fractal_terrain;
+    use crate::quantize::{Units, quantize};
+
+    /// A device winner collapsing `c` into `p` at `p`'s position.
+    fn winner(s: &State, p: u32, c: u32) -> layout::Winner {
+        layout::Winner {
+            v: p,
+            other: c,
+            error: 0.0,
+            key: 0,
+            target: s.positions[p as usize],
+        }
+    }
+
+    /// The state of a 16 x 16 terrain as the GPU loop starts from.
+    fn terrain_state() -> State {
+        let q = quantize(&fractal_terrain(16, 3), 14, Units::Linear);
+        let options = SimplifyOptions::default();
+        let mut s = State::new(&q, &options);
+        s.quadrics = s
+            .fan_quadrics(options.boundary_weight)
+            .expect("a manifold terrain");
+        s
+    }
+
+    fn neighbours(s: &State, v: u32) -> Vec<u32> {
+        let mut fan = Fan::default();
+        s.table.fan(v, &mut fan);
+        fan.corners.iter().map(|&k| s.table.v(next(k))).collect()
+    }
+
+    #[test]
+    fn overlapping_device_winners_keep_the_first() {
+        let mut s = terrain_state();
+        // An interior vertex, one of its neighbours, and a second pair whose
+        // survivor is another neighbour: it lies in the first pair's
+        // neighbourhood, so only the first may be kept. A third pair far
+        // away is independent of both.
+        let p = 5 * 16 + 5;
+        let ring = neighbours(&s, p);
+        let (c, p2) = (ring[0], ring[2]);
+        let c2 = *neighbours(&s, p2)
+            .iter()
+            .find(|&&x| x != p && !ring.contains(&x))
+            .expect("a neighbour of p2 outside p's ring");
+        let far = 12 * 16 + 12;
+        let far_c = neighbours(&s, far)[0];
+        let mut winners = vec![winner(&s, p, c), winner(&s, p2, c2), winner(&s, far, far_c)];
+        winners.sort_unstable_by_key(|w| w.v);
+        let alive_before = s.alive.iter().filter(|&&a| a).count();
+        let mut claims = vec![0u32; s.alive.len()];
+        let applied = apply_winners(&mut s, &winners, &mut claims, 1);
+        assert_eq!(applied.refused, 0);
+        assert_eq!(applied.overlapping, 1);
+        let kept: Vec<u32> = applied.winners.iter().map(|w| w.p).collect();
+        let first = p.min(p2);
+        assert_eq!(
+            kept,
+            [first, far],
+            "the lower survivor of the overlapping pair is kept"
+        );
+        assert_eq!(applied.collapses.len(), 2);
+        let alive_after = s.alive.iter().filter(|&&a| a).count();
+        assert_eq!(alive_before - alive_after, 2);
+        // The dropped pair at the next step (a new stamp): the old claims
+        // no longer block it.
+        let dropped = if first == p { (p2, c2) } else { (p, c) };
+        let w = winner(&s, dropped.0, dropped.1);
+        let again = apply_winners(&mut s, &[w], &mut claims, 2);
+        assert_eq!(
+            (again.refused, again.overlapping, again.collapses.len()),
+            (0, 0, 1)
+        );
+    }
+
+    #[test]
+    fn device_garbage_is_refused_not_applied() {
+        let mut s = terrain_state();
+        let p = 5 * 16 + 5;
+        let ring = neighbours(&s, p);
+        let far = 12 * 16 + 12;
+        let mut off_grid = winner(&s, p, ring[0]);
+        off_grid.target[2] = 1 << 14;
+        let garbage = [
+            winner(&s, p, p),         // not a pair
+            winner(&s, p, far),       // not an edge
+            winner(&s, p, 4_000_000), // no such vertex
+            off_grid,                 // off the grid
+        ];
+        let n = s.alive.len();
+        let mut claims = vec![0u32; n];
+        for (i, w) in garbage.iter().enumerate() {
+            let applied = apply_winners(&mut s, std::slice::from_ref(w), &mut claims, 1);
+            assert_eq!(
+                (applied.refused, applied.collapses.len()),
+                (1, 0),
+                "case {i}"
+            );
+        }
+        // A collapse applied, then a winner naming its removed vertex.
+        let w = winner(&s, p, ring[0]);
+        let applied = apply_winners(&mut s, &[w], &mut claims, 2);
+        assert_eq!(applied.collapses.len(), 1);
+        let w = winner(&s, ring[1], ring[0]);
+        let dead = apply_winners(&mut s, &[w], &mut claims, 3);
+        assert_eq!((dead.refused, dead.collapses.len()), (1, 0));
+        assert_eq!(s.alive.iter().filter(|&&a| a).count(), n - 1);
+    }
 
     #[test]
     fn frames_round_trip() {

@@ -281,14 +281,14 @@ impl State {
 /// Time spent per phase over the whole simplification, printed under
 /// `SPLITSTREAM_DEBUG`.
 #[derive(Default)]
-struct Phases {
+pub(super) struct Phases {
     at: Option<std::time::Instant>,
     seconds: Vec<(&'static str, f64)>,
 }
 
 impl Phases {
     /// Charges the time since the last lap to `name`.
-    fn lap(&mut self, name: &'static str) {
+    pub(super) fn lap(&mut self, name: &'static str) {
         let now = std::time::Instant::now();
         if let Some(at) = self.at {
             let dt = (now - at).as_secs_f64();
@@ -300,7 +300,7 @@ impl Phases {
         self.at = Some(now);
     }
 
-    fn report(&self) -> String {
+    pub(super) fn report(&self) -> String {
         let total: f64 = self.seconds.iter().map(|(_, s)| s).sum();
         let parts: Vec<String> = self
             .seconds
@@ -406,15 +406,15 @@ impl Tracking {
 }
 
 /// A collapse chosen and checked in this step, with what applying it needs.
-struct Winner {
-    p: u32,
-    best: Best,
+pub(super) struct Winner {
+    pub p: u32,
+    pub best: Best,
     /// Where the merged vertex goes.
-    target: [u32; 3],
-    plan: Plan,
+    pub target: [u32; 3],
+    pub plan: Plan,
     /// The fans of P then C as its check walked them, at `fans` in
     /// [`Buffers::fans`]: applying the collapse needs no walk.
-    fans: (u32, u32, u32),
+    pub fans: (u32, u32, u32),
 }
 
 /// Simplifies `mesh` (quantized, checked manifold: [`super::Checked`]) with
@@ -1358,12 +1358,15 @@ struct Checked {
 /// `f` over consecutive chunks of `items` in parallel, the results in
 /// order. Each chunk fills its own buffers: no allocation per item and no
 /// merging copies (rayon's fold/reduce re-copies at every level).
-fn par_chunks_map<T: Sync, R: Send>(items: &[T], f: impl Fn(&[T]) -> R + Sync + Send) -> Vec<R> {
+pub(super) fn par_chunks_map<T: Sync, R: Send>(
+    items: &[T],
+    f: impl Fn(&[T]) -> R + Sync + Send,
+) -> Vec<R> {
     items.par_chunks(chunk_size(items.len())).map(f).collect()
 }
 
 /// The chunk length of the data-parallel passes over `len` items.
-fn chunk_size(len: usize) -> usize {
+pub(super) fn chunk_size(len: usize) -> usize {
     (len / (8 * rayon::current_num_threads())).clamp(512, 16384)
 }
 
@@ -1662,34 +1665,6 @@ fn is_local_minimum(s: &State, p: u32, c: u32, key: u64, keys: &[AtomicU64], fan
     })
 }
 
-/// Applies the collapse chosen by `p` if `check_collapse` accepts it,
-/// returning its record and plan; `None` leaves the state untouched (GPU
-/// backends choose in f32, the CPU has the last word in f64).
-pub(super) fn try_apply_collapse(
-    s: &mut State,
-    p: u32,
-    b: Best,
-    target: [u32; 3],
-    fans: &mut [Fan; 2],
-) -> Option<(Collapse, Plan)> {
-    let mut scratch = CheckScratch::default();
-    let plan = check_collapse(s, p, b.other, s.to_metric(target), &mut scratch).ok()?;
-    let (record, q) = prepare(s, p, b, target, plan);
-    s.table.collapse(p, b.other, plan.left, plan.right, fans);
-    commit(s, p, b.other, target, plan, q);
-    Some((record, plan))
-}
-
-/// The record of the collapse of `p` and `b.other` to `target` and the
-/// merged quadric, from the mesh before it.
-fn prepare(s: &State, p: u32, b: Best, target: [u32; 3], plan: Plan) -> (Collapse, Quadric) {
-    let c = b.other;
-    let q = s.quadrics[p as usize] + s.quadrics[c as usize];
-    let ends = [p, c].map(|v| (s.positions[v as usize], s.split_valence[v as usize]));
-    let record = record(b, p, target, plan, &q, ends, &s.orig);
-    (record, q)
-}
-
 /// The record of the collapse of `p` and `b.other` to `target`, given the
 /// merged quadric and the positions and split valences of P and C.
 fn record(
@@ -1723,22 +1698,6 @@ fn record(
     }
 }
 
-/// The merged vertex's new attributes once the corner table is collapsed.
-fn commit(s: &mut State, p: u32, c: u32, target: [u32; 3], plan: Plan, q: Quadric) {
-    let (pi, ci) = (p as usize, c as usize);
-    s.positions[pi] = target;
-    s.quadrics[pi] = q;
-    s.boundary[pi] |= s.boundary[ci];
-    s.alive[ci] = false;
-    s.split_valence[pi] = plan.valence_r as u8;
-    s.valence[pi] = plan.valence_r as u32;
-    for w in [plan.wing_a, plan.wing_b] {
-        if w != NONE {
-            s.valence[w as usize] -= 1;
-        }
-    }
-}
-
 /// Applies a step's winners, in parallel, returning their records in order.
 ///
 /// The collapses of a step touch disjoint parts of the mesh: the triangles
@@ -1747,7 +1706,7 @@ fn commit(s: &mut State, p: u32, c: u32, target: [u32; 3], plan: Plan, q: Quadri
 /// its endpoints' 1-rings). Only a wing can be shared, so the wings' new
 /// corners and valences are set afterwards, in winner order, as one
 /// collapse after the other would leave them.
-fn apply_collapses(s: &mut State, winners: &[Winner], fans: &[u32]) -> Vec<Collapse> {
+pub(super) fn apply_collapses(s: &mut State, winners: &[Winner], fans: &[u32]) -> Vec<Collapse> {
     // The unsafe writes below rely on this; debug builds (every test run)
     // check it.
     #[cfg(debug_assertions)]
@@ -2107,29 +2066,24 @@ impl RefreshChunk {
     }
 }
 
-/// Marks the vertices within two edges of each merged vertex: the only
-/// ones whose best collapse can have changed (errors, links, fold-overs and
-/// wing valences all live in the 2-ring).
-pub(super) fn mark_two_rings(s: &State, merged: &[u32], dirty: &mut [bool]) {
-    dirty.fill(false);
-    let touched: Vec<u32> = merged
-        .par_iter()
-        .flat_map_iter(|&r| {
-            let mut fan = Fan::default();
-            let mut inner = Fan::default();
-            let mut out = vec![r];
-            s.table.fan(r, &mut fan);
-            for x in neighbours_of(s, &fan) {
-                out.push(x);
-                s.table.fan(x, &mut inner);
-                out.extend(neighbours_of(s, &inner));
+/// Stamps with `stamp` the vertices within two edges of each merged vertex:
+/// the only ones whose best collapse can have changed (errors, links,
+/// fold-overs and wing valences all live in the 2-ring).
+pub(super) fn mark_two_rings(s: &State, merged: &[u32], dirty: &[AtomicU32], stamp: u32) {
+    merged.par_iter().for_each_init(
+        || (Fan::default(), Fan::default()),
+        |(fan, inner), &r| {
+            dirty[r as usize].store(stamp, Relaxed);
+            s.table.fan(r, fan);
+            for x in neighbours_of(s, fan) {
+                dirty[x as usize].store(stamp, Relaxed);
+                s.table.fan(x, inner);
+                for y in neighbours_of(s, inner) {
+                    dirty[y as usize].store(stamp, Relaxed);
+                }
             }
-            out
-        })
-        .collect();
-    for v in touched {
-        dirty[v as usize] = true;
-    }
+        },
+    );
 }
 
 /// The neighbours of a fan's centre: the next vertex of each corner, and on

@@ -97,16 +97,16 @@ impl Device for OclDevice {
             .map_err(|e| kernel_error("writing a buffer", e))
     }
 
-    fn read(&mut self, buffer: Buffer, words: usize) -> Result<Vec<u32>, GpuError> {
-        let mut out = vec![0u32; words];
-        if words > 0 {
+    fn read_into(&mut self, buffer: Buffer, out: &mut [u32]) -> Result<(), GpuError> {
+        if !out.is_empty() {
+            let words = out.len();
             self.buffers[&buffer]
-                .read(&mut out)
+                .read(out)
                 .len(words)
                 .enq()
                 .map_err(|e| kernel_error("reading a buffer", e))?;
         }
-        Ok(out)
+        Ok(())
     }
 
     fn zero(&mut self, buffer: Buffer) -> Result<(), GpuError> {

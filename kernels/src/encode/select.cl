@@ -68,3 +68,11 @@ __kernel void block(__global const Params *P, __global const uint2 *corners,
     block_fan(t, blocked, w.v);
     block_fan(t, blocked, w.other);
 }
+
+__kernel void live_errors(__global const Params *P, __global const Best *best,
+                          __global const uint *list, __global uint *errors) {
+    uint i = get_global_id(0);
+    if (i >= P->list_len) return;
+    Best b = best[list[i]];
+    errors[i] = b.other != NONE ? as_uint(b.error) : NONE;
+}

@@ -29,6 +29,8 @@ struct Winner {
 @group(0) @binding(8) var<storage, read> list: array<u32>;
 @group(0) @binding(9) var<storage, read_write> winners: array<Winner>;
 @group(0) @binding(10) var<storage, read_write> counter: array<atomic<u32>>;
+// Per listed vertex, its request's error (f32 bits), NONE if it has none.
+@group(0) @binding(12) var<storage, read_write> errors: array<u32>;
 
 fn key_less(a: vec2<u32>, b: vec2<u32>) -> bool {
     return a.x < b.x || (a.x == b.x && a.y < b.y);
@@ -115,4 +117,21 @@ fn block(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) 
     let w = winners[params.mode + i];
     block_fan(w.v);
     block_fan(w.other);
+}
+
+// The errors of the listed (live) vertices' requests, for the host's
+// threshold S: the host reads these 4 bytes a live vertex instead of every
+// vertex's 24-byte `Best`.
+@compute @workgroup_size(256)
+fn live_errors(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let i = flat_index(id, groups);
+    if i >= params.list_len {
+        return;
+    }
+    let b = best[list[i]];
+    var error = NONE;
+    if b.other != NONE {
+        error = bitcast<u32>(b.error);
+    }
+    errors[i] = error;
 }

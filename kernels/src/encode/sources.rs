@@ -80,6 +80,8 @@ pub enum Slot {
     Winners = 9,
     Counter = 10,
     Updates = 11,
+    /// The live vertices' request errors (`live_errors`).
+    Errors = 12,
 }
 
 /// One compute entry point.
@@ -90,17 +92,19 @@ pub enum Kernel {
     Admit,
     LocalMin,
     Block,
+    LiveErrors,
     UpdateTriangles,
     UpdateVertices,
 }
 
 impl Kernel {
-    pub const ALL: [Kernel; 7] = [
+    pub const ALL: [Kernel; 8] = [
         Kernel::QuadricInit,
         Kernel::BestEdge,
         Kernel::Admit,
         Kernel::LocalMin,
         Kernel::Block,
+        Kernel::LiveErrors,
         Kernel::UpdateTriangles,
         Kernel::UpdateVertices,
     ];
@@ -113,6 +117,7 @@ impl Kernel {
             Kernel::Admit => "admit",
             Kernel::LocalMin => "local_min",
             Kernel::Block => "block",
+            Kernel::LiveErrors => "live_errors",
             Kernel::UpdateTriangles => "update_triangles",
             Kernel::UpdateVertices => "update_vertices",
         }
@@ -122,7 +127,9 @@ impl Kernel {
         match self {
             Kernel::QuadricInit => WgslModule::QuadricInit,
             Kernel::BestEdge => WgslModule::BestEdge,
-            Kernel::Admit | Kernel::LocalMin | Kernel::Block => WgslModule::Select,
+            Kernel::Admit | Kernel::LocalMin | Kernel::Block | Kernel::LiveErrors => {
+                WgslModule::Select
+            }
             Kernel::UpdateTriangles | Kernel::UpdateVertices => WgslModule::Update,
         }
     }
@@ -142,6 +149,7 @@ impl Kernel {
                 Params, Corners, CornerOf, Best, Keys, List, Winners, Counter,
             ],
             Kernel::Block => &[Params, Corners, CornerOf, Blocked, Winners],
+            Kernel::LiveErrors => &[Params, Best, List, Errors],
             Kernel::UpdateTriangles => &[Params, Corners, Updates],
             Kernel::UpdateVertices => &[Params, CornerOf, Vertices, Quadrics, Updates],
         }

@@ -133,11 +133,11 @@ impl Device for WgpuDevice {
         Ok(())
     }
 
-    fn read(&mut self, buffer: Buffer, words: usize) -> Result<Vec<u32>, GpuError> {
-        if words == 0 {
-            return Ok(Vec::new());
+    fn read_into(&mut self, buffer: Buffer, out: &mut [u32]) -> Result<(), GpuError> {
+        if out.is_empty() {
+            return Ok(());
         }
-        let bytes = 4 * words as u64;
+        let bytes = 4 * out.len() as u64;
         if self.staging.as_ref().is_none_or(|s| s.size() < bytes) {
             self.staging = Some(self.ctx.device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some("splitstream readback"),
@@ -162,14 +162,14 @@ impl Device for WgpuDevice {
             .recv()
             .map_err(kernel_error)?
             .map_err(|e| kernel_error(format!("readback: {e}")))?;
-        let out = {
+        {
             let view = staging
                 .get_mapped_range(0..bytes)
                 .map_err(|e| kernel_error(format!("readback: {e}")))?;
-            bytemuck::cast_slice(&view).to_vec()
-        };
+            out.copy_from_slice(bytemuck::cast_slice(&view));
+        }
         staging.unmap();
-        Ok(out)
+        Ok(())
     }
 
     fn zero(&mut self, buffer: Buffer) -> Result<(), GpuError> {
