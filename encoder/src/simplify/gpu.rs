@@ -22,10 +22,10 @@ use std::sync::atomic::AtomicU32;
 use std::sync::atomic::Ordering::Relaxed;
 
 use rayon::prelude::*;
-use splitstream_kernels::encode::Engine;
 use splitstream_kernels::encode::layout::{
     self, ALIVE, BOUNDARY, CONSTRAINED, LOCKED, Params, TriangleUpdate, VertexUpdate,
 };
+use splitstream_kernels::encode::{Engine, Updates};
 use splitstream_kernels::gpu::{Api, GpuError};
 
 use super::check::{CheckScratch, check_collapse};
@@ -56,11 +56,14 @@ pub fn simplify_gpu(
     let corners: Vec<[u32; 2]> = s
         .table
         .vertex
-        .iter()
+        .par_iter()
         .zip(&s.table.opposite)
         .map(|(&v, &o)| [v, o])
         .collect();
-    let vertices: Vec<[u32; 4]> = (0..n).map(|v| vertex_words(&s, v)).collect();
+    let vertices: Vec<[u32; 4]> = (0..n)
+        .into_par_iter()
+        .map(|v| vertex_words(&s, v))
+        .collect();
     let mut engine = Engine::open(
         api,
         &splitstream_kernels::encode::MeshData {
@@ -88,7 +91,7 @@ pub fn simplify_gpu(
     phases.lap("open");
     let local = engine.quadric_init(&base)?;
     s.quadrics = local
-        .iter()
+        .par_iter()
         .enumerate()
         .map(|(v, q)| to_global(q, s.geometry(v as u32)))
         .collect();
@@ -105,8 +108,10 @@ pub fn simplify_gpu(
     let mut meter = EdgeMeter::new(&s);
     let (mut edge, mut edge_measured_at) = (meter.measure(&s), alive_count);
     let mut rejected_total = 0usize;
-    // Per vertex, the last step whose kept winners' neighbourhoods hold it.
-    let mut claims = vec![0u32; n];
+    // Per vertex, the lowest winner whose neighbourhood holds it, during
+    // `apply_winners` (NO_CLAIM otherwise).
+    let claims: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(NO_CLAIM)).collect();
+    let mut updates = Updates::default();
     let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
     phases.lap("quadrics");
     while alive_count > options.target_vertices {
@@ -161,7 +166,7 @@ pub fn simplify_gpu(
             winners.sort_unstable_by_key(|w| w.v);
         }
         let stamp = steps.len() as u32 + 1;
-        let applied = apply_winners(&mut s, &winners, &mut claims, stamp);
+        let applied = apply_winners(&mut s, &winners, &claims);
         let rejected = applied.refused + applied.overlapping;
         rejected_total += rejected;
         if applied.collapses.is_empty() {
@@ -170,9 +175,9 @@ pub fn simplify_gpu(
             break;
         }
         phases.lap("apply");
-        let (triangles, vertices) = changes(&s, &applied);
+        changes(&s, &applied, &mut updates);
         phases.lap("changes");
-        engine.update(&base, &triangles, &vertices)?;
+        engine.update(&base, &updates)?;
         phases.lap("update");
         let merged: Vec<u32> = applied.winners.iter().map(|w| w.p).collect();
         live = live
@@ -279,22 +284,25 @@ struct CheckedChunk {
     refused: usize,
 }
 
+/// No winner's neighbourhood holds the vertex (see [`apply_winners`]).
+const NO_CLAIM: u32 = u32::MAX;
+
 /// Checks the device's winners again in f64, keeps those that touch
 /// disjoint neighbourhoods, and applies them in parallel.
 ///
 /// The device chooses in f32 and its output is not trusted: each winner is
-/// checked (`check_collapse`) against the mesh as the step found it, as
-/// the CPU backend checks its own, then, in ascending survivor id, kept
-/// only if no kept winner's neighbourhood (its endpoints and their
-/// neighbours, `claims` stamped with `stamp`) holds one of its endpoints.
-/// That is the CPU backend's blocking rule, and what `apply_collapses`'
-/// parallel writes need: kept collapses share no endpoint and no triangle.
-fn apply_winners(
-    s: &mut State,
-    winners: &[layout::Winner],
-    claims: &mut [u32],
-    stamp: u32,
-) -> Applied {
+/// checked (`check_collapse`) against the mesh as the step found it, as the
+/// CPU backend checks its own. Then every valid winner claims its
+/// neighbourhood (its endpoints and their neighbours) in `claims`, the
+/// lowest index winning, and a winner is kept only if it holds both its
+/// endpoints: no lower winner's neighbourhood holds one. Two kept winners
+/// thus never have an endpoint in each other's neighbourhood (if one had,
+/// the neighbour relation being symmetric, the lower one's neighbourhood
+/// would hold an endpoint of the higher), which is the CPU backend's
+/// blocking rule and what `apply_collapses`' parallel writes need: kept
+/// collapses share no endpoint and no triangle. `claims` is left as found
+/// (all `NO_CLAIM`).
+fn apply_winners(s: &mut State, winners: &[layout::Winner], claims: &[AtomicU32]) -> Applied {
     let s_now: &State = s;
     let chunks: Vec<CheckedChunk> = par_chunks_map(winners, |chunk| {
         let mut scratch = CheckScratch::default();
@@ -331,21 +339,65 @@ fn apply_winners(
         }
         out
     });
+    // Each valid winner's index among the valid ones, in winner order.
+    let firsts: Vec<u32> = chunks
+        .iter()
+        .scan(0u32, |at, chunk| {
+            let first = *at;
+            *at += chunk.valid.len() as u32;
+            Some(first)
+        })
+        .collect();
+    let hoods = || {
+        chunks
+            .par_iter()
+            .zip(&firsts)
+            .flat_map_iter(|(chunk, &first)| {
+                chunk
+                    .valid
+                    .iter()
+                    .enumerate()
+                    .map(move |(i, (_, (from, to)))| {
+                        (first + i as u32, &chunk.hood[*from as usize..*to as usize])
+                    })
+            })
+    };
+    hoods().for_each(|(index, hood)| {
+        for &x in hood {
+            claims[x as usize].fetch_min(index, Relaxed);
+        }
+    });
+    let holds = |index: u32, w: &Winner| {
+        [w.p, w.best.other]
+            .iter()
+            .all(|&x| claims[x as usize].load(Relaxed) == index)
+    };
+    let kept_flags: Vec<Vec<bool>> = chunks
+        .par_iter()
+        .zip(&firsts)
+        .map(|(chunk, &first)| {
+            let valid = chunk.valid.iter().enumerate();
+            valid
+                .map(|(i, (w, _))| holds(first + i as u32, w))
+                .collect()
+        })
+        .collect();
+    hoods().for_each(|(_, hood)| {
+        for &x in hood {
+            claims[x as usize].store(NO_CLAIM, Relaxed);
+        }
+    });
     let mut kept = Vec::with_capacity(winners.len());
     let mut fans = Vec::new();
     let (mut refused, mut overlapping) = (0, 0);
-    for chunk in chunks {
+    for (chunk, flags) in chunks.into_iter().zip(kept_flags) {
         refused += chunk.refused;
         let base = fans.len() as u32;
         fans.extend_from_slice(&chunk.corners);
-        for (mut winner, (from, to)) in chunk.valid {
-            let ends = [winner.p, winner.best.other];
-            if ends.iter().any(|&x| claims[x as usize] == stamp) {
+        for ((mut winner, _), keep) in chunk.valid.into_iter().zip(flags) {
+            if !keep {
                 overlapping += 1;
                 continue;
-            }
-            for &x in &chunk.hood[from as usize..to as usize] {
-                claims[x as usize] = stamp;
             }
             winner.fans.0 += base;
             kept.push(winner);
@@ -379,11 +431,12 @@ fn as_best(w: &layout::Winner) -> Best {
     }
 }
 
-/// The triangles and vertices a step's collapses rewrote: every triangle
-/// around each merged vertex (their corners moved to it, their opposites
-/// across the folded edges changed), the removed triangles, and the merged,
-/// removed and wing vertices (corners re-anchored).
-fn changes(s: &State, applied: &Applied) -> (Vec<TriangleUpdate>, Vec<VertexUpdate>) {
+/// Fills `updates` with the triangles and vertices a step's collapses
+/// rewrote: every triangle around each merged vertex (their corners moved to
+/// it, their opposites across the folded edges changed), the removed
+/// triangles, and the merged, removed and wing vertices (corners
+/// re-anchored).
+fn changes(s: &State, applied: &Applied, updates: &mut Updates) {
     let kept = &applied.winners;
     let mut triangles: Vec<u32> = kept
         .par_chunks(chunk_size(kept.len()))
@@ -408,31 +461,31 @@ fn changes(s: &State, applied: &Applied) -> (Vec<TriangleUpdate>, Vec<VertexUpda
     triangles.dedup();
     vertices.par_sort_unstable();
     vertices.dedup();
-    let triangles = triangles
-        .into_par_iter()
-        .map(|t| {
+    let (triangle_updates, vertex_updates) = updates.fill(triangles.len(), vertices.len());
+    triangle_updates
+        .par_iter_mut()
+        .zip(&triangles)
+        .for_each(|(u, &t)| {
             let k = 3 * t as usize;
-            TriangleUpdate {
+            *u = TriangleUpdate {
                 triangle: t,
                 vertex: std::array::from_fn(|i| s.table.vertex[k + i]),
                 opposite: std::array::from_fn(|i| s.table.opposite[k + i]),
-            }
-        })
-        .collect();
-    let vertices = vertices
-        .into_par_iter()
-        .map(|v| {
+            };
+        });
+    vertex_updates
+        .par_iter_mut()
+        .zip(&vertices)
+        .for_each(|(u, &v)| {
             let words = vertex_words(s, v as usize);
-            VertexUpdate {
+            *u = VertexUpdate {
                 vertex: v,
                 position: [words[0], words[1], words[2]],
                 flags: words[3],
                 corner_of: s.table.corner_of[v as usize],
                 quadric: to_local(&s.quadrics[v as usize], s.geometry(v)),
-            }
-        })
-        .collect();
-    (triangles, vertices)
+            };
+        });
 }
 
 #[cfg(test)]
@@ -464,6 +517,12 @@ mod tests {
         s
     }
 
+    fn no_claims(s: &State) -> Vec<AtomicU32> {
+        (0..s.alive.len())
+            .map(|_| AtomicU32::new(NO_CLAIM))
+            .collect()
+    }
+
     fn neighbours(s: &State, v: u32) -> Vec<u32> {
         let mut fan = Fan::default();
         s.table.fan(v, &mut fan);
@@ -489,8 +548,8 @@ mod tests {
         let mut winners = vec![winner(&s, p, c), winner(&s, p2, c2), winner(&s, far, far_c)];
         winners.sort_unstable_by_key(|w| w.v);
         let alive_before = s.alive.iter().filter(|&&a| a).count();
-        let mut claims = vec![0u32; s.alive.len()];
-        let applied = apply_winners(&mut s, &winners, &mut claims, 1);
+        let claims = no_claims(&s);
+        let applied = apply_winners(&mut s, &winners, &claims);
         assert_eq!(applied.refused, 0);
         assert_eq!(applied.overlapping, 1);
         let kept: Vec<u32> = applied.winners.iter().map(|w| w.p).collect();
@@ -503,11 +562,12 @@ mod tests {
         assert_eq!(applied.collapses.len(), 2);
         let alive_after = s.alive.iter().filter(|&&a| a).count();
         assert_eq!(alive_before - alive_after, 2);
-        // The dropped pair at the next step (a new stamp): the old claims
-        // no longer block it.
+        // Claims last for one call: the dropped pair alone is kept at the
+        // next step.
+        assert!(claims.iter().all(|c| c.load(Relaxed) == NO_CLAIM));
         let dropped = if first == p { (p2, c2) } else { (p, c) };
         let w = winner(&s, dropped.0, dropped.1);
-        let again = apply_winners(&mut s, &[w], &mut claims, 2);
+        let again = apply_winners(&mut s, &[w], &claims);
         assert_eq!(
             (again.refused, again.overlapping, again.collapses.len()),
             (0, 0, 1)
@@ -529,9 +589,9 @@ mod tests {
             off_grid,                 // off the grid
         ];
         let n = s.alive.len();
-        let mut claims = vec![0u32; n];
+        let claims = no_claims(&s);
         for (i, w) in garbage.iter().enumerate() {
-            let applied = apply_winners(&mut s, std::slice::from_ref(w), &mut claims, 1);
+            let applied = apply_winners(&mut s, std::slice::from_ref(w), &claims);
             assert_eq!(
                 (applied.refused, applied.collapses.len()),
                 (1, 0),
@@ -540,10 +600,10 @@ mod tests {
         }
         // A collapse applied, then a winner naming its removed vertex.
         let w = winner(&s, p, ring[0]);
-        let applied = apply_winners(&mut s, &[w], &mut claims, 2);
+        let applied = apply_winners(&mut s, &[w], &claims);
         assert_eq!(applied.collapses.len(), 1);
         let w = winner(&s, ring[1], ring[0]);
-        let dead = apply_winners(&mut s, &[w], &mut claims, 3);
+        let dead = apply_winners(&mut s, &[w], &claims);
         assert_eq!((dead.refused, dead.collapses.len()), (1, 0));
         assert_eq!(s.alive.iter().filter(|&&a| a).count(), n - 1);
     }
