@@ -321,6 +321,18 @@ impl Engine {
             self.device
                 .run(Kernel::LocalMin, &walk, live, Buffer::Live)?;
             let count = self.device.read(Buffer::Counter, 1)?[0];
+            // A step's winners are disjoint pairs: more than the buffer
+            // holds (or fewer than before) is a device fault, not a result
+            // to read past the buffer's end.
+            let capacity = Buffer::Winners.words(self.vertex_count, 0) / 7;
+            if count < done || count as usize > capacity {
+                return Err(GpuError::Kernel {
+                    api: self.device.info().api,
+                    detail: format!(
+                        "the device counted {count} winners after {done}, a step holds at most {capacity}"
+                    ),
+                });
+            }
             if count == done {
                 break;
             }
@@ -337,5 +349,67 @@ impl Engine {
         let mut winners: Vec<Winner> = bytemuck::cast_slice(&words).to_vec();
         winners.sort_unstable_by_key(|w| w.v);
         Ok(winners)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A device whose kernels do nothing and whose winner counter reads
+    /// `counter`.
+    struct FaultyCounter {
+        info: DeviceInfo,
+        counter: u32,
+    }
+
+    impl Device for FaultyCounter {
+        fn info(&self) -> &DeviceInfo {
+            &self.info
+        }
+        fn write(&mut self, _: Buffer, _: &[u32]) -> Result<(), GpuError> {
+            Ok(())
+        }
+        fn read_into(&mut self, buffer: Buffer, out: &mut [u32]) -> Result<(), GpuError> {
+            out.fill(0);
+            if buffer == Buffer::Counter {
+                out[0] = self.counter;
+            }
+            Ok(())
+        }
+        fn zero(&mut self, _: Buffer) -> Result<(), GpuError> {
+            Ok(())
+        }
+        fn run(&mut self, _: Kernel, _: &Params, _: u32, _: Buffer) -> Result<(), GpuError> {
+            Ok(())
+        }
+    }
+
+    fn engine(counter: u32) -> Engine {
+        Engine {
+            device: Box::new(FaultyCounter {
+                info: DeviceInfo {
+                    api: Api::Wgpu,
+                    name: "faulty".into(),
+                    detail: String::new(),
+                },
+                counter,
+            }),
+            vertex_count: 100,
+            live_len: 100,
+        }
+    }
+
+    #[test]
+    fn a_winner_count_past_the_buffer_is_a_device_fault() {
+        // 100 vertices: at most 51 winners fit the buffer.
+        let err = engine(1_000_000).select(&Params::default(), 3).unwrap_err();
+        assert!(
+            matches!(err, GpuError::Kernel { api: Api::Wgpu, .. }),
+            "{err:?}"
+        );
+        assert!(err.to_string().contains("1000000 winners"), "{err}");
+        // A count the buffer holds is read back as that many winners.
+        assert_eq!(engine(51).select(&Params::default(), 1).unwrap().len(), 51);
     }
 }
