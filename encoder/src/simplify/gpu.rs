@@ -32,9 +32,9 @@ use super::check::{CheckScratch, check_collapse};
 use super::select::{Best, pair_key};
 use super::state::{
     Collapse, EdgeMeter, MAX_VALENCE, Phases, Simplification, SimplifyOptions, State, Winner,
-    apply_collapses, chunk_size, mark_two_rings, par_chunks_map,
+    apply_collapses, mark_two_rings, par_chunks_map,
 };
-use crate::corner_table::{Fan, NONE};
+use crate::corner_table::NONE;
 use crate::quadric::Quadric;
 use crate::quantize::QuantizedMesh;
 
@@ -265,6 +265,9 @@ fn to_local(q: &Quadric, o: [f64; 3]) -> [f32; 10] {
 /// The device's winners of one step that the CPU kept and applied.
 struct Applied {
     winners: Vec<Winner>,
+    /// The fans of P then C of each kept winner, before its collapse
+    /// ([`Winner::fans`] indexes them).
+    fans: Vec<u32>,
     collapses: Vec<Collapse>,
     /// Winners the f64 check refused.
     refused: usize,
@@ -406,6 +409,7 @@ fn apply_winners(s: &mut State, winners: &[layout::Winner], claims: &[AtomicU32]
     let collapses = apply_collapses(s, &kept, &fans);
     Applied {
         winners: kept,
+        fans,
         collapses,
         refused,
         overlapping,
@@ -436,20 +440,17 @@ fn as_best(w: &layout::Winner) -> Best {
 /// it, their opposites across the folded edges changed), the removed
 /// triangles, and the merged, removed and wing vertices (corners
 /// re-anchored).
+///
+/// The triangles are those of P's and C's fans before the collapse, which
+/// its check walked: the merged vertex's fan after it plus the removed
+/// ones, with no walk.
 fn changes(s: &State, applied: &Applied, updates: &mut Updates) {
     let kept = &applied.winners;
     let mut triangles: Vec<u32> = kept
-        .par_chunks(chunk_size(kept.len()))
-        .flat_map_iter(|chunk| {
-            let mut fan = Fan::default();
-            let mut out = Vec::new();
-            for w in chunk {
-                s.table.fan(w.p, &mut fan);
-                out.extend(fan.corners.iter().map(|&k| k / 3));
-                let removed = [w.plan.left, w.plan.right].into_iter();
-                out.extend(removed.filter(|&c| c != NONE).map(|c| c / 3));
-            }
-            out
+        .par_iter()
+        .flat_map_iter(|w| {
+            let (start, np, nc) = (w.fans.0 as usize, w.fans.1 as usize, w.fans.2 as usize);
+            applied.fans[start..start + np + nc].iter().map(|&k| k / 3)
         })
         .collect();
     let mut vertices: Vec<u32> = kept
@@ -491,7 +492,7 @@ fn changes(s: &State, applied: &Applied, updates: &mut Updates) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::corner_table::next;
+    use crate::corner_table::{Fan, next};
     use crate::input::fractal_terrain;
     use crate::quantize::{Units, quantize};
 

@@ -1366,7 +1366,7 @@ pub(super) fn par_chunks_map<T: Sync, R: Send>(
 }
 
 /// The chunk length of the data-parallel passes over `len` items.
-pub(super) fn chunk_size(len: usize) -> usize {
+fn chunk_size(len: usize) -> usize {
     (len / (8 * rayon::current_num_threads())).clamp(512, 16384)
 }
 
