@@ -509,13 +509,106 @@ mod tests {
 
     /// The state of a 16 x 16 terrain as the GPU loop starts from.
     fn terrain_state() -> State {
+        terrain().1
+    }
+
+    fn terrain() -> (QuantizedMesh, State) {
         let q = quantize(&fractal_terrain(16, 3), 14, Units::Linear);
         let options = SimplifyOptions::default();
         let mut s = State::new(&q, &options);
         s.quadrics = s
             .fan_quadrics(options.boundary_weight)
             .expect("a manifold terrain");
-        s
+        (q, s)
+    }
+
+    /// The live part of `s` as a mesh.
+    fn live_mesh(s: &State, q: &QuantizedMesh) -> crate::Mesh {
+        let mut index = vec![NONE; s.alive.len()];
+        let mut positions = Vec::new();
+        for v in (0..s.alive.len()).filter(|&v| s.alive[v]) {
+            index[v] = positions.len() as u32;
+            positions.push(q.dequantize(s.positions[v]));
+        }
+        let triangles = s
+            .table
+            .vertex
+            .chunks_exact(3)
+            .filter(|t| t[0] != NONE)
+            .map(|t| std::array::from_fn(|k| index[t[k] as usize]))
+            .collect();
+        crate::Mesh {
+            positions,
+            triangles,
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(128))]
+
+        /// Whatever the device returns (vertices dead, missing or repeated,
+        /// pairs that are no edge or overlap, targets anywhere on or off
+        /// the grid, in any order), the host applies only collapses that
+        /// leave a manifold mesh of the same topology, one vertex fewer each.
+        #[test]
+        fn any_device_winners_leave_a_manifold_of_the_same_topology(
+            steps in proptest::collection::vec(
+                proptest::collection::vec((0u32..300, 0u32..300, 0u8..8), 0..48),
+                1..5,
+            )
+        ) {
+            let (q, mut s) = terrain();
+            let claims = no_claims(&s);
+            let before = check_mesh_of(&s, &q);
+            let mut collapses = 0;
+            for step in steps {
+                let winners: Vec<layout::Winner> = step
+                    .iter()
+                    .map(|&(v, pick, kind)| {
+                        // Mostly a real edge of a live vertex (kinds 0-5),
+                        // else any pair.
+                        let live = s.alive.get(v as usize).copied().unwrap_or(false);
+                        let ring = if live { neighbours(&s, v) } else { Vec::new() };
+                        let other = match ring.len() {
+                            len if kind < 6 && len > 0 => ring[pick as usize % len],
+                            _ => pick,
+                        };
+                        let position = |x: u32| s.positions.get(x as usize).copied();
+                        let target = match pick % 4 {
+                            0 => position(v),
+                            1 => position(other),
+                            2 => Some([v * 50, other * 50, 1 << 14]),
+                            _ => position(v).zip(position(other)).map(|(a, b)| {
+                                std::array::from_fn(|k| (a[k] + b[k]) / 2)
+                            }),
+                        };
+                        layout::Winner {
+                            v,
+                            other,
+                            error: 0.0,
+                            key: 0,
+                            target: target.unwrap_or([0; 3]),
+                        }
+                    })
+                    .collect();
+                let applied = apply_winners(&mut s, &winners, &claims);
+                proptest::prop_assert_eq!(
+                    applied.collapses.len() + applied.refused + applied.overlapping,
+                    winners.len()
+                );
+                collapses += applied.collapses.len();
+            }
+            let after = check_mesh_of(&s, &q);
+            proptest::prop_assert_eq!(after.vertices, before.vertices - collapses);
+            proptest::prop_assert_eq!(after.euler_characteristic, before.euler_characteristic);
+            proptest::prop_assert_eq!(after.boundary_loops, before.boundary_loops);
+            proptest::prop_assert_eq!(after.components, 1);
+            proptest::prop_assert!(claims.iter().all(|c| c.load(Relaxed) == NO_CLAIM));
+        }
+    }
+
+    fn check_mesh_of(s: &State, q: &QuantizedMesh) -> crate::input::MeshStats {
+        crate::input::check_mesh(&live_mesh(s, q)).expect("a manifold mesh")
     }
 
     fn no_claims(s: &State) -> Vec<AtomicU32> {
