@@ -495,6 +495,7 @@ mod tests {
     use crate::corner_table::{Fan, next};
     use crate::input::fractal_terrain;
     use crate::quantize::{Units, quantize};
+    use crate::simplify::state::live_mesh;
 
     /// A device winner collapsing `c` into `p` at `p`'s position.
     fn winner(s: &State, p: u32, c: u32) -> layout::Winner {
@@ -520,27 +521,6 @@ mod tests {
             .fan_quadrics(options.boundary_weight)
             .expect("a manifold terrain");
         (q, s)
-    }
-
-    /// The live part of `s` as a mesh.
-    fn live_mesh(s: &State, q: &QuantizedMesh) -> crate::Mesh {
-        let mut index = vec![NONE; s.alive.len()];
-        let mut positions = Vec::new();
-        for v in (0..s.alive.len()).filter(|&v| s.alive[v]) {
-            index[v] = positions.len() as u32;
-            positions.push(q.dequantize(s.positions[v]));
-        }
-        let triangles = s
-            .table
-            .vertex
-            .chunks_exact(3)
-            .filter(|t| t[0] != NONE)
-            .map(|t| std::array::from_fn(|k| index[t[k] as usize]))
-            .collect();
-        crate::Mesh {
-            positions,
-            triangles,
-        }
     }
 
     proptest::proptest! {
@@ -608,7 +588,8 @@ mod tests {
     }
 
     fn check_mesh_of(s: &State, q: &QuantizedMesh) -> crate::input::MeshStats {
-        crate::input::check_mesh(&live_mesh(s, q)).expect("a manifold mesh")
+        crate::input::check_mesh(&live_mesh(&s.table, &s.alive, &s.positions, q))
+            .expect("a manifold mesh")
     }
 
     fn no_claims(s: &State) -> Vec<AtomicU32> {

@@ -2145,35 +2145,38 @@ impl EdgeMeter {
     }
 }
 
+/// The live vertices and triangles of a simplification state as a mesh in
+/// real coordinates, compacted (surviving vertices in ascending id, live
+/// triangles in order).
+pub(super) fn live_mesh(
+    table: &CornerTable,
+    alive: &[bool],
+    positions: &[[u32; 3]],
+    mesh: &QuantizedMesh,
+) -> crate::Mesh {
+    let mut index = vec![NONE; alive.len()];
+    let mut real = Vec::new();
+    for v in (0..alive.len()).filter(|&v| alive[v]) {
+        index[v] = real.len() as u32;
+        real.push(mesh.dequantize(positions[v]));
+    }
+    let triangles = table
+        .vertex
+        .chunks_exact(3)
+        .filter(|t| t[0] != NONE)
+        .map(|t| std::array::from_fn(|k| index[t[k] as usize]))
+        .collect();
+    crate::Mesh {
+        positions: real,
+        triangles,
+    }
+}
+
 impl Simplification {
     /// The simplified mesh in real coordinates, compacted (surviving
     /// vertices in ascending id, live triangles in order).
     pub fn to_mesh(&self, mesh: &QuantizedMesh) -> crate::Mesh {
-        let mut index = vec![NONE; self.alive.len()];
-        let mut positions = Vec::with_capacity(self.alive_count);
-        for (v, &alive) in self.alive.iter().enumerate() {
-            if alive {
-                index[v] = positions.len() as u32;
-                positions.push(mesh.dequantize(self.positions[v]));
-            }
-        }
-        let triangles = self
-            .table
-            .vertex
-            .chunks_exact(3)
-            .filter(|t| t[0] != NONE)
-            .map(|t| {
-                [
-                    index[t[0] as usize],
-                    index[t[1] as usize],
-                    index[t[2] as usize],
-                ]
-            })
-            .collect();
-        crate::Mesh {
-            positions,
-            triangles,
-        }
+        live_mesh(&self.table, &self.alive, &self.positions, mesh)
     }
 
     /// Largest quadric error of any collapse.
