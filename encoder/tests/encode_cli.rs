@@ -198,3 +198,23 @@ fn one_level_notes_that_the_base_size_has_no_effect() {
         "{stderr}"
     );
 }
+
+#[test]
+fn gpu_bench_can_leave_out_the_decoder_table() {
+    let out = succeeded(&splitstream(&[
+        "gpu-bench",
+        "--sides",
+        "24",
+        "--backends",
+        "cpu,sequential",
+        "--skip-decoder",
+    ]));
+    assert!(out.contains("| 24x24 | 576 |"), "{out}");
+    assert!(
+        out.contains("| cpu |") && out.contains("| sequential |"),
+        "{out}"
+    );
+    assert!(!out.contains("GPU decoder"), "{out}");
+    let err = one_line_error(&splitstream(&["gpu-bench", "--sides", "1"]));
+    assert!(err.contains("--sides: 1"), "{err}");
+}

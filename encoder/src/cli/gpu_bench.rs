@@ -48,6 +48,10 @@ pub struct Settings {
     /// backend has no adapter.
     #[arg(long)]
     pub require_gpu: bool,
+    /// Leave out the GPU decoder's table (it re-encodes each terrain on the
+    /// CPU and decodes it four times: at 4M vertices about half a minute).
+    #[arg(long)]
+    pub skip_decoder: bool,
 }
 
 /// What one contender measured.
@@ -137,6 +141,9 @@ pub fn run(settings: &Settings) -> CliResult {
                 row.note
             );
         }
+    }
+    if settings.skip_decoder {
+        return Ok(());
     }
     // The WGSL decoder (sdk-native, feature `gpu`) on the same terrains.
     gpu_decoder(&settings.sides, settings.require_gpu)
