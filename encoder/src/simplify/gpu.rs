@@ -165,7 +165,6 @@ pub fn simplify_gpu(
             // winners in.
             winners.sort_unstable_by_key(|w| w.v);
         }
-        let stamp = steps.len() as u32 + 1;
         let applied = apply_winners(&mut s, &winners, &claims);
         let rejected = applied.refused + applied.overlapping;
         rejected_total += rejected;
@@ -185,6 +184,7 @@ pub fn simplify_gpu(
             .copied()
             .filter(|&v| s.alive[v as usize])
             .collect();
+        let stamp = steps.len() as u32 + 1;
         mark_two_rings(&s, &merged, &dirty, stamp);
         dirty_list = live
             .par_iter()
@@ -271,8 +271,8 @@ struct Applied {
     collapses: Vec<Collapse>,
     /// Winners the f64 check refused.
     refused: usize,
-    /// Winners dropped because a kept winner's neighbourhood held one of
-    /// their endpoints.
+    /// Valid winners dropped because a lower valid winner's neighbourhood
+    /// held one of their endpoints.
     overlapping: usize,
 }
 
