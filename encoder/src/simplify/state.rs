@@ -1703,7 +1703,8 @@ fn record(
 /// The collapses of a step touch disjoint parts of the mesh: the triangles
 /// around P and C, and P's and C's own entries, belong to one collapse each
 /// (the endpoints of two winners are never neighbours: each winner blocks
-/// its endpoints' 1-rings). Only a wing can be shared, so the wings' new
+/// its endpoints' 1-rings, here in `step_winners`, for the GPU backends in
+/// `gpu::apply_winners`' claims). Only a wing can be shared, so the wings' new
 /// corners and valences are set afterwards, in winner order, as one
 /// collapse after the other would leave them.
 pub(super) fn apply_collapses(s: &mut State, winners: &[Winner], fans: &[u32]) -> Vec<Collapse> {
