@@ -273,7 +273,13 @@ impl MeshState<'_> {
             }
         }
         let mut sum = 0u32;
-        for i in 0..count {
+        for (i, &r) in rs[..count].iter().enumerate() {
+            // The owner's own position too: its record reads it first
+            // (the parent of the split's positions, SPEC §7.4), and nothing
+            // else loads it before.
+            if let Some(p) = self.positions.get(r as usize) {
+                sum = sum.wrapping_add(p[0]);
+            }
             for &v in &ahead.vertices[i][..ahead.len[i] as usize] {
                 if let (Some(p), Some(&d)) =
                     (self.positions.get(v as usize), self.deficit.get(v as usize))
