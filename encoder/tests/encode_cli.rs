@@ -99,17 +99,22 @@ fn bad_streams_and_arguments_get_one_line_naming_the_file() {
     let s = stream.to_str().unwrap();
     succeeded(&splitstream(&["encode", input.to_str().unwrap(), "-o", s]));
     let bytes = std::fs::read(&stream).unwrap();
-    // Cut inside level 0: every reader names the file and the problem.
+    // Cut: every reader that needs the whole stream names the file and
+    // the problem; `info` describes the prefix.
     let cut = input.with_file_name("cut.sps");
     std::fs::write(&cut, &bytes[..bytes.len() / 2]).unwrap();
     let c = cut.to_str().unwrap();
-    for command in ["info", "verify"] {
-        let err = one_line_error(&splitstream(&[command, c]));
+    let decoded = input.with_file_name("cut.ply");
+    let d = decoded.to_str().unwrap();
+    for args in [vec!["verify", c], vec!["decode", c, "-o", d]] {
+        let err = one_line_error(&splitstream(&args));
         assert!(
             err.contains("cut.sps: ") && err.contains("truncated"),
-            "{command}: {err}"
+            "{args:?}: {err}"
         );
     }
+    let described = succeeded(&splitstream(&["info", c]));
+    assert!(described.contains("truncated: levels "), "{described}");
     let garbage = temp("garbage.sps", "not a stream at all");
     let err = one_line_error(&splitstream(&["info", garbage.to_str().unwrap()]));
     assert!(err.contains("garbage.sps: not a splitstream file"), "{err}");
@@ -119,6 +124,70 @@ fn bad_streams_and_arguments_get_one_line_naming_the_file() {
     assert!(err.contains("--level 99"), "{err}");
     let err = one_line_error(&splitstream(&["decode", s, "-o", "out.xyz"]));
     assert!(err.contains("out.xyz"), "{err}");
+}
+
+#[test]
+fn a_prefix_of_the_stream_decodes_to_its_last_whole_level() {
+    let input = raster();
+    let stream = input.with_file_name("for-prefix.sps");
+    let s = stream.to_str().unwrap();
+    succeeded(&splitstream(&["encode", input.to_str().unwrap(), "-o", s]));
+    let bytes = std::fs::read(&stream).unwrap();
+    let doc: serde_json::Value =
+        serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();
+    let levels = doc["levels"].as_array().unwrap();
+    assert!(levels.len() >= 3, "{doc}");
+    assert_eq!(doc["levels_in_file"].as_u64(), Some(levels.len() as u64));
+    let hash = |stdout: &str| {
+        stdout
+            .split("state hash ")
+            .nth(1)
+            .unwrap()
+            .trim()
+            .to_string()
+    };
+    let out = input.with_file_name("prefix.obj");
+    let o = out.to_str().unwrap();
+    // Cut one byte before the end of level k (k ≥ 1): levels 0..k are whole.
+    for (k, level) in levels.iter().enumerate().skip(1) {
+        let end = (level["offset"].as_u64().unwrap() + level["length"].as_u64().unwrap()) as usize;
+        let cut = input.with_file_name(format!("prefix-{k}.sps"));
+        std::fs::write(&cut, &bytes[..end - 1]).unwrap();
+        let c = cut.to_str().unwrap();
+        let partial = succeeded(&splitstream(&["decode", c, "-o", o, "--available"]));
+        assert!(
+            partial.contains(&format!("level {} (levels {k}..=", k - 1)),
+            "{partial}"
+        );
+        let whole = succeeded(&splitstream(&[
+            "decode",
+            s,
+            "-o",
+            o,
+            "--level",
+            &(k - 1).to_string(),
+        ]));
+        assert_eq!(hash(&partial), hash(&whole), "prefix up to level {k}");
+        let described: serde_json::Value =
+            serde_json::from_str(&succeeded(&splitstream(&["info", c, "--json"]))).unwrap();
+        assert_eq!(described["levels_in_file"].as_u64(), Some(k as u64));
+    }
+    // The whole file: `--available` changes nothing.
+    let all = succeeded(&splitstream(&["decode", s, "-o", o, "--available"]));
+    let whole = succeeded(&splitstream(&["decode", s, "-o", o]));
+    assert_eq!(all, whole);
+    // Not even level 0: one line, and --codecs needs every level.
+    let head = input.with_file_name("prefix-head.sps");
+    std::fs::write(
+        &head,
+        &bytes[..levels[0]["offset"].as_u64().unwrap() as usize + 1],
+    )
+    .unwrap();
+    let h = head.to_str().unwrap();
+    let err = one_line_error(&splitstream(&["decode", h, "-o", o, "--available"]));
+    assert!(err.contains("no whole level in the file"), "{err}");
+    let err = one_line_error(&splitstream(&["info", h, "--codecs"]));
+    assert!(err.contains("--codecs"), "{err}");
 }
 
 #[test]

@@ -50,11 +50,32 @@ pub fn field_sizes(
     header: &Header,
     table: &LevelTable<'_>,
 ) -> Result<FieldSizes, String> {
+    field_sizes_of(stream, header, table, table.len())
+}
+
+/// How many levels, from level 0, have all their bytes in `stream` (a
+/// prefix of a stream holds its first levels whole, SPEC §4.1).
+pub fn levels_in(stream: &[u8], table: &LevelTable<'_>) -> u16 {
+    (0..table.len())
+        .take_while(|&k| {
+            let e = table.get(k);
+            e.offset + e.length as u64 <= stream.len() as u64
+        })
+        .count() as u16
+}
+
+/// Sums chunk sizes per substream over levels `0..levels` of `stream`.
+fn field_sizes_of(
+    stream: &[u8],
+    header: &Header,
+    table: &LevelTable<'_>,
+    levels: u16,
+) -> Result<FieldSizes, String> {
     let mut sizes = FieldSizes {
         framing: splitstream_decoder_core::head_len(header.level_count) as u64,
         ..FieldSizes::default()
     };
-    for k in 0..table.len() {
+    for k in 0..levels {
         let e = table.get(k);
         let end = e.offset + e.length as u64;
         let bytes = stream.get(e.offset as usize..end as usize).ok_or_else(|| {
@@ -137,8 +158,28 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
     let fail = |e: splitstream_decoder_core::Error| format!("{}: {e}", input.display());
     let header = Header::parse(&stream).map_err(fail)?;
     let table = LevelTable::parse(&stream, &header).map_err(fail)?;
-    let sizes =
-        field_sizes(&stream, &header, &table).map_err(|e| format!("{}: {e}", input.display()))?;
+    // A prefix of the stream (its first levels, as a client fetches them)
+    // is described as far as it goes.
+    let in_file = levels_in(&stream, &table);
+    let last = table.get(table.len() - 1);
+    let declared_bytes = last.offset + last.length as u64;
+    let truncated = (in_file < table.len()).then(|| {
+        format!(
+            "truncated: levels {in_file}..={} are not in the file (it has {} of {declared_bytes} bytes); \
+             the fields count levels before {in_file} only",
+            table.len() - 1,
+            stream.len(),
+        )
+    });
+    if codecs && truncated.is_some() {
+        return Err(format!(
+            "{}: --codecs re-codes the whole stream, and the file holds levels 0..{in_file} of {}",
+            input.display(),
+            table.len()
+        ));
+    }
+    let sizes = field_sizes_of(&stream, &header, &table, in_file)
+        .map_err(|e| format!("{}: {e}", input.display()))?;
     let recoded = if codecs {
         recode(&stream, &header, &sizes).map_err(|e| format!("{}: {e}", input.display()))?
     } else {
@@ -225,6 +266,8 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
             "workspace_bytes": header.workspace_bytes,
             "workspace_bytes_per_vertex": header.workspace_bytes as f64 / n,
             "max_chunk_len": header.max_chunk_len,
+            "declared_bytes": declared_bytes,
+            "levels_in_file": in_file,
             "levels": levels,
             "fields": fields,
         });
@@ -292,6 +335,9 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
             memory[k as usize],
             e.geometric_error
         );
+    }
+    if let Some(truncated) = &truncated {
+        println!("  {truncated}");
     }
     let recoded_header: String = recoded
         .iter()

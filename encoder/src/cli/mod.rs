@@ -220,6 +220,11 @@ pub enum Command {
         /// Stop after this level (0 = base mesh).
         #[arg(long)]
         level: Option<u16>,
+        /// Decode the levels whose bytes are all in the file and stop
+        /// before the first one cut off (a prefix of the stream, as fetched
+        /// with range requests), instead of failing on a truncated file.
+        #[arg(long)]
+        available: bool,
     },
     /// Header, level table (with the decoder memory each prefix of levels
     /// needs), bits per field and per vertex.
@@ -267,7 +272,8 @@ pub fn run(cli: Cli) -> CliResult {
             input,
             output,
             level,
-        } => decode::run(&input, &output, level),
+            available,
+        } => decode::run(&input, &output, decode::DecodeOptions { level, available }),
         Command::Info {
             input,
             json,
