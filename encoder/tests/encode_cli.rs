@@ -171,6 +171,13 @@ fn a_prefix_of_the_stream_decodes_to_its_last_whole_level() {
         let described: serde_json::Value =
             serde_json::from_str(&succeeded(&splitstream(&["info", c, "--json"]))).unwrap();
         assert_eq!(described["levels_in_file"].as_u64(), Some(k as u64));
+        // Bits per vertex of what the file holds: levels 0..k's bytes over
+        // level k - 1's vertices.
+        let held = &levels[k - 1];
+        assert_eq!(described["vertices_in_file"], held["vertices"]);
+        let bytes = held["offset"].as_f64().unwrap() + held["length"].as_f64().unwrap();
+        let bpv = described["bits_per_vertex"].as_f64().unwrap();
+        assert!((bpv - 8.0 * bytes / held["vertices"].as_f64().unwrap()).abs() < 1e-9);
     }
     // The whole file: `--available` changes nothing.
     let all = succeeded(&splitstream(&["decode", s, "-o", o, "--available"]));
@@ -188,6 +195,11 @@ fn a_prefix_of_the_stream_decodes_to_its_last_whole_level() {
     assert!(err.contains("no whole level in the file"), "{err}");
     let err = one_line_error(&splitstream(&["info", h, "--codecs"]));
     assert!(err.contains("--codecs"), "{err}");
+    let described = succeeded(&splitstream(&["info", h]));
+    assert!(
+        described.contains("no whole level in the file"),
+        "{described}"
+    );
 }
 
 #[test]

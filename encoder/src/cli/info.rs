@@ -202,8 +202,25 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
                 })
         })
         .collect();
-    let n = header.vertex_capacity as f64;
-    let bpv = |bytes: u64| 8.0 * bytes as f64 / n;
+    // Per vertex of what the file holds: the whole stream, or for a prefix
+    // the levels before the first one cut off (their bytes and the finest
+    // one's vertices).
+    let (vertices_held, bytes_held) = match in_file {
+        k if k == table.len() => (header.vertex_capacity, stream.len() as u64),
+        0 => (
+            0,
+            splitstream_decoder_core::head_len(header.level_count) as u64,
+        ),
+        k => {
+            let e = table.get(k - 1);
+            (e.vertex_count, e.offset + e.length as u64)
+        }
+    };
+    // With no whole level there is nothing to divide by (`null` in JSON).
+    let bpv = |bytes: u64| match vertices_held {
+        0 => f64::NAN,
+        n => 8.0 * bytes as f64 / n as f64,
+    };
     let connectivity: u64 = (1..FIELDS)
         .filter(|&i| !is_geometry(i))
         .map(|i| sizes.stored[i])
@@ -259,12 +276,13 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
             "vertices": header.vertex_capacity,
             "triangles": header.triangle_capacity,
             "bytes": stream.len(),
-            "bits_per_vertex": bpv(stream.len() as u64),
+            "vertices_in_file": vertices_held,
+            "bits_per_vertex": bpv(bytes_held),
             "connectivity_bits_per_vertex": bpv(connectivity),
             "geometry_bits_per_vertex": bpv(geometry),
             "framing_bytes": sizes.framing,
             "workspace_bytes": header.workspace_bytes,
-            "workspace_bytes_per_vertex": header.workspace_bytes as f64 / n,
+            "workspace_bytes_per_vertex": header.workspace_bytes as f64 / header.vertex_capacity as f64,
             "max_chunk_len": header.max_chunk_len,
             "declared_bytes": declared_bytes,
             "levels_in_file": in_file,
@@ -296,16 +314,32 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
         header.version_minor,
         header.lane_count
     );
-    println!(
-        "  {} vertices, {} triangles, {} bytes ({:.2} bits/vertex: connectivity {:.2}, geometry {:.2}, framing {:.2})",
-        header.vertex_capacity,
-        header.triangle_capacity,
-        stream.len(),
-        bpv(stream.len() as u64),
-        bpv(connectivity),
-        bpv(geometry),
-        bpv(sizes.framing)
-    );
+    let held = match in_file {
+        k if k == table.len() => format!("{} bytes", stream.len()),
+        0 => String::new(),
+        k => format!(
+            "{declared_bytes} bytes declared; levels 0..={} in the file: {vertices_held} vertices in {bytes_held} bytes",
+            k - 1
+        ),
+    };
+    if in_file == 0 {
+        println!(
+            "  {} vertices, {} triangles, {declared_bytes} bytes declared; no whole level in the file ({} bytes)",
+            header.vertex_capacity,
+            header.triangle_capacity,
+            stream.len()
+        );
+    } else {
+        println!(
+            "  {} vertices, {} triangles, {held} ({:.2} bits/vertex: connectivity {:.2}, geometry {:.2}, framing {:.2})",
+            header.vertex_capacity,
+            header.triangle_capacity,
+            bpv(bytes_held),
+            bpv(connectivity),
+            bpv(geometry),
+            bpv(sizes.framing)
+        );
+    }
     println!(
         "  positions: {} bits/axis, {mode} placement, origin {:?}, step {:?}",
         header.bits, header.origin, header.scale
@@ -313,7 +347,7 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
     println!(
         "  decoder memory: {} bytes ({:.1} bytes/vertex), stored and deflate chunks up to {} bytes",
         header.workspace_bytes,
-        header.workspace_bytes as f64 / n,
+        header.workspace_bytes as f64 / header.vertex_capacity as f64,
         header.max_chunk_len
     );
     println!(
