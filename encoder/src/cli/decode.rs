@@ -27,9 +27,7 @@ pub fn run(input: &Path, output: &Path, options: DecodeOptions) -> CliResult {
     }
     // A prefix of the stream, as a client holds it after fetching its first
     // levels (SPEC §4.1): the levels before the first one cut off.
-    let in_file = (0..=last)
-        .take_while(|&k| decoder.level_range(k).end <= stream.len() as u64)
-        .count() as u16;
+    let in_file = super::info::levels_in(&stream, decoder.level_table());
     let mut missing = String::new();
     if options.available && in_file <= stop {
         if in_file == 0 {

@@ -173,7 +173,7 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
     });
     if codecs && truncated.is_some() {
         return Err(format!(
-            "{}: --codecs re-codes the whole stream, and the file holds levels 0..{in_file} of {}",
+            "{}: --codecs re-codes the whole stream, and the file holds {in_file} of its {} levels",
             input.display(),
             table.len()
         ));
