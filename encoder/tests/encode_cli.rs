@@ -27,6 +27,20 @@ fn raster() -> PathBuf {
     temp("raster.asc", &s)
 }
 
+/// The raster of [`raster`] and its stream, encoded with the defaults into
+/// `name` beside it.
+fn encoded_raster(name: &str) -> (PathBuf, PathBuf) {
+    let input = raster();
+    let stream = input.with_file_name(name);
+    succeeded(&splitstream(&[
+        "encode",
+        input.to_str().unwrap(),
+        "-o",
+        stream.to_str().unwrap(),
+    ]));
+    (input, stream)
+}
+
 /// The `v x y z` lines of an OBJ file.
 fn obj_positions(path: &PathBuf) -> Vec<[f64; 3]> {
     std::fs::read_to_string(path)
@@ -94,10 +108,8 @@ fn a_raster_is_encoded_constrained_and_decodes_exactly() {
 
 #[test]
 fn bad_streams_and_arguments_get_one_line_naming_the_file() {
-    let input = raster();
-    let stream = input.with_file_name("for-errors.sps");
+    let (input, stream) = encoded_raster("for-errors.sps");
     let s = stream.to_str().unwrap();
-    succeeded(&splitstream(&["encode", input.to_str().unwrap(), "-o", s]));
     let bytes = std::fs::read(&stream).unwrap();
     // Cut: every reader that needs the whole stream names the file and
     // the problem; `info` describes the prefix.
@@ -128,10 +140,8 @@ fn bad_streams_and_arguments_get_one_line_naming_the_file() {
 
 #[test]
 fn a_prefix_of_the_stream_decodes_to_its_last_whole_level() {
-    let input = raster();
-    let stream = input.with_file_name("for-prefix.sps");
+    let (input, stream) = encoded_raster("for-prefix.sps");
     let s = stream.to_str().unwrap();
-    succeeded(&splitstream(&["encode", input.to_str().unwrap(), "-o", s]));
     let bytes = std::fs::read(&stream).unwrap();
     let doc: serde_json::Value =
         serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();
@@ -204,10 +214,8 @@ fn a_prefix_of_the_stream_decodes_to_its_last_whole_level() {
 
 #[test]
 fn info_gives_the_memory_each_prefix_of_levels_needs() {
-    let input = raster();
-    let stream = input.with_file_name("for-info.sps");
+    let (_, stream) = encoded_raster("for-info.sps");
     let s = stream.to_str().unwrap();
-    succeeded(&splitstream(&["encode", input.to_str().unwrap(), "-o", s]));
     let doc: serde_json::Value =
         serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();
     let memory: Vec<u64> = doc["levels"]
