@@ -215,7 +215,7 @@ impl EncodeOptions {
 }
 
 /// The coding options' own rules, shared by [`EncodeOptions::check`] and
-/// [`transcode`]: chunks of at least one byte or value, and 1 to 32 rANS
+/// [`transcode()`]: chunks of at least one byte or value, and 1 to 32 rANS
 /// lanes (SPEC §5.5.3; the writer would put any other count in a header
 /// that every decoder refuses).
 pub fn check_coding(

@@ -28,12 +28,15 @@ use splitstream_kernels::encode::layout::{
 use splitstream_kernels::encode::{Engine, Updates};
 use splitstream_kernels::gpu::{Api, GpuError};
 
+use super::apply::apply_collapses;
 use super::check::{CheckScratch, check_collapse};
+use super::meter::EdgeMeter;
+use super::parallel::par_chunks_map;
+use super::phases::Phases;
+use super::refresh::mark_two_rings;
 use super::select::{Best, pair_key};
-use super::state::{
-    Collapse, EdgeMeter, MAX_VALENCE, Phases, Simplification, SimplifyOptions, State, Winner,
-    apply_collapses, mark_two_rings, par_chunks_map,
-};
+use super::state::{Collapse, MAX_VALENCE, Simplification, SimplifyOptions, State};
+use super::winners::Winner;
 use crate::corner_table::NONE;
 use crate::quadric::Quadric;
 use crate::quantize::QuantizedMesh;

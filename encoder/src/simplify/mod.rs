@@ -26,13 +26,32 @@
 //!
 //! [`simplify_on`] runs the same steps with the data-parallel passes on a
 //! GPU backend (`gpu`: which step runs where is tabled there).
+//!
+//! Files, in the order of a CPU step (`cpu` is the loop): `state` holds the
+//! arrays both backends share and the result; `offers` and `select` choose
+//! each vertex's request; `winners` keeps the reciprocal local minima that
+//! pass `check`; `apply` applies them in parallel; `refresh` re-evaluates
+//! the edges around the merged vertices; `compact` renumbers the live
+//! vertices densely once half of them are gone. `tracking` is the loop's
+//! per-vertex bookkeeping, `quantile` the threshold S, `meter` the mean
+//! edge length, `phases` the timer of `SPLITSTREAM_DEBUG`.
 
+mod apply;
 mod backend;
 mod check;
+mod compact;
+mod cpu;
 mod gpu;
+mod meter;
+mod offers;
+mod parallel;
+mod phases;
 mod quantile;
+mod refresh;
 mod select;
 mod state;
+mod tracking;
+mod winners;
 
 pub use backend::{Backend, GpuError};
 pub use state::{Collapse, MAX_VALENCE, NO_SPLIT, Simplification, SimplifyOptions};
@@ -80,7 +99,7 @@ pub fn simplify(
     options: &SimplifyOptions,
     progress: impl FnMut(usize),
 ) -> Simplification {
-    state::simplify(mesh.mesh, options, progress)
+    cpu::simplify(mesh.mesh, options, progress)
 }
 
 /// [`simplify`] on `backend`. The CPU backend never fails; a GPU backend
@@ -92,7 +111,7 @@ pub fn simplify_on(
     progress: impl FnMut(usize),
 ) -> Result<Simplification, GpuError> {
     match backend.api() {
-        None => Ok(state::simplify(mesh.mesh, options, progress)),
+        None => Ok(cpu::simplify(mesh.mesh, options, progress)),
         Some(api) => gpu::simplify_gpu(api, mesh.mesh, options, progress),
     }
 }

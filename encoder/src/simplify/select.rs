@@ -256,7 +256,7 @@ pub struct Choices {
     /// A lower bound of the keys of the other candidates, those after
     /// `second` (after `best` where `second` is not known); `u32::MAX`
     /// when there are none. What a change of scale cannot reorder is
-    /// told by it (`state::rescaled`).
+    /// told by it (`cpu::rescaled`).
     pub bound: u32,
 }
 
@@ -317,7 +317,7 @@ impl<'a> Ranking<'a> {
 
 /// §2 step a: the cheapest edge of `v` to a neighbour that is not blocked,
 /// skipping edges known to be invalid (their validity is checked only once
-/// chosen), in [`Rank`] order, and the runner-up with another partner.
+/// chosen), in [`Ranking`] order, and the runner-up with another partner.
 ///
 /// `reopened` receives the neighbours `u` whose edge to `v` was refused before
 /// `v`'s 1-ring last changed: that edge may be valid again and `u` should
