@@ -1,0 +1,467 @@
+//! The valid vectors: hand-made streams, encoder output under the format's
+//! options, and a real mesh.
+
+use splitstream_decoder_core::handmade;
+use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
+use splitstream_decoder_core::{DeficitContexts, Header, PlanePolicy, PositionMode, WingPolicy};
+use splitstream_encoder::emit::EncodeOptions;
+use splitstream_encoder::quantize::Lattice;
+use std::path::Path;
+
+use super::meshes;
+use super::mutate::*;
+use super::{Specs, deflate_opts, encoded, opts};
+
+pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
+    // The smallest legal streams, built by hand.
+    s.valid(
+        "minimal-triangle",
+        "A single triangle as the seed, level 0 only and no rounds: the smallest legal stream.",
+        &["minimal", "handmade", "base-only"],
+        handmade::single_triangle_stream(),
+    );
+    s.valid(
+        "minimal-tetrahedron",
+        "A tetrahedron whose vertices are all leaves as the seed, level 0 only and no rounds.",
+        &["minimal", "handmade", "base-only"],
+        write_stream(&handmade::stored(), &[handmade::tetrahedron_leaves()]),
+    );
+    s.valid(
+        "handmade-tetra-split-stored",
+        "SPEC Appendix A: a tetrahedron and one split of vertex 0; 4-byte stored chunks.",
+        &["minimal", "handmade", "one-split"],
+        handmade::tetra_stream(ChunkCodec::Stored),
+    );
+    s.valid(
+        "handmade-tetra-split-deflate",
+        "SPEC Appendix A with every chunk a deflate stream of one stored block (larger than its raw bytes).",
+        &["minimal", "handmade", "one-split", "deflate-stored-block"],
+        wrap_chunks_in_deflate(&handmade::tetra_stream(ChunkCodec::Stored)),
+    );
+    s.valid(
+        "handmade-boundary-ghost-wing",
+        "One triangle; a boundary vertex splits with the ghost vertex as one wing (adds one triangle).",
+        &["minimal", "handmade", "one-split", "ghost-wing"],
+        handmade::boundary_ghost_wing_stream(),
+    );
+
+    // Encoded meshes.
+    let sphere3 = meshes::checked(meshes::icosphere(3), "icosphere(3)");
+    let sphere2 = meshes::checked(meshes::icosphere(2), "icosphere(2)");
+    let holed = meshes::checked(
+        meshes::grid(24, 20, 1, Some([8, 15, 6, 12])),
+        "grid with hole",
+    );
+    let small_holed = meshes::checked(
+        meshes::grid(14, 12, 4, Some([4, 9, 4, 8])),
+        "small grid with hole",
+    );
+    let bumpy = meshes::checked(meshes::grid(30, 30, 2, None), "grid");
+    let locked = meshes::checked(meshes::grid(16, 16, 3, None), "grid for lock_boundary");
+    let cone = meshes::checked(meshes::cone(96, 4), "cone");
+    s.valid(
+        "icosphere-optimal-deflate",
+        "Icosphere (642 vertices, closed): optimal positions, deflate, 5 levels.",
+        &["encoded"],
+        encoded(&sphere3, deflate_opts()),
+    );
+    s.valid(
+        "icosphere-constrained-stored",
+        "Icosphere (162 vertices), constrained positions, stored chunks, 10 bits.",
+        &["encoded"],
+        encoded(
+            &sphere2,
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::Stored,
+                bits: 10,
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "grid-hole-optimal-deflate",
+        "Height field with an outer boundary and a rectangular hole, optimal positions, deflate.",
+        &["encoded", "hole"],
+        encoded(&holed, deflate_opts()),
+    );
+    s.valid(
+        "grid-hole-constrained-tiny-chunks",
+        "Small height field with a hole, constrained positions, 7-byte stored chunks: every substream spans many chunks and values straddle chunk boundaries.",
+        &["encoded", "hole", "tiny-chunks"],
+        encoded(
+            &small_holed,
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::Stored,
+                chunk_limit: 7,
+                rans_chunk_limit: 7,
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "icosphere-tiny-chunks-deflate",
+        "Icosphere (162 vertices), 24-byte chunks, deflate where it helps: stored and deflate chunks mixed within substreams.",
+        &["encoded", "tiny-chunks", "mixed-codecs"],
+        encoded(
+            &sphere2,
+            EncodeOptions {
+                chunk_limit: 24,
+                rans_chunk_limit: 24,
+                ..deflate_opts()
+            },
+        ),
+    );
+    for (levels, mesh, what) in [
+        (1, &sphere2, "icosphere"),
+        (2, &sphere2, "icosphere"),
+        (8, &bumpy, "grid"),
+    ] {
+        s.valid(
+            &format!("{what}-levels-{levels}"),
+            &format!("{what} encoded with levels = {levels}."),
+            &["encoded"],
+            encoded(mesh, EncodeOptions { levels, ..opts() }),
+        );
+    }
+    s.valid(
+        "grid-deflate-stored-blocks",
+        "The small height field with a hole, 64-byte chunks, every chunk re-coded as a deflate stream of one stored block.",
+        &["encoded", "hole", "deflate-stored-block"],
+        wrap_chunks_in_deflate(&encoded(
+            &small_holed,
+            EncodeOptions {
+                codec: ChunkCodec::Stored,
+                chunk_limit: 64,
+                rans_chunk_limit: 64,
+                ..opts()
+            },
+        )),
+    );
+    s.valid(
+        "cone-high-valence",
+        "Closed cone whose apex and bottom centre have valence 96 (rings of 96 vertices).",
+        &["encoded", "high-valence"],
+        encoded(&cone, opts()),
+    );
+    s.valid(
+        "grid-lock-boundary",
+        "Height field encoded with lock_boundary (boundary vertices stay in the base mesh), 4 levels, 20 bits.",
+        &["encoded", "lock-boundary"],
+        encoded(
+            &locked,
+            EncodeOptions {
+                lock_boundary: true,
+                levels: 4,
+                bits: 20,
+                ..opts()
+            },
+        ),
+    );
+    let terrain = meshes::checked(
+        splitstream_encoder::input::fractal_terrain(33, 7),
+        "terrain",
+    );
+    s.valid(
+        "terrain-constrained-deflate",
+        "33x33 fractal terrain (the demo's generator), constrained positions, deflate, 6 levels; x and y quantized on the raster's own lattice (one step a cell).",
+        &["encoded", "terrain"],
+        encoded(
+            &terrain,
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                levels: 6,
+                ..deflate_opts()
+            },
+        ),
+    );
+    s.valid(
+        "stepped-terrain-placement-ties",
+        "40x40 height field of whole-unit heights 0..3, constrained positions (every axis on its lattice), every substream rANS-coded: the placement context meets its ties 10t = -5u, u and 5u (SPEC §7.4).",
+        &["encoded", "terrain", "rans", "position-constrained", "placement-ties"],
+        encoded(
+            &meshes::checked(meshes::stepped_grid(40, 40, 1), "stepped grid"),
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::RansAlways { lanes: 4 },
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "icosphere-rans",
+        "Icosphere (642 vertices), default encoder options: optimal positions, rANS with 4 lanes (deflate where smaller), 5 levels.",
+        &["encoded", "rans"],
+        encoded(&sphere3, opts()),
+    );
+    s.valid(
+        "grid-hole-rans-always-1-lane",
+        "Height field with a hole, every substream rANS-coded in a single lane.",
+        &["encoded", "hole", "rans", "rans-1-lane"],
+        encoded(
+            &holed,
+            EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 1 },
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "terrain-constrained-rans-32-lanes",
+        "33x33 fractal terrain, constrained positions, every substream rANS-coded with 32 lanes (more lanes than values in small chunks: empty lanes).",
+        &["encoded", "terrain", "rans", "rans-empty-lanes"],
+        encoded(
+            &terrain,
+            EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::RansAlways { lanes: 32 },
+                levels: 6,
+                ..opts()
+            },
+        ),
+    );
+    s.valid(
+        "icosphere-rans-tiny-chunks",
+        "Icosphere (162 vertices), every substream rANS-coded in chunks of at most 5 values and 3 lanes: each chunk has its own tables and lanes.",
+        &["encoded", "rans", "tiny-chunks"],
+        encoded(
+            &sphere2,
+            EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 3 },
+                chunk_limit: 5,
+                rans_chunk_limit: 5,
+                ..opts()
+            },
+        ),
+    );
+    // Format 3.4: `max_chunk_len` bounds byte-codec chunks only. With every
+    // substream rANS-coded there is no byte-codec chunk, the header says 1,
+    // and every rANS chunk codes more values than that (SPEC §5.2).
+    s.valid(
+        "icosphere4-rans-chunks-above-max-chunk-len",
+        "Icosphere (2,562 vertices), every substream rANS-coded in chunks of up to 16,384 values, no byte-codec chunk: max_chunk_len is 1, and the finest level's edge substream codes more values than RANS_SLOT_BYTES (format 3.4; a rANS chunk needs no buffer of its length).",
+        &["encoded", "rans"],
+        {
+            let sphere4 = meshes::checked(meshes::icosphere(4), "icosphere(4)");
+            let stream = encoded(
+                &sphere4,
+                EncodeOptions {
+                    codec: ChunkCodec::RansAlways { lanes: 4 },
+                    chunk_limit: 1,
+                    ..opts()
+                },
+            );
+            let header = Header::parse(&stream).expect("valid");
+            assert_eq!((header.max_chunk_len, header.version_minor), (1, 4));
+            stream
+        },
+    );
+    s.valid(
+        "handmade-tetra-split-rans",
+        "SPEC Appendix A's split with every substream rANS-coded (1 lane).",
+        &["minimal", "handmade", "one-split", "rans"],
+        handmade::tetra_stream(ChunkCodec::RansAlways { lanes: 1 }),
+    );
+    // Every plane policy byte (SPEC §5.1, §7.4), forced for every level.
+    for (i, policy) in PlanePolicy::ALL.into_iter().enumerate() {
+        let (mode, what) = if i % 2 == 0 {
+            (PositionMode::Constrained, "constrained")
+        } else {
+            (PositionMode::Optimal, "optimal")
+        };
+        for (mesh, name) in [(&sphere2, "icosphere"), (&small_holed, "grid-hole")] {
+            s.valid(
+                &format!("plane-{}-{name}", policy.name()),
+                &format!(
+                    "{name} ({what} positions, stored chunks) with plane policy `{}` (byte {}) in every level.",
+                    policy.name(),
+                    policy.to_byte()
+                ),
+                &["encoded", "plane-policy"],
+                encoded(
+                    mesh,
+                    EncodeOptions {
+                        position_mode: mode,
+                        codec: ChunkCodec::Stored,
+                        plane: Some(policy),
+                        ..opts()
+                    },
+                ),
+            );
+        }
+    }
+    // Every wing policy byte (SPEC §5.1, §7.4; near and near-xy are 3.2),
+    // forced for every level, in both position modes.
+    for policy in WingPolicy::ALL {
+        for (mode, what) in [
+            (PositionMode::Constrained, "constrained"),
+            (PositionMode::Optimal, "optimal"),
+        ] {
+            for (mesh, name) in [(&sphere2, "icosphere"), (&small_holed, "grid-hole")] {
+                s.valid(
+                    &format!("wings-{}-{name}-{what}", policy.name()),
+                    &format!(
+                        "{name} ({what} positions, rANS) with wing policy `{}` (byte {}) in every level.",
+                        policy.name(),
+                        policy.to_byte()
+                    ),
+                    &["encoded", "wing-policy"],
+                    encoded(
+                        mesh,
+                        EncodeOptions {
+                            position_mode: mode,
+                            wings: Some(policy),
+                            ..opts()
+                        },
+                    ),
+                );
+            }
+        }
+    }
+    // Both deficit contexts (SPEC §5.1, §5.5.5; valence is 3.3), forced for
+    // every level, in both position modes, with the rANS codec (the
+    // contexts, and the number of tables, only matter to it).
+    for contexts in DeficitContexts::ALL {
+        for (mode, what) in [
+            (PositionMode::Constrained, "constrained"),
+            (PositionMode::Optimal, "optimal"),
+        ] {
+            for (mesh, name) in [(&sphere2, "icosphere"), (&small_holed, "grid-hole")] {
+                s.valid(
+                    &format!("deficits-{}-{name}-{what}", contexts.name()),
+                    &format!(
+                        "{name} ({what} positions, rANS) with deficit contexts `{}` (byte {}) in every level.",
+                        contexts.name(),
+                        contexts.to_byte()
+                    ),
+                    &["encoded", "deficit-contexts"],
+                    encoded(
+                        mesh,
+                        EncodeOptions {
+                            position_mode: mode,
+                            deficits: Some(contexts),
+                            ..opts()
+                        },
+                    ),
+                );
+            }
+        }
+    }
+    // 31 bits per axis: the arithmetic of SPEC §7.4 at its widest (the
+    // seed's rounds span the whole grid).
+    for (mode, what) in [
+        (PositionMode::Optimal, "optimal"),
+        (PositionMode::Constrained, "constrained"),
+    ] {
+        // rANS on the whole 31-bit grid (every axis, a raster's too), with
+        // the plane policy `plane` or, without one, chosen per level.
+        let wide_rans = |plane: Option<PlanePolicy>| EncodeOptions {
+            position_mode: mode,
+            bits: 31,
+            codec: ChunkCodec::RansAlways { lanes: 2 },
+            plane,
+            lattice: Some(Lattice::Ignore),
+            ..opts()
+        };
+        for (mesh, name) in [(&sphere3, "icosphere"), (&terrain, "terrain")] {
+            s.valid(
+                &format!("bits-31-{name}-{what}"),
+                &format!(
+                    "{name}, {what} positions, 31 bits per axis (the largest grid), rANS, plane policy chosen per level."
+                ),
+                &["encoded", "bits-31", "rans"],
+                encoded(mesh, wide_rans(None)),
+            );
+        }
+        s.valid(
+            &format!("bits-31-icosphere-{what}-x"),
+            &format!(
+                "Icosphere (162 vertices), {what} positions, 31 bits per axis, plane policy `x` in every level: residuals and plane offsets wrap modulo 2^32 (SPEC §7.4)."
+            ),
+            &["encoded", "bits-31", "plane-policy", "wrapped-residuals"],
+            encoded(
+                &sphere2,
+                EncodeOptions {
+                    position_mode: mode,
+                    bits: 31,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Axis(0)),
+                    ..opts()
+                },
+            ),
+        );
+        s.valid(
+            &format!("bits-31-icosphere-{what}-off"),
+            &format!(
+                "Icosphere (162 vertices), {what} positions, 31 bits per axis, plane policy `off` (no plane offsets: the residuals are read x, y, z)."
+            ),
+            &["encoded", "bits-31", "plane-policy"],
+            encoded(
+                &sphere2,
+                EncodeOptions {
+                    position_mode: mode,
+                    bits: 31,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Off),
+                    ..opts()
+                },
+            ),
+        );
+        // Format 3.1's height prediction at its widest: 128-bit surface
+        // arithmetic, points far outside thin wedges, folded fans (the
+        // sphere) where no wedge holds the point.
+        for (mesh, name) in [(&terrain, "terrain"), (&sphere2, "icosphere")] {
+            s.valid(
+                &format!("bits-31-{name}-{what}-height"),
+                &format!(
+                    "{name}, {what} positions, 31 bits per axis, plane policy `height` (3.1) in every level: z predicted from the surface of R's fan, modulo 2^32 (SPEC §7.4)."
+                ),
+                &["encoded", "bits-31", "plane-policy", "height", "wrapped-residuals"],
+                encoded(mesh, wide_rans(Some(PlanePolicy::Height))),
+            );
+        }
+        s.valid(
+            &format!("grid-hole-{what}-height"),
+            &format!(
+                "Small height field with a hole, {what} positions, plane policy `height` (3.1) in every level: boundary fans whose open side holds no wedge keep the linear prediction."
+            ),
+            &["encoded", "plane-policy", "height", "boundary"],
+            encoded(
+                &small_holed,
+                EncodeOptions {
+                    position_mode: mode,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Height),
+                    ..opts()
+                },
+            ),
+        );
+        s.valid(
+            &format!("bits-31-grid-hole-{what}-dominant"),
+            &format!(
+                "Small height field with a hole, {what} positions, 31 bits per axis, plane policy `dominant` in every level."
+            ),
+            &["encoded", "bits-31", "plane-policy"],
+            encoded(
+                &small_holed,
+                EncodeOptions {
+                    position_mode: mode,
+                    bits: 31,
+                    codec: ChunkCodec::Stored,
+                    plane: Some(PlanePolicy::Dominant),
+                    lattice: Some(Lattice::Ignore),
+                    ..opts()
+                },
+            ),
+        );
+    }
+    let bunny = meshes::real(real_data, "bunny.ply")?;
+    s.valid(
+        "bunny-npm",
+        "The npm `bunny` package's Stanford bunny (encoder/data/fetch.sh), default encoder options.",
+        &["encoded", "real-mesh"],
+        encoded(&bunny, opts()),
+    );
+    Ok(())
+}
