@@ -92,6 +92,10 @@ pub fn simplify_gpu(
         ..Params::default()
     };
     phases.lap("open");
+    let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
+    if debug {
+        eprintln!("{api} open: {}", engine.open_times());
+    }
     let local = engine.quadric_init(&base)?;
     s.quadrics = local
         .par_iter()
@@ -115,7 +119,6 @@ pub fn simplify_gpu(
     // `apply_winners` (NO_CLAIM otherwise).
     let claims: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(NO_CLAIM)).collect();
     let mut updates = Updates::default();
-    let debug = std::env::var_os("SPLITSTREAM_DEBUG").is_some();
     phases.lap("quadrics");
     while alive_count > options.target_vertices {
         if alive_count * 5 < edge_measured_at * 4 {

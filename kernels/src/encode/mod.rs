@@ -23,6 +23,8 @@ mod ocl_host;
 #[cfg(feature = "wgpu")]
 mod wgpu_host;
 
+use std::time::{Duration, Instant};
+
 use crate::gpu::{Api, DeviceInfo, GpuError};
 use layout::{MODE_ALL, MODE_REPICK, Params, TriangleUpdate, VertexUpdate, Winner};
 pub use sources::{Kernel, Slot, WgslModule};
@@ -106,6 +108,8 @@ impl Buffer {
 /// The primitive operations a compute API offers the engine.
 pub trait Device {
     fn info(&self) -> &DeviceInfo;
+    /// How long opening took, by part (see [`OpenTimes`]).
+    fn open_times(&self) -> OpenTimes;
     /// Writes `words` at the start of `buffer`, growing it when needed.
     fn write(&mut self, buffer: Buffer, words: &[u32]) -> Result<(), GpuError>;
     /// Reads the first `out.len()` words of `buffer` into `out` (waits for
@@ -180,6 +184,34 @@ pub struct Engine {
     device: Box<dyn Device>,
     vertex_count: usize,
     live_len: u32,
+    upload: Duration,
+}
+
+/// Where the time of [`Engine::open`] went (printed by the encoder under
+/// `SPLITSTREAM_DEBUG`): opening the API's context on the device, compiling
+/// the kernels (WGSL modules and pipelines, or the OpenCL program), creating
+/// the buffers, and handing the mesh to the queue (wgpu may finish the copy
+/// later, with the first dispatch).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct OpenTimes {
+    pub context: Duration,
+    pub compile: Duration,
+    pub buffers: Duration,
+    pub upload: Duration,
+}
+
+impl std::fmt::Display for OpenTimes {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let ms = |d: Duration| d.as_secs_f64() * 1e3;
+        write!(
+            f,
+            "context {:.0} ms, compile {:.0} ms, buffers {:.0} ms, upload {:.0} ms",
+            ms(self.context),
+            ms(self.compile),
+            ms(self.buffers),
+            ms(self.upload)
+        )
+    }
 }
 
 impl Engine {
@@ -200,6 +232,7 @@ impl Engine {
             #[allow(unreachable_patterns)]
             api => return Err(GpuError::NotCompiled { api }),
         };
+        let upload = Instant::now();
         device.write(Buffer::Corners, bytemuck::cast_slice(mesh.corners))?;
         device.write(Buffer::CornerOf, mesh.corner_of)?;
         device.write(Buffer::Vertices, bytemuck::cast_slice(mesh.vertices))?;
@@ -209,11 +242,20 @@ impl Engine {
             device,
             vertex_count: n,
             live_len: 0,
+            upload: upload.elapsed(),
         })
     }
 
     pub fn info(&self) -> &DeviceInfo {
         self.device.info()
+    }
+
+    /// How long [`Engine::open`] took, by part.
+    pub fn open_times(&self) -> OpenTimes {
+        OpenTimes {
+            upload: self.upload,
+            ..self.device.open_times()
+        }
     }
 
     /// Quadric init: every vertex's quadric in its own frame, left on the
@@ -367,6 +409,9 @@ mod tests {
         fn info(&self) -> &DeviceInfo {
             &self.info
         }
+        fn open_times(&self) -> OpenTimes {
+            OpenTimes::default()
+        }
         fn write(&mut self, _: Buffer, _: &[u32]) -> Result<(), GpuError> {
             Ok(())
         }
@@ -397,6 +442,7 @@ mod tests {
             }),
             vertex_count: 100,
             live_len: 100,
+            upload: Duration::ZERO,
         }
     }
 

@@ -3,9 +3,10 @@
 //! one in-order queue, kernel arguments in `Kernel::slots` order.
 
 use std::collections::HashMap;
+use std::time::Instant;
 
 use super::layout::Params;
-use super::{Buffer, Device, Kernel};
+use super::{Buffer, Device, Kernel, OpenTimes};
 use crate::gpu::{Api, DeviceInfo, GpuError, OclContext, open_opencl};
 
 /// Work-items per work-group of every dispatch.
@@ -16,6 +17,7 @@ pub struct OclDevice {
     program: ocl::Program,
     buffers: HashMap<Buffer, ocl::Buffer<u32>>,
     max_alloc: u64,
+    opened: OpenTimes,
 }
 
 fn kernel_error(what: &str, e: impl ToString) -> GpuError {
@@ -39,8 +41,11 @@ pub fn build_program(ctx: &OclContext) -> Result<ocl::Program, GpuError> {
 
 impl OclDevice {
     pub fn new(n: usize, corners: usize) -> Result<OclDevice, GpuError> {
+        let started = Instant::now();
         let ctx = open_opencl()?;
+        let context = started.elapsed();
         let program = build_program(&ctx)?;
+        let compile = started.elapsed() - context;
         let max_alloc = match ctx.device.info(ocl::enums::DeviceInfo::MaxMemAllocSize) {
             Ok(ocl::enums::DeviceInfoResult::MaxMemAllocSize(b)) => b,
             _ => u64::MAX,
@@ -50,10 +55,16 @@ impl OclDevice {
             program,
             buffers: HashMap::new(),
             max_alloc,
+            opened: OpenTimes {
+                context,
+                compile,
+                ..OpenTimes::default()
+            },
         };
         for buffer in Buffer::ALL {
             device.allocate(buffer, buffer.words(n, corners))?;
         }
+        device.opened.buffers = started.elapsed() - context - compile;
         Ok(device)
     }
 
@@ -81,6 +92,9 @@ impl OclDevice {
 impl Device for OclDevice {
     fn info(&self) -> &DeviceInfo {
         &self.ctx.info
+    }
+    fn open_times(&self) -> OpenTimes {
+        self.opened
     }
 
     fn write(&mut self, buffer: Buffer, words: &[u32]) -> Result<(), GpuError> {

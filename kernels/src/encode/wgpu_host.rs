@@ -4,9 +4,10 @@
 //! `write_buffer` is ordered before the next submission).
 
 use std::collections::HashMap;
+use std::time::Instant;
 
 use super::layout::{GROUP, Params};
-use super::{Buffer, Device, Kernel, WgslModule};
+use super::{Buffer, Device, Kernel, OpenTimes, WgslModule};
 use crate::gpu::{Api, DeviceInfo, GpuError, WgpuContext, open_wgpu};
 
 pub struct WgpuDevice {
@@ -14,6 +15,7 @@ pub struct WgpuDevice {
     pipelines: HashMap<Kernel, wgpu::ComputePipeline>,
     buffers: HashMap<Buffer, wgpu::Buffer>,
     staging: Option<wgpu::Buffer>,
+    opened: OpenTimes,
 }
 
 fn kernel_error(detail: impl ToString) -> GpuError {
@@ -25,7 +27,9 @@ fn kernel_error(detail: impl ToString) -> GpuError {
 
 impl WgpuDevice {
     pub fn new(n: usize, corners: usize) -> Result<WgpuDevice, GpuError> {
+        let started = Instant::now();
         let ctx = open_wgpu()?;
+        let context = started.elapsed();
         let scope = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
         let mut modules = HashMap::new();
         for module in WgslModule::ALL {
@@ -55,16 +59,23 @@ impl WgpuDevice {
         if let Some(e) = pollster::block_on(scope.pop()) {
             return Err(kernel_error(format!("pipeline creation: {e}")));
         }
+        let compile = started.elapsed() - context;
         let mut device = WgpuDevice {
             ctx,
             pipelines,
             buffers: HashMap::new(),
             staging: None,
+            opened: OpenTimes {
+                context,
+                compile,
+                ..OpenTimes::default()
+            },
         };
         for buffer in Buffer::ALL {
             let bytes = 4 * buffer.words(n, corners) as u64;
             device.allocate(buffer, bytes)?;
         }
+        device.opened.buffers = started.elapsed() - context - compile;
         Ok(device)
     }
 
@@ -117,6 +128,9 @@ impl WgpuDevice {
 impl Device for WgpuDevice {
     fn info(&self) -> &DeviceInfo {
         &self.ctx.info
+    }
+    fn open_times(&self) -> OpenTimes {
+        self.opened
     }
 
     fn write(&mut self, buffer: Buffer, words: &[u32]) -> Result<(), GpuError> {
