@@ -13,6 +13,7 @@
 
 use crate::Error;
 use crate::limits::MAX_SPLIT_VALENCE;
+use crate::predict::floor_div;
 use crate::ring::Ring;
 use crate::symbols::WingCandidates;
 
@@ -90,8 +91,11 @@ fn centre_distances(
             n += 1;
         }
     }
-    let n = n.max(1);
-    let centre = [sum[0] / n, sum[1] / n, sum[2] / n];
+    // The floor mean as a multiplication (`floor_div`: sums of at most 255
+    // coordinates below 2^31 stay below 2^40); three divisions here were on
+    // every split's critical path.
+    let n = n.max(1) as i64;
+    let centre = sum.map(|s| floor_div(s as i64, n) as u64);
     for w in 0..vertices.len().div_ceil(64) {
         let mut bits = eligible.word(w);
         while bits != 0 {
