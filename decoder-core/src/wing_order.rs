@@ -92,8 +92,8 @@ fn centre_distances(
         }
     }
     // The floor mean as a multiplication (`floor_div`: sums of at most 255
-    // coordinates below 2^31 stay below 2^40); three divisions here were on
-    // every split's critical path.
+    // coordinates below 2^31 stay below 2^40), not three u64 divisions a
+    // split: those are library calls on 32-bit targets.
     let n = n.max(1) as i64;
     let centre = sum.map(|s| floor_div(s as i64, n) as u64);
     for w in 0..vertices.len().div_ceil(64) {
