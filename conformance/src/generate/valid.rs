@@ -4,6 +4,7 @@
 use splitstream_decoder_core::handmade;
 use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
 use splitstream_decoder_core::{DeficitContexts, Header, PlanePolicy, PositionMode, WingPolicy};
+use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::EncodeOptions;
 use splitstream_encoder::quantize::Lattice;
 use std::path::Path;
@@ -293,60 +294,37 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
     }
     // Every wing policy byte (SPEC §5.1, §7.4; near and near-xy are 3.2),
     // forced for every level, in both position modes.
+    let small = [(&sphere2, "icosphere"), (&small_holed, "grid-hole")];
     for policy in WingPolicy::ALL {
-        for (mode, what) in [
-            (PositionMode::Constrained, "constrained"),
-            (PositionMode::Optimal, "optimal"),
-        ] {
-            for (mesh, name) in [(&sphere2, "icosphere"), (&small_holed, "grid-hole")] {
-                s.valid(
-                    &format!("wings-{}-{name}-{what}", policy.name()),
-                    &format!(
-                        "{name} ({what} positions, rANS) with wing policy `{}` (byte {}) in every level.",
-                        policy.name(),
-                        policy.to_byte()
-                    ),
-                    &["encoded", "wing-policy"],
-                    encoded(
-                        mesh,
-                        EncodeOptions {
-                            position_mode: mode,
-                            wings: Some(policy),
-                            ..opts()
-                        },
-                    ),
-                );
-            }
-        }
+        let choice = Forced {
+            id: "wings",
+            field: "wing policy",
+            name: policy.name(),
+            byte: policy.to_byte(),
+            feature: "wing-policy",
+        };
+        forced_in_every_level(s, &small, choice, |mode| EncodeOptions {
+            position_mode: mode,
+            wings: Some(policy),
+            ..opts()
+        });
     }
     // Both deficit contexts (SPEC §5.1, §5.5.5; valence is 3.3), forced for
     // every level, in both position modes, with the rANS codec (the
     // contexts, and the number of tables, only matter to it).
     for contexts in DeficitContexts::ALL {
-        for (mode, what) in [
-            (PositionMode::Constrained, "constrained"),
-            (PositionMode::Optimal, "optimal"),
-        ] {
-            for (mesh, name) in [(&sphere2, "icosphere"), (&small_holed, "grid-hole")] {
-                s.valid(
-                    &format!("deficits-{}-{name}-{what}", contexts.name()),
-                    &format!(
-                        "{name} ({what} positions, rANS) with deficit contexts `{}` (byte {}) in every level.",
-                        contexts.name(),
-                        contexts.to_byte()
-                    ),
-                    &["encoded", "deficit-contexts"],
-                    encoded(
-                        mesh,
-                        EncodeOptions {
-                            position_mode: mode,
-                            deficits: Some(contexts),
-                            ..opts()
-                        },
-                    ),
-                );
-            }
-        }
+        let choice = Forced {
+            id: "deficits",
+            field: "deficit contexts",
+            name: contexts.name(),
+            byte: contexts.to_byte(),
+            feature: "deficit-contexts",
+        };
+        forced_in_every_level(s, &small, choice, |mode| EncodeOptions {
+            position_mode: mode,
+            deficits: Some(contexts),
+            ..opts()
+        });
     }
     // 31 bits per axis: the arithmetic of SPEC §7.4 at its widest (the
     // seed's rounds span the whole grid).
@@ -464,4 +442,40 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
         encoded(&bunny, opts()),
     );
     Ok(())
+}
+
+/// A level-header choice forced in every level of a vector (SPEC §5.1):
+/// `{id}-{name}-{mesh}-{mode}` names the vector, `field` and `byte` describe it.
+struct Forced {
+    id: &'static str,
+    field: &'static str,
+    name: &'static str,
+    byte: u8,
+    feature: &'static str,
+}
+
+/// One rANS vector per mesh of `meshes` and position mode with `choice`
+/// forced in every level, encoded with `options(mode)`.
+fn forced_in_every_level(
+    s: &mut Specs,
+    meshes: &[(&Mesh, &str)],
+    choice: Forced,
+    options: impl Fn(PositionMode) -> EncodeOptions,
+) {
+    for (mode, what) in [
+        (PositionMode::Constrained, "constrained"),
+        (PositionMode::Optimal, "optimal"),
+    ] {
+        for &(mesh, name) in meshes {
+            s.valid(
+                &format!("{}-{}-{name}-{what}", choice.id, choice.name),
+                &format!(
+                    "{name} ({what} positions, rANS) with {} `{}` (byte {}) in every level.",
+                    choice.field, choice.name, choice.byte
+                ),
+                &["encoded", choice.feature],
+                encoded(mesh, options(mode)),
+            );
+        }
+    }
 }
