@@ -15,6 +15,8 @@ use splitstream_decoder_core::{
     Error, Header, Inflater, LevelTable, MeshState, RecordSource, Ring, SplitRecord, layout_for,
 };
 
+use splitstream_sdk_native::threaded::{self, TwoThreadMemory};
+
 use crate::protocol::{Outcome, Verdict};
 
 /// A decoder the runner can call directly.
@@ -33,6 +35,12 @@ pub const BUILTINS: &[Builtin] = &[
         summary: "the reference decoder (decoder-core's Decoder, level by level, round by round)",
         hidden: false,
         decode: decoder_core,
+    },
+    Builtin {
+        name: "two-threads",
+        summary: "decoder-core's rounds with the split records read on a second thread (sdk-native threaded)",
+        hidden: false,
+        decode: two_threads,
     },
     #[cfg(feature = "gpu")]
     Builtin {
@@ -98,6 +106,30 @@ pub fn decoder_core(stream: &[u8]) -> Outcome {
             while level.next_round()?.is_some() {
                 hashes.push(level.state().state_hash());
             }
+        }
+        Ok(())
+    })();
+    finish(hashes, result)
+}
+
+/// decoder-core with each level's records read on a second thread
+/// (`splitstream_sdk_native::threaded`).
+pub fn two_threads(stream: &[u8]) -> Outcome {
+    let mut hashes = Vec::new();
+    let result = (|| {
+        let mut ws = OwnedWorkspace::for_stream(stream)?;
+        let mut decoder = ws.decoder(stream)?;
+        let mut memory = TwoThreadMemory::new(decoder.state().vertex_capacity());
+        while let Some(k) = decoder.next_level() {
+            let range = decoder.level_range(k);
+            let bytes = usize::try_from(range.start)
+                .ok()
+                .zip(usize::try_from(range.end).ok())
+                .and_then(|(s, e)| stream.get(s..e))
+                .ok_or(Error::Truncated)?;
+            threaded::decode_level_observed(&mut decoder, k, bytes, &mut memory, |_, state| {
+                hashes.push(state.state_hash())
+            })?;
         }
         Ok(())
     })();

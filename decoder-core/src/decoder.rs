@@ -6,7 +6,12 @@ use crate::inflate::Inflater;
 use crate::layout::Layout;
 use crate::level_header::LevelHeader;
 use crate::level_table::{LevelInfo, LevelTable};
+use crate::limits::MAX_SPLIT_VALENCE;
 use crate::limits::substream::{self, SLOTS};
+use crate::pipe::{PendingSplits, RecordPipe, RecordsHalf};
+
+/// The flags' slot among a level's refinement substreams (ids 1..=7).
+const FLAGS_SLOT: usize = 0;
 use crate::record::{StreamSource, read_base};
 use crate::ring::Ring;
 use crate::round::{RecordSource, RoundStats};
@@ -364,7 +369,17 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
             source: StreamSource::new(&mut self.subs, self.mode),
             observer,
         };
-        match self.state.run_round(declared, &mut source, self.ring) {
+        let result = self.state.run_round(declared, &mut source, self.ring);
+        self.round_done(result)
+    }
+
+    /// The round's outcome: its counts, or the error, which poisons the
+    /// decoder.
+    fn round_done(
+        &mut self,
+        result: Result<RoundStats, Error>,
+    ) -> Result<Option<RoundInfo>, Error> {
+        match result {
             Ok(stats) => {
                 let info = RoundInfo {
                     level: self.level,
@@ -386,6 +401,68 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
                 })
             }
         }
+    }
+
+    /// Moves the level's record substreams into a [`RecordsHalf`] that
+    /// reads them with `inflater` and keeps its own copy of the positions in
+    /// `positions` (at least the decoder's vertex capacity; the current
+    /// positions are copied in): the records can then be read on another
+    /// thread while [`LevelDecoder::next_round_piped`] runs the rounds here
+    /// (see [`crate::pipe`]). Give them back with
+    /// [`LevelDecoder::join_records`] before the level ends.
+    pub fn split_records(
+        &mut self,
+        inflater: &'d mut Inflater,
+        positions: &'d mut [[u32; 3]],
+    ) -> Result<RecordsHalf<'l, 'd>, Error> {
+        let n = self.state.vertex_count() as usize;
+        if positions.len() < self.state.vertex_capacity() as usize {
+            return Err(Error::CapacityExceeded);
+        }
+        positions[..n].copy_from_slice(self.state.positions());
+        let source = StreamSource::new(&mut self.subs, self.mode);
+        let coding = source.coding();
+        Ok(RecordsHalf {
+            subs: self.subs.split_off(FLAGS_SLOT, inflater),
+            coding,
+            keys: [0; MAX_SPLIT_VALENCE],
+            ring: Ring::default(),
+            positions,
+            bits: self.state.bits(),
+            failed: None,
+        })
+    }
+
+    /// Takes back the record substreams of [`LevelDecoder::split_records`];
+    /// [`LevelDecoder::next_round`] then ends the level (SPEC §7.6).
+    pub fn join_records(&mut self, records: RecordsHalf<'l, 'd>) {
+        self.subs.join(FLAGS_SLOT, records.subs);
+    }
+
+    /// Decodes the next round (SPEC §7.3) with its records read through
+    /// `pipe` by the [`RecordsHalf`] of [`LevelDecoder::split_records`],
+    /// holding up to `pending` splits whose records are on their way.
+    /// `None` once the rounds are all done: join the records and call
+    /// [`LevelDecoder::next_round`] to end the level. Every round ends in
+    /// the state [`LevelDecoder::next_round`] gives, and fails with the
+    /// same error.
+    pub fn next_round_piped<P: RecordPipe>(
+        &mut self,
+        pipe: &mut P,
+        pending: &mut PendingSplits<'_>,
+    ) -> Result<Option<RoundInfo>, Error> {
+        if *self.poisoned {
+            return Err(Error::Poisoned);
+        }
+        if self.done || self.round == self.header.round_count {
+            return Ok(None);
+        }
+        let declared = self.header.split_count(self.round);
+        let mut source = StreamSource::new(&mut self.subs, self.mode);
+        let result = self
+            .state
+            .run_round_piped(declared, &mut source, pipe, self.ring, pending);
+        self.round_done(result)
     }
 
     /// The mesh state as of the last round.

@@ -39,6 +39,7 @@ mod level_table;
 pub mod limits;
 #[cfg(feature = "alloc")]
 pub mod owned;
+pub mod pipe;
 pub mod predict;
 mod rans;
 #[cfg(feature = "alloc")]

@@ -13,7 +13,7 @@ use crate::round::{RecordSource, all_ones};
 use crate::split::SplitRecord;
 use crate::state::MeshState;
 use crate::substream::Substreams;
-use crate::symbols::deficit_of;
+use crate::symbols::{WingCandidates, deficit_of};
 use crate::wing_order::{NearKeys, WingPolicy, near_keys, near_wings};
 
 /// Substream slot of a refinement substream id (ids 1..=7 use slots 0..=6).
@@ -73,6 +73,18 @@ fn read_vector(s: &mut Substreams<'_, '_>, slot: usize, plane: &Plane) -> Result
     Ok(plane.decode(coded))
 }
 
+impl StreamSource<'_, '_, '_> {
+    /// How the level codes its records.
+    pub(crate) fn coding(&self) -> RecordCoding {
+        RecordCoding {
+            mode: self.mode,
+            plane: self.plane,
+            wings: self.wings,
+            deficits: self.deficits,
+        }
+    }
+}
+
 impl RecordSource for StreamSource<'_, '_, '_> {
     #[inline]
     fn flag(&mut self, _state: &MeshState<'_>, _v: u32) -> Result<bool, Error> {
@@ -92,76 +104,125 @@ impl RecordSource for StreamSource<'_, '_, '_> {
     /// level's deficit contexts),
     /// then (constrained) the placement code and one residual vector, or
     /// (optimal) two residual vectors.
+    #[inline]
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
-        let s = &mut *self.subs;
-        let k = ring.len();
         let eligible = state.wing_candidates(ring);
-        let wing_context = context::wing(eligible.count());
-        let o_rank = s.byte(slot(substream::WING_OFFSET), wing_context)?;
-        let d_rank = s.byte(slot(substream::WING_DISTANCE), wing_context)?;
-        let (o, d) = match self.wings {
-            WingPolicy::Ranks => eligible.wings(o_rank, d_rank)?,
-            near => {
-                let m = near_keys(state.positions(), ring, &eligible, near, &mut self.keys);
-                near_wings(&self.keys[..m], k, o_rank, d_rank)?
-            }
-        };
-        let (valence_p, valence_c) = (d + 2, k - d + 2);
-        let contexts = self.deficits;
-        let deficit_p = deficit_of(
-            s.byte(
-                slot(substream::DEFICIT_P),
-                context::deficit_p(contexts, valence_p),
-            )?,
-            valence_p,
-        )?;
-        let deficit_c = deficit_of(
-            s.byte(
-                slot(substream::DEFICIT_C),
-                context::deficit_c(contexts, deficit_p, valence_c),
-            )?,
-            valence_c,
-        )?;
-        let positions = state.positions();
-        let parent = positions[r as usize];
-        let means = arc_means(positions, parent, ring, o, d);
-        let plane = Plane::new(self.plane, &means);
-        let origin = parent.map(|x| x as i64);
-        let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|i| a[i] + b[i]) };
-        let fan = SplitFan {
-            positions,
-            parent,
+        let coding = self.coding();
+        let fan = RecordFan {
+            positions: state.positions(),
+            bits: state.bits(),
+            r,
             ring,
+            eligible: &eligible,
         };
-        let (p, c) = match self.mode {
-            PositionMode::Constrained => {
-                let code = s.byte(slot(substream::PLACEMENT), context::placement(&means))?;
-                let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
-                let prediction = predict(&means, self.mode, target);
-                let r = read_vector(s, slot(substream::EDGE), &plane)?;
-                let x = fan.vector(self.plane, target, prediction, r);
-                constrained_positions(parent, code, x)
-            }
-            PositionMode::Optimal => {
-                let p_hat = predict(&means, self.mode, Target::P);
-                let c_hat = predict(&means, self.mode, Target::C);
-                let s_vec = read_vector(s, slot(substream::EDGE), &plane)?;
-                let t_vec = read_vector(s, slot(substream::PLACEMENT), &plane)?;
-                let p = fan.vector(self.plane, Target::P, p_hat, s_vec);
-                let c = fan.vector(self.plane, Target::C, c_hat, t_vec);
-                (add(origin, p), add(origin, c))
-            }
-        };
-        let bits = state.bits();
-        Ok(SplitRecord {
-            wing_offset: o as u8,
-            wing_distance: d as u8,
-            deficit_p,
-            deficit_c,
-            position_p: to_grid(p, bits)?,
-            position_c: to_grid(c, bits)?,
-        })
+        read_record(self.subs, &coding, &mut self.keys, &fan)
     }
+}
+
+/// How a level codes its split records (SPEC §5.1): the position mode and
+/// the level's policies.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct RecordCoding {
+    pub(crate) mode: PositionMode,
+    pub(crate) plane: PlanePolicy,
+    pub(crate) wings: WingPolicy,
+    pub(crate) deficits: DeficitContexts,
+}
+
+/// What a split record is read against (SPEC §7.4): the positions, R and
+/// its ring, and the ring entries that may be wings (from the round-start
+/// candidates).
+pub(crate) struct RecordFan<'a> {
+    pub(crate) positions: &'a [[u32; 3]],
+    pub(crate) bits: u8,
+    pub(crate) r: u32,
+    pub(crate) ring: &'a Ring,
+    pub(crate) eligible: &'a WingCandidates,
+}
+
+/// Reads the record of the split of `fan.r` (SPEC §7.4), fields in order:
+/// wing ranks (in ring order, or in the near order of the level's wing
+/// policy), split valences of P and C (in the level's deficit contexts),
+/// then (constrained) the placement code and one residual vector, or
+/// (optimal) two residual vectors.
+#[inline(always)]
+pub(crate) fn read_record(
+    s: &mut Substreams<'_, '_>,
+    coding: &RecordCoding,
+    keys: &mut NearKeys,
+    fan: &RecordFan<'_>,
+) -> Result<SplitRecord, Error> {
+    let RecordFan {
+        positions,
+        bits,
+        r,
+        ring,
+        eligible,
+    } = *fan;
+    let k = ring.len();
+    let wing_context = context::wing(eligible.count());
+    let o_rank = s.byte(slot(substream::WING_OFFSET), wing_context)?;
+    let d_rank = s.byte(slot(substream::WING_DISTANCE), wing_context)?;
+    let (o, d) = match coding.wings {
+        WingPolicy::Ranks => eligible.wings(o_rank, d_rank)?,
+        near => {
+            let m = near_keys(positions, ring, eligible, near, keys);
+            near_wings(&keys[..m], k, o_rank, d_rank)?
+        }
+    };
+    let (valence_p, valence_c) = (d + 2, k - d + 2);
+    let contexts = coding.deficits;
+    let deficit_p = deficit_of(
+        s.byte(
+            slot(substream::DEFICIT_P),
+            context::deficit_p(contexts, valence_p),
+        )?,
+        valence_p,
+    )?;
+    let deficit_c = deficit_of(
+        s.byte(
+            slot(substream::DEFICIT_C),
+            context::deficit_c(contexts, deficit_p, valence_c),
+        )?,
+        valence_c,
+    )?;
+    let parent = *positions.get(r as usize).ok_or(Error::CapacityExceeded)?;
+    let means = arc_means(positions, parent, ring, o, d);
+    let plane = Plane::new(coding.plane, &means);
+    let origin = parent.map(|x| x as i64);
+    let add = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { core::array::from_fn(|i| a[i] + b[i]) };
+    let fan = SplitFan {
+        positions,
+        parent,
+        ring,
+    };
+    let (p, c) = match coding.mode {
+        PositionMode::Constrained => {
+            let code = s.byte(slot(substream::PLACEMENT), context::placement(&means))?;
+            let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
+            let prediction = predict(&means, coding.mode, target);
+            let r = read_vector(s, slot(substream::EDGE), &plane)?;
+            let x = fan.vector(coding.plane, target, prediction, r);
+            constrained_positions(parent, code, x)
+        }
+        PositionMode::Optimal => {
+            let p_hat = predict(&means, coding.mode, Target::P);
+            let c_hat = predict(&means, coding.mode, Target::C);
+            let s_vec = read_vector(s, slot(substream::EDGE), &plane)?;
+            let t_vec = read_vector(s, slot(substream::PLACEMENT), &plane)?;
+            let p = fan.vector(coding.plane, Target::P, p_hat, s_vec);
+            let c = fan.vector(coding.plane, Target::C, c_hat, t_vec);
+            (add(origin, p), add(origin, c))
+        }
+    };
+    Ok(SplitRecord {
+        wing_offset: o as u8,
+        wing_distance: d as u8,
+        deficit_p,
+        deficit_c,
+        position_p: to_grid(p, bits)?,
+        position_c: to_grid(c, bits)?,
+    })
 }
 
 fn to_grid(p: [i64; 3], bits: u8) -> Result<[u32; 3], Error> {

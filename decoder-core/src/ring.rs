@@ -98,6 +98,16 @@ impl Ring {
         true
     }
 
+    /// Makes this a ring walked before, entries and corners as the walk
+    /// gave them (`pipe.rs` keeps them while a record is read elsewhere).
+    /// Both slices have the same length, at most [`MAX_SPLIT_VALENCE`].
+    pub(crate) fn set_walked(&mut self, vertices: &[u32], corners: &[u32]) {
+        let k = vertices.len().min(corners.len()).min(MAX_SPLIT_VALENCE);
+        self.vertices[..k].copy_from_slice(&vertices[..k]);
+        self.corners[..k].copy_from_slice(&corners[..k]);
+        self.len = k;
+    }
+
     /// Valence: ring length, the ghost counted (SPEC §6.1).
     pub fn len(&self) -> usize {
         self.len

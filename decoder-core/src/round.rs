@@ -9,6 +9,7 @@
 
 use crate::Error;
 use crate::limits::NONE;
+use crate::pipe::{PendingSplits, RecordPipe};
 use crate::ring::{FAN_LEN, FANS, FansAhead, Ring};
 use crate::split::{SplitOutcome, SplitRecord};
 use crate::state::{MeshState, next};
@@ -73,6 +74,37 @@ impl MeshState<'_> {
         source: &mut S,
         ring: &mut Ring,
     ) -> Result<RoundStats, Error> {
+        self.round_with(declared, source, ring, &mut Fused)
+    }
+
+    /// [`MeshState::run_round`] with each split's record read elsewhere:
+    /// `pipe` gets every flagged vertex's ring and gives its record back
+    /// (in split order), and the split is applied when it comes back, at the
+    /// latest when `pending` is full or the round ends. `source` only gives
+    /// the flags. The state after the round is the same as
+    /// [`MeshState::run_round`]'s, and so is the error (see
+    /// [`crate::pipe`]).
+    pub fn run_round_piped<S: RecordSource, P: RecordPipe>(
+        &mut self,
+        declared: u32,
+        source: &mut S,
+        pipe: &mut P,
+        ring: &mut Ring,
+        pending: &mut PendingSplits<'_>,
+    ) -> Result<RoundStats, Error> {
+        pending.clear();
+        let mut piped = Piped { pipe, pending };
+        self.round_with(declared, source, ring, &mut piped)
+    }
+
+    /// Steps 1 to 3 of SPEC §7.3, each flagged split handed to `splits`.
+    fn round_with<S: RecordSource, F: FlaggedSplits<S>>(
+        &mut self,
+        declared: u32,
+        source: &mut S,
+        ring: &mut Ring,
+        splits: &mut F,
+    ) -> Result<RoundStats, Error> {
         let n = self.vertex_count;
         if n as u64 + declared as u64 > self.vertex_capacity() as u64 {
             return Err(Error::CapacityExceeded);
@@ -89,7 +121,7 @@ impl MeshState<'_> {
             candidates: candidates[..words].iter().map(|w| w.count_ones()).sum(),
             ..RoundStats::default()
         };
-        let result = self.flag_and_split(n, words, source, ring, &mut stats);
+        let result = self.flag_and_split(n, words, source, ring, splits, &mut stats);
         let (_, round_start, blocked) = self.bitmaps();
         round_start[..words].fill(0);
         blocked[..words].fill(0);
@@ -104,12 +136,13 @@ impl MeshState<'_> {
     /// Steps 2 and 3 of SPEC §7.3, fused (see [`MeshState::run_round`]).
     /// Returns a flag-pass error as `Err`, the first split error as
     /// `Ok(Some(_))`.
-    fn flag_and_split<S: RecordSource>(
+    fn flag_and_split<S: RecordSource, F: FlaggedSplits<S>>(
         &mut self,
         n: u32,
         words: usize,
         source: &mut S,
         ring: &mut Ring,
+        splits: &mut F,
         stats: &mut RoundStats,
     ) -> Result<Option<Error>, Error> {
         let mut split_error = None;
@@ -139,7 +172,13 @@ impl MeshState<'_> {
                 // another. (Where the flags are not known yet, every
                 // candidate's fan is warmed.)
                 if warm_up {
-                    self.walk_batch(&batch[..len], w, source, &mut ring.ahead);
+                    self.walk_batch(
+                        &batch[..len],
+                        w,
+                        source,
+                        &mut ring.ahead,
+                        F::READS_POSITIONS,
+                    );
                 }
                 for &v in &batch[..len] {
                     if self.bitmaps().2[w] & (1u64 << (v % 64)) != 0 {
@@ -157,21 +196,14 @@ impl MeshState<'_> {
                     if split_error.is_some() {
                         continue;
                     }
-                    let c = self.vertex_count;
-                    let split = source.record(self, v, ring).and_then(|record| {
-                        let outcome = self.apply_split(v, ring, &record, c)?;
-                        source.applied(v, c, &outcome);
-                        Ok(outcome)
-                    });
-                    match split {
-                        Ok(outcome) => stats.triangles_added += outcome.triangles_added,
-                        Err(e) => split_error = Some(e),
-                    }
+                    let c = n + stats.splits - 1;
+                    splits.flagged(self, source, v, c, ring, stats, &mut split_error);
                 }
                 // The fans walked ahead are the batch's: none outlives it.
                 ring.ahead.owner = [NONE; FANS];
             }
         }
+        splits.finish(self, stats, &mut split_error);
         Ok(split_error)
     }
 
@@ -199,6 +231,7 @@ impl MeshState<'_> {
         w: usize,
         source: &mut S,
         ahead: &mut FansAhead,
+        positions: bool,
     ) {
         let mut upcoming = [0u32; WARM_BATCH];
         let mut upcoming_len = 0;
@@ -217,7 +250,7 @@ impl MeshState<'_> {
                 walk_len += 1;
             }
         }
-        self.walk_fans(&walk[..walk_len], ahead);
+        self.walk_fans(&walk[..walk_len], ahead, positions);
     }
 
     /// Walks the fans of `rs` (ascending) in lockstep into `ahead`, then
@@ -227,7 +260,7 @@ impl MeshState<'_> {
     /// and one corner per fan), so that many fans' loads fit in the
     /// processor's window at once; the positions, which depend on no
     /// further load, come last, all together.
-    fn walk_fans(&self, rs: &[u32], ahead: &mut FansAhead) {
+    fn walk_fans(&self, rs: &[u32], ahead: &mut FansAhead, positions: bool) {
         let count = rs.len().min(FANS);
         let mut corner = [NONE; FANS];
         for i in 0..FANS {
@@ -273,6 +306,19 @@ impl MeshState<'_> {
             }
         }
         let mut sum = 0u32;
+        if !positions {
+            // The records are read elsewhere (`pipe.rs`): only the wings'
+            // deficits are read here, when the splits are applied.
+            for i in 0..count {
+                for &v in &ahead.vertices[i][..ahead.len[i] as usize] {
+                    if let Some(&d) = self.deficit.get(v as usize) {
+                        sum = sum.wrapping_add(d as u32);
+                    }
+                }
+            }
+            core::hint::black_box(sum);
+            return;
+        }
         for (i, &r) in rs[..count].iter().enumerate() {
             // The owner's own position too: its record reads it first
             // (the parent of the split's positions, SPEC §7.4), and nothing
@@ -289,5 +335,145 @@ impl MeshState<'_> {
             }
         }
         core::hint::black_box(sum);
+    }
+}
+
+/// What a round does with each flagged vertex once its ring is walked and
+/// blocked (SPEC §7.3, step 3): `flagged` is called in split order, the
+/// `c`-th vertex index for its C, until a split fails; `finish` once the
+/// round's flags are all read.
+trait FlaggedSplits<S> {
+    /// Whether the round's records are read on this thread, from this
+    /// state's positions (the fans walked ahead then touch them too).
+    const READS_POSITIONS: bool = true;
+    #[allow(clippy::too_many_arguments)]
+    fn flagged(
+        &mut self,
+        state: &mut MeshState<'_>,
+        source: &mut S,
+        r: u32,
+        c: u32,
+        ring: &Ring,
+        stats: &mut RoundStats,
+        split_error: &mut Option<Error>,
+    );
+    fn finish(
+        &mut self,
+        _state: &mut MeshState<'_>,
+        _stats: &mut RoundStats,
+        _split_error: &mut Option<Error>,
+    ) {
+    }
+}
+
+/// The decoder on one thread: each record is read and its split applied
+/// at once.
+struct Fused;
+
+impl<S: RecordSource> FlaggedSplits<S> for Fused {
+    #[inline(always)]
+    fn flagged(
+        &mut self,
+        state: &mut MeshState<'_>,
+        source: &mut S,
+        r: u32,
+        c: u32,
+        ring: &Ring,
+        stats: &mut RoundStats,
+        split_error: &mut Option<Error>,
+    ) {
+        let split = source.record(state, r, ring).and_then(|record| {
+            let outcome = state.apply_split(r, ring, &record, c)?;
+            source.applied(r, c, &outcome);
+            Ok(outcome)
+        });
+        match split {
+            Ok(outcome) => stats.triangles_added += outcome.triangles_added,
+            Err(e) => *split_error = Some(e),
+        }
+    }
+}
+
+/// The records read elsewhere (`pipe.rs`): each ring goes into the pipe and
+/// waits in `pending` until its record comes back.
+struct Piped<'a, 'p, P> {
+    pipe: &'a mut P,
+    pending: &'a mut PendingSplits<'p>,
+}
+
+impl<P: RecordPipe> Piped<'_, '_, P> {
+    /// Applies the oldest pending split with its record, waiting for the
+    /// record if `wait`; `false` when nothing was applied.
+    fn apply_oldest(
+        &mut self,
+        state: &mut MeshState<'_>,
+        wait: bool,
+        stats: &mut RoundStats,
+        split_error: &mut Option<Error>,
+    ) -> bool {
+        if self.pending.is_empty() {
+            return false;
+        }
+        let Some(record) = self.pipe.take(wait) else {
+            if wait {
+                // The other half went away: nothing more will come back.
+                *split_error = split_error.or(Some(Error::Poisoned));
+                self.pending.clear();
+            }
+            return false;
+        };
+        let Some((r, c, ring)) = self.pending.pop() else {
+            return false;
+        };
+        if split_error.is_some() {
+            // After a failed split nothing is applied: the records still
+            // in the pipe are drained.
+            return true;
+        }
+        match record.and_then(|record| state.apply_split(r, ring, &record, c)) {
+            Ok(outcome) => stats.triangles_added += outcome.triangles_added,
+            Err(e) => *split_error = Some(e),
+        }
+        true
+    }
+}
+
+impl<S: RecordSource, P: RecordPipe> FlaggedSplits<S> for Piped<'_, '_, P> {
+    const READS_POSITIONS: bool = false;
+
+    #[inline]
+    fn flagged(
+        &mut self,
+        state: &mut MeshState<'_>,
+        _source: &mut S,
+        r: u32,
+        c: u32,
+        ring: &Ring,
+        stats: &mut RoundStats,
+        split_error: &mut Option<Error>,
+    ) {
+        // Room for this ring: the oldest waits for its record if need be.
+        while self.pending.is_full() && split_error.is_none() {
+            if !self.apply_oldest(state, true, stats, split_error) {
+                break;
+            }
+        }
+        if split_error.is_some() {
+            return;
+        }
+        let eligible = state.wing_candidates(ring);
+        self.pipe.send(r, c, ring.vertices(), &eligible);
+        self.pending.push(r, c, ring);
+        // Whatever has come back already is applied now.
+        while self.apply_oldest(state, false, stats, split_error) {}
+    }
+
+    fn finish(
+        &mut self,
+        state: &mut MeshState<'_>,
+        stats: &mut RoundStats,
+        split_error: &mut Option<Error>,
+    ) {
+        while self.apply_oldest(state, true, stats, split_error) {}
     }
 }

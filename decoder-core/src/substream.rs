@@ -42,6 +42,28 @@ struct Reader<'b> {
     ahead_error: Option<Error>,
 }
 
+impl Reader<'_> {
+    /// A reader with nothing to read: its slot is read elsewhere.
+    fn idle(id: u8) -> Self {
+        Reader {
+            id,
+            next_chunk: 0,
+            end_chunk: 0,
+            payload_at: 0,
+            buf: &mut [],
+            chunk: None,
+            rans: false,
+            len: 0,
+            pos: 0,
+            bit_byte: 0,
+            bit_index: 8,
+            ahead: 0,
+            ahead_len: 0,
+            ahead_error: None,
+        }
+    }
+}
+
 /// The open substreams of one level.
 pub struct Substreams<'l, 'b> {
     level: &'l [u8],
@@ -119,6 +141,42 @@ impl<'l, 'b> Substreams<'l, 'b> {
             header,
             readers,
             inflater,
+        }
+    }
+
+    /// Moves the readers of every slot but `keep` into substreams of their
+    /// own, which inflate with `inflater`: the records of a level read on
+    /// one thread while its flags are read on another (`pipe.rs`). Each
+    /// part reads only its own slots; the others are idle in it (no chunks,
+    /// nothing to read, so [`Substreams::finish`] passes them).
+    /// [`Substreams::join`] puts them back.
+    pub fn split_off(&mut self, keep: usize, inflater: &'b mut Inflater) -> Substreams<'l, 'b> {
+        let mut i = 0;
+        let readers = self.readers.each_mut().map(|r| {
+            let slot = i;
+            i += 1;
+            let idle = Reader::idle(r.id);
+            if slot == keep {
+                idle
+            } else {
+                core::mem::replace(r, idle)
+            }
+        });
+        Substreams {
+            level: self.level,
+            header: self.header,
+            readers,
+            inflater,
+        }
+    }
+
+    /// Takes back the readers [`Substreams::split_off`] moved into `part`
+    /// (all but `keep`'s, as there).
+    pub fn join(&mut self, keep: usize, part: Substreams<'l, 'b>) {
+        for (slot, (mine, theirs)) in self.readers.iter_mut().zip(part.readers).enumerate() {
+            if slot != keep {
+                *mine = theirs;
+            }
         }
     }
 

@@ -86,6 +86,7 @@ fn fix_head_checksums(s: &mut [u8]) {
 fn decode_both(stream: &[u8]) -> Result<(), TestCaseError> {
     let owned = decode_all(stream, true);
     let d = streams::decode_full(stream);
+    streams::check_piped(stream, &d).map_err(TestCaseError::fail)?;
     match (&owned, d.error) {
         (Ok(mesh), None) => {
             prop_assert_eq!(&mesh.round_hashes, &d.hashes);

@@ -44,6 +44,7 @@ proptest! {
             return Err(TestCaseError::fail(msg));
         }
         streams::check_fans_ahead(&g.stream, &d).map_err(TestCaseError::fail)?;
+        streams::check_piped(&g.stream, &d).map_err(TestCaseError::fail)?;
         prop_assert_eq!(d.positions.len() as u32, g.base_vertices + g.splits);
         let chi = check_oriented_manifold(d.positions.len(), &d.triangles)
             .map_err(TestCaseError::fail)?;
@@ -59,6 +60,7 @@ proptest! {
         let g = streams::generate(&mut Choices::new(&choices), true);
         let d = streams::decode_full(&g.stream);
         streams::check_fans_ahead(&g.stream, &d).map_err(TestCaseError::fail)?;
+        streams::check_piped(&g.stream, &d).map_err(TestCaseError::fail)?;
         if let Err(msg) = streams::check_against(&g, &d) {
             return Err(TestCaseError::fail(msg));
         }
@@ -112,6 +114,8 @@ proptest! {
             rans_chunk_limit: 5,
         };
         let stream = write_stream(&params, &[base_level, level]);
+        let d = streams::decode_full(&stream);
+        streams::check_piped(&stream, &d).map_err(TestCaseError::fail)?;
         match decode_all(&stream, true) {
             Ok(mesh) => {
                 prop_assert_eq!(mesh.positions.len(), nv + splits as usize);
@@ -124,6 +128,32 @@ proptest! {
             }
         }
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// The `decode_mutated` fuzz target's edits (records, split counts,
+    /// level counts, stream parameters of deep seed streams, reframed with
+    /// valid checksums): the records read through a pipe decode exactly as
+    /// the one-thread rounds, errors included.
+    #[test]
+    fn piped_records_decode_mutated_streams_alike(
+        pick in any::<u8>(),
+        ops in proptest::collection::vec(any::<u8>(), 1..96),
+    ) {
+        let seeds = seeds();
+        let seed = &seeds[pick as usize % seeds.len()];
+        let (params, levels) = streams::mutate_levels(seed, &mut Choices::new(&ops));
+        let stream = streams::frame(&params, &levels, seed.seeded);
+        let d = streams::decode_full(&stream);
+        streams::check_piped(&stream, &d).map_err(TestCaseError::fail)?;
+    }
+}
+
+fn seeds() -> &'static [streams::Generated] {
+    static SEEDS: std::sync::OnceLock<Vec<streams::Generated>> = std::sync::OnceLock::new();
+    SEEDS.get_or_init(streams::seed_generated)
 }
 
 /// The seed streams of the fuzz targets all decode and keep the invariants.

@@ -1,6 +1,7 @@
 //! Criterion benchmark of decoder-core on the 1M-vertex synthetic terrain:
-//! single-thread decoding of every level, in vertex splits per second
-//! (the goal of decoder-core's README), for both entropy codecs in one run.
+//! decoding of every level on one thread and on two (sdk-native
+//! `threaded`), in vertex splits per second (the goal of decoder-core's
+//! README), for both entropy codecs in one run.
 //! Each stream is encoded once and kept in target/bench-data/ (encoding
 //! takes a while); the file name carries the format version and the codec.
 
@@ -13,6 +14,7 @@ use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::input::fractal_terrain;
+use splitstream_sdk_native::threaded::{self, TwoThreadMemory};
 
 const SIDE: usize = 1000;
 
@@ -66,6 +68,28 @@ fn decode(c: &mut Criterion) {
                 b.iter(|| {
                     let mut decoder = ws.decoder(&stream).expect("valid stream");
                     decoder.decode_available(&stream).expect("decodes");
+                    decoder.triangles().len()
+                })
+            },
+        );
+        // The same with each level's records read on a second thread
+        // (sdk-native `threaded`): the ratio of the two is the figure.
+        let capacity = ws
+            .decoder(&stream)
+            .expect("valid stream")
+            .state()
+            .vertex_capacity();
+        let mut memory = TwoThreadMemory::new(capacity);
+        group.bench_function(
+            format!("terrain {SIDE}x{SIDE}, {name}, all levels, two threads"),
+            |b| {
+                b.iter(|| {
+                    let mut decoder = ws.decoder(&stream).expect("valid stream");
+                    while let Some(k) = decoder.next_level() {
+                        let bytes = decoder.level_bytes(k, &stream).expect("level");
+                        threaded::decode_level(&mut decoder, k, bytes, &mut memory)
+                            .expect("decodes");
+                    }
                     decoder.triangles().len()
                 })
             },

@@ -136,6 +136,33 @@ fn bad_streams_and_arguments_get_one_line_naming_the_file() {
     assert!(err.contains("--level 99"), "{err}");
     let err = one_line_error(&splitstream(&["decode", s, "-o", "out.xyz"]));
     assert!(err.contains("out.xyz"), "{err}");
+    let err = one_line_error(&splitstream(&["decode", s, "-o", o, "--threads", "3"]));
+    assert!(err.contains("--threads"), "{err}");
+    let err = one_line_error(&splitstream(&["decode", c, "-o", d, "--threads", "2"]));
+    assert!(
+        err.contains("cut.sps: ") && err.contains("truncated"),
+        "{err}"
+    );
+}
+
+#[test]
+fn two_threads_decode_the_same_mesh() {
+    let (input, stream) = encoded_raster("for-threads.sps");
+    let s = stream.to_str().unwrap();
+    let one = input.with_file_name("one-thread.obj");
+    let two = input.with_file_name("two-threads.obj");
+    let a = succeeded(&splitstream(&["decode", s, "-o", one.to_str().unwrap()]));
+    let b = succeeded(&splitstream(&[
+        "decode",
+        s,
+        "-o",
+        two.to_str().unwrap(),
+        "--threads",
+        "2",
+    ]));
+    let tail = |out: &str| out.split(": ").nth(1).unwrap().to_string();
+    assert_eq!(tail(&a), tail(&b));
+    assert_eq!(std::fs::read(&one).unwrap(), std::fs::read(&two).unwrap());
 }
 
 #[test]

@@ -209,6 +209,19 @@ SsStatus ss_decoder_decode_level(SsDecoder *decoder,
                                  const uint8_t *bytes,
                                  size_t len);
 
+// `ss_decoder_decode_level` on two cores: the rounds on the calling
+// thread, the split records on a second thread that lives as long as the
+// call; the same state, the same statuses. The first call allocates 12
+// bytes per vertex of the decoder's capacity and about 200 KiB more, kept
+// until `ss_decoder_free`.
+//
+// # Safety
+// `decoder` is a live handle; `bytes` points to `len` readable bytes.
+SsStatus ss_decoder_decode_level_two_threads(SsDecoder *decoder,
+                                             uint16_t level,
+                                             const uint8_t *bytes,
+                                             size_t len);
+
 // Starts level `level` from its bytes (copied) for round-by-round
 // decoding with `ss_decoder_next_round`; level 0's seed mesh is decoded
 // here.

@@ -6,6 +6,8 @@
 //! * [`grid_tile`]: a client-side simplifier for regular elevation tiles
 //!   (quad-tree split and merge with edge straightening, after Rishe et al.,
 //!   "Mesh Simplification Algorithm for Online 3D GIS", 2005).
+//! * [`threaded`]: one stream decoded on two cores, the split records
+//!   read on a second thread.
 //! * [`view`]: how many levels a viewer needs, from each level's geometric
 //!   error projected on screen ([`Session::level_for_screen_error`]).
 //! * [`gpu`] (feature `gpu`): the refinement rounds on a wgpu device,
@@ -18,6 +20,7 @@ pub mod ffi;
 #[cfg(feature = "gpu")]
 pub mod gpu;
 pub mod grid_tile;
+pub mod threaded;
 pub mod view;
 
 pub use ffi::Session;

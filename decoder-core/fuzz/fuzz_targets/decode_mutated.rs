@@ -26,6 +26,9 @@ fuzz_target!(|data: &[u8]| {
     if let Err(msg) = streams::check_fans_ahead(&stream, &decoded) {
         panic!("{msg}");
     }
+    if let Err(msg) = streams::check_piped(&stream, &decoded) {
+        panic!("{msg}");
+    }
     if ops.is_empty() {
         streams::check_against(seed, &decoded).unwrap();
     }

@@ -18,4 +18,7 @@ fuzz_target!(|data: &[u8]| {
     if let Err(msg) = streams::check_fans_ahead(&g.stream, &decoded) {
         panic!("{msg}");
     }
+    if let Err(msg) = streams::check_piped(&g.stream, &decoded) {
+        panic!("{msg}");
+    }
 });

@@ -23,6 +23,7 @@
 
 use splitstream_decoder_core::handmade;
 use splitstream_decoder_core::limits::{LEAF, NONE};
+use splitstream_decoder_core::pipe::{InPlacePipe, PendingSplit, PendingSplits};
 use splitstream_decoder_core::symbols::{deficit_of, split_valence_symbol};
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
@@ -738,6 +739,101 @@ pub fn check_fans_ahead(stream: &[u8], d: &Decoded) -> Result<(), String> {
         ));
     }
     Ok(())
+}
+
+/// Checks that decoding with the records read through a pipe
+/// (`MeshState::run_round_piped`, the two-thread decoder's rounds run on
+/// one thread) decodes `stream` as `d`, the default decode, did: the same
+/// hashes after every round, the same error, and without an error the same
+/// final mesh; with records coming back at once or only when waited for,
+/// and as few as one split pending.
+pub fn check_piped(stream: &[u8], d: &Decoded) -> Result<(), String> {
+    for (lag, pending) in [(false, 96), (true, 1), (true, 5)] {
+        let piped = decode_piped(stream, lag, pending);
+        // After an error only the hashes reported and the error count
+        // (SPEC §10.2): the failing round's splits still pending are not
+        // applied, where the one-thread rounds applied them.
+        let same_mesh = d.error.is_some()
+            || (piped.triangles == d.triangles
+                && piped.positions == d.positions
+                && piped.deficits == d.deficits);
+        if piped.hashes != d.hashes || piped.error != d.error || !same_mesh {
+            return Err(format!(
+                "piped records (lag {lag}, {pending} pending) changed the decode: {} hashes and error {:?}, against {} and {:?}",
+                piped.hashes.len(),
+                piped.error,
+                d.hashes.len(),
+                d.error
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Decodes `stream` round by round with each level's records split off and
+/// read through an [`InPlacePipe`].
+pub fn decode_piped(stream: &[u8], lag: bool, pending: usize) -> Decoded {
+    let mut out = Decoded {
+        hashes: Vec::new(),
+        level_hashes: Vec::new(),
+        error: None,
+        levels: 0,
+        levels_that_fit: 0,
+        triangles: Vec::new(),
+        positions: Vec::new(),
+        deficits: Vec::new(),
+    };
+    let len = workspace_len(stream).unwrap_or(0).min(64 << 20);
+    let mut ws = vec![0u8; len];
+    let mut inflater = Box::new(Inflater::new());
+    let mut records_inflater = Box::new(Inflater::new());
+    let mut slots = vec![PendingSplit::default(); pending];
+    let mut decoder = match Decoder::new(stream, &mut ws, &mut inflater) {
+        Ok(d) => d,
+        Err(e) => {
+            out.error = Some(e);
+            return out;
+        }
+    };
+    out.levels_that_fit = decoder.levels_that_fit();
+    let mut mirror = vec![[0u32; 3]; decoder.state().vertex_capacity() as usize];
+    let result = (|| -> Result<(), Error> {
+        while let Some(k) = decoder.next_level() {
+            let range = decoder.level_range(k);
+            let bytes = stream
+                .get(range.start as usize..range.end as usize)
+                .ok_or(Error::Truncated)?;
+            let mut level = decoder.begin_level(k, bytes)?;
+            if k == 0 {
+                out.hashes.push(level.state().state_hash());
+            }
+            let mut half = level.split_records(&mut records_inflater, &mut mirror)?;
+            let mut pipe = InPlacePipe::new(&mut half, lag);
+            let mut queue = PendingSplits::new(&mut slots).ok_or(Error::CapacityExceeded)?;
+            let rounds = (|| {
+                while level.next_round_piped(&mut pipe, &mut queue)?.is_some() {
+                    out.hashes.push(level.state().state_hash());
+                }
+                Ok(())
+            })();
+            drop(pipe);
+            level.join_records(half);
+            rounds?;
+            // The rounds are done: this ends the level; a round left over
+            // would be a bug of the piped path.
+            if level.next_round()?.is_some() {
+                return Err(Error::Poisoned);
+            }
+            out.level_hashes.push(decoder.state_hash());
+        }
+        Ok(())
+    })();
+    out.error = result.err();
+    out.levels = decoder.levels_done();
+    out.triangles = decoder.triangles().to_vec();
+    out.positions = decoder.positions().to_vec();
+    out.deficits = decoder.state().deficits().to_vec();
+    out
 }
 
 /// Checks a decode against the replay that generated the stream.

@@ -3,19 +3,28 @@
 use std::path::Path;
 
 use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_sdk_native::threaded::{self, TwoThreadMemory};
 
 use super::output::write_mesh;
 use super::{CliResult, read_file};
 
 /// What to decode: up to `level` (the last level by default), and with
-/// `available` only the levels whose bytes are all in the file.
+/// `available` only the levels whose bytes are all in the file; with
+/// `threads` 2 each level's records are read on a second thread.
 pub struct DecodeOptions {
     pub level: Option<u16>,
     pub available: bool,
+    pub threads: u32,
 }
 
 pub fn run(input: &Path, output: &Path, options: DecodeOptions) -> CliResult {
     super::output::mesh_extension(output)?;
+    if !(1..=2).contains(&options.threads) {
+        return Err(format!(
+            "--threads {}: a stream decodes on 1 or 2 threads",
+            options.threads
+        ));
+    }
     let stream = read_file(input)?;
     let fail = |e: splitstream_decoder_core::Error| format!("{}: {e}", input.display());
     let mut ws = OwnedWorkspace::for_stream(&stream).map_err(fail)?;
@@ -45,6 +54,8 @@ pub fn run(input: &Path, output: &Path, options: DecodeOptions) -> CliResult {
         );
         stop = in_file - 1;
     }
+    let mut two_threads =
+        (options.threads == 2).then(|| TwoThreadMemory::new(decoder.state().vertex_capacity()));
     while let Some(k) = decoder.next_level().filter(|&k| k <= stop) {
         let bytes = decoder.level_bytes(k, &stream).map_err(|e| {
             if options.available {
@@ -59,7 +70,11 @@ pub fn run(input: &Path, output: &Path, options: DecodeOptions) -> CliResult {
                 )
             }
         })?;
-        decoder.decode_level(k, bytes).map_err(fail)?;
+        match &mut two_threads {
+            Some(memory) => threaded::decode_level(&mut decoder, k, bytes, memory),
+            None => decoder.decode_level(k, bytes),
+        }
+        .map_err(fail)?;
     }
     let positions: Vec<[f64; 3]> = decoder
         .positions()

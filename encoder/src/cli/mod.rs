@@ -225,6 +225,10 @@ pub enum Command {
         /// with range requests), instead of failing on a truncated file.
         #[arg(long)]
         available: bool,
+        /// 2: read each level's split records on a second thread while the
+        /// rounds run on this one (sdk-native `threaded`); the same mesh.
+        #[arg(long, default_value_t = 1)]
+        threads: u32,
     },
     /// Header, level table (with the decoder memory each prefix of levels
     /// needs), bits per field and per vertex.
@@ -273,7 +277,16 @@ pub fn run(cli: Cli) -> CliResult {
             output,
             level,
             available,
-        } => decode::run(&input, &output, decode::DecodeOptions { level, available }),
+            threads,
+        } => decode::run(
+            &input,
+            &output,
+            decode::DecodeOptions {
+                level,
+                available,
+                threads,
+            },
+        ),
         Command::Info {
             input,
             json,

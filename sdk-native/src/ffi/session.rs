@@ -23,6 +23,7 @@ use splitstream_decoder_core::{
     level_within_error,
 };
 
+use crate::threaded::{self, TwoThreadMemory};
 use crate::view::{ScreenView, ViewError};
 
 /// A progressive decoding session: created from the stream head (header and
@@ -51,6 +52,9 @@ pub struct Session {
     /// Levels done when the open level began (the decoder's own count is
     /// out of reach while a level borrows it).
     done_while_open: u16,
+    /// What [`Session::decode_level_two_threads`] needs besides the
+    /// workspace, made at its first call.
+    two_threads: Option<Box<TwoThreadMemory>>,
 }
 
 impl Session {
@@ -109,6 +113,7 @@ impl Session {
             levels_that_fit,
             workspace_bytes,
             done_while_open: 0,
+            two_threads: None,
         })
     }
 
@@ -212,6 +217,25 @@ impl Session {
             return Err(self.misuse(k));
         }
         self.decoder_mut().decode_level(k, bytes)
+    }
+
+    /// [`Session::decode_level`] on two cores: the rounds here, the split
+    /// records on a second thread (see [`crate::threaded`]), to the same
+    /// state. The first call allocates 12 bytes per vertex of the
+    /// session's capacity and about 200 KiB more, kept until the session
+    /// is dropped.
+    pub fn decode_level_two_threads(&mut self, k: u16, bytes: &[u8]) -> Result<(), Error> {
+        if self.level.is_some() {
+            return Err(self.misuse(k));
+        }
+        let capacity = self.decoder().state().vertex_capacity();
+        let mut memory = self
+            .two_threads
+            .take()
+            .unwrap_or_else(|| Box::new(TwoThreadMemory::new(capacity)));
+        let result = threaded::decode_level(self.decoder_mut(), k, bytes, &mut memory);
+        self.two_threads = Some(memory);
+        result
     }
 
     /// Starts level `k` (its bytes are copied); decode its rounds with

@@ -3,8 +3,10 @@
  * by tests/c_abi.rs.
  *
  *   example decode STREAM.sps   decodes the stream progressively (head
- *                               first, then each level's byte range; even
- *                               levels whole, odd ones round by round) and
+ *                               first, then each level's byte range;
+ *                               levels 0, 3, ... whole, levels 1, 4, ...
+ *                               round by round, levels 2, 5, ... whole on
+ *                               two threads) and
  *                               prints "ok HASH VERTICES TRIANGLES" or
  *                               "error CLASS: MESSAGE".
  *   example grid                simplifies two synthetic tiles and prints
@@ -85,8 +87,12 @@ static int decode(const char *path) {
             info.length = info.offset < len ? (uint32_t)(len - info.offset) : 0;
         }
         const unsigned char *bytes = stream + (info.offset < len ? info.offset : len);
-        if (k % 2 == 0) {
+        if (k % 3 == 0) {
             if (ss_decoder_decode_level(d, (uint16_t)k, bytes, info.length) != SS_STATUS_OK)
+                goto failed;
+        } else if (k % 3 == 2) {
+            if (ss_decoder_decode_level_two_threads(d, (uint16_t)k, bytes, info.length) !=
+                SS_STATUS_OK)
                 goto failed;
         } else {
             if (ss_decoder_begin_level(d, (uint16_t)k, bytes, info.length) != SS_STATUS_OK)

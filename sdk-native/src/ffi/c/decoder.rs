@@ -329,6 +329,29 @@ pub unsafe extern "C" fn ss_decoder_decode_level(
     unsafe { with_level_bytes(decoder, bytes, len, |s, b| s.decode_level(level, b)) }
 }
 
+/// `ss_decoder_decode_level` on two cores: the rounds on the calling
+/// thread, the split records on a second thread that lives as long as the
+/// call; the same state, the same statuses. The first call allocates 12
+/// bytes per vertex of the decoder's capacity and about 200 KiB more, kept
+/// until `ss_decoder_free`.
+///
+/// # Safety
+/// `decoder` is a live handle; `bytes` points to `len` readable bytes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn ss_decoder_decode_level_two_threads(
+    decoder: *mut SsDecoder,
+    level: u16,
+    bytes: *const u8,
+    len: usize,
+) -> SsStatus {
+    // SAFETY: the caller's contract is this function's.
+    unsafe {
+        with_level_bytes(decoder, bytes, len, |s, b| {
+            s.decode_level_two_threads(level, b)
+        })
+    }
+}
+
 /// Starts level `level` from its bytes (copied) for round-by-round
 /// decoding with `ss_decoder_next_round`; level 0's seed mesh is decoded
 /// here.

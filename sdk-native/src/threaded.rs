@@ -1,0 +1,253 @@
+//! One stream decoded on two cores: decoder-core's rounds on the calling
+//! thread, the split records (SPEC §7.4) read on a second thread
+//! (`splitstream_decoder_core::pipe`).
+//!
+//! The calling thread reads the flags, walks the flagged vertices' rings and
+//! applies the splits; the second reads the records from their own
+//! substreams. Rings go one way and records the other, in batches of
+//! [`BATCH`], so that the threads meet once per batch rather than once per
+//! split. Every round ends in the state a one-thread decode gives (the same
+//! state hash, SPEC §8), and a bad stream fails with the same error.
+//!
+//! It costs memory beside the decoder's workspace: a copy of the positions
+//! (12 bytes a vertex), a second inflater and [`PENDING`] waiting rings
+//! (about 2 KiB each). See the README's "On two cores" for what it gains.
+
+use std::collections::VecDeque;
+use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
+
+use splitstream_decoder_core::pipe::{PendingSplit, PendingSplits, RecordPipe, RecordsHalf};
+use splitstream_decoder_core::{
+    Decoder, Error, Inflater, MeshState, RoundInfo, SplitRecord, WingCandidates,
+};
+
+/// Splits sent to the records thread at once: at first, whenever the
+/// records thread has nothing left to do (at the start of each round), so
+/// that it starts soon; then twice as many each time, up to [`BATCH`], so
+/// that the threads meet seldom.
+pub const FIRST_BATCH: usize = 8;
+/// The most splits sent at once.
+pub const BATCH: usize = 256;
+/// Splits whose records may be on their way at once: how far the rings may
+/// run ahead of the records (three batches, so that the calling thread
+/// walks the next batch while the records of the one before come back).
+pub const PENDING: usize = 3 * BATCH;
+
+/// The memory a two-thread decode needs beside the decoder's workspace,
+/// kept from level to level.
+pub struct TwoThreadMemory {
+    inflater: Box<Inflater>,
+    positions: Vec<[u32; 3]>,
+    pending: Vec<PendingSplit>,
+}
+
+impl TwoThreadMemory {
+    /// Memory for a decoder holding up to `vertex_capacity` vertices.
+    pub fn new(vertex_capacity: u32) -> Self {
+        TwoThreadMemory {
+            inflater: Box::default(),
+            positions: vec![[0; 3]; vertex_capacity as usize],
+            pending: vec![PendingSplit::default(); PENDING],
+        }
+    }
+
+    /// Bytes it holds (besides the allocator's own).
+    pub fn bytes(&self) -> usize {
+        size_of::<Inflater>()
+            + self.positions.len() * size_of::<[u32; 3]>()
+            + self.pending.len() * size_of::<PendingSplit>()
+    }
+}
+
+/// Decodes level `level` from its `bytes` like [`Decoder::decode_level`],
+/// with the records read on a second thread.
+pub fn decode_level(
+    decoder: &mut Decoder<'_, '_>,
+    level: u16,
+    bytes: &[u8],
+    memory: &mut TwoThreadMemory,
+) -> Result<(), Error> {
+    decode_level_observed(decoder, level, bytes, memory, |_, _| {})
+}
+
+/// [`decode_level`], showing `after` the state after level 0's seed mesh
+/// (with `None`) and after every round (with the round's counts), as the
+/// conformance runner checks it (SPEC §8).
+pub fn decode_level_observed<F>(
+    decoder: &mut Decoder<'_, '_>,
+    level: u16,
+    bytes: &[u8],
+    memory: &mut TwoThreadMemory,
+    mut after: F,
+) -> Result<(), Error>
+where
+    F: FnMut(Option<&RoundInfo>, &MeshState<'_>),
+{
+    let capacity = decoder.state().vertex_capacity() as usize;
+    if memory.positions.len() < capacity {
+        memory.positions.resize(capacity, [0; 3]);
+    }
+    let mut level_decoder = decoder.begin_level(level, bytes)?;
+    if level == 0 {
+        after(None, level_decoder.state());
+    }
+    let records = level_decoder.split_records(&mut memory.inflater, &mut memory.positions)?;
+    let Some(mut pending) = PendingSplits::new(&mut memory.pending) else {
+        return Err(Error::CapacityExceeded);
+    };
+    let (rounds, records) = std::thread::scope(|scope| {
+        let (requests, requests_in) = channel();
+        let (answers_out, answers) = channel();
+        let worker = scope.spawn(move || serve(records, requests_in, answers_out));
+        let mut pipe = ChannelPipe {
+            building: Batch::default(),
+            batch: FIRST_BATCH,
+            outstanding: 0,
+            requests,
+            answers,
+            ready: VecDeque::new(),
+        };
+        let rounds = loop {
+            match level_decoder.next_round_piped(&mut pipe, &mut pending) {
+                Ok(Some(info)) => after(Some(&info), level_decoder.state()),
+                Ok(None) => break Ok(()),
+                Err(e) => break Err(e),
+            }
+        };
+        // Closing the requests ends the worker, which gives the record
+        // substreams back.
+        drop(pipe);
+        match worker.join() {
+            Ok(records) => (rounds, records),
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
+    });
+    level_decoder.join_records(records);
+    rounds?;
+    // The rounds are done: this ends the level (SPEC §7.6).
+    while level_decoder.next_round()?.is_some() {}
+    Ok(())
+}
+
+/// One split's request: R, C's index, the eligible wing entries and where
+/// its ring lies in the batch's `vertices`.
+struct Request {
+    r: u32,
+    c: u32,
+    eligible: WingCandidates,
+    ring_start: u32,
+    ring_len: u32,
+}
+
+#[derive(Default)]
+struct Batch {
+    requests: Vec<Request>,
+    vertices: Vec<u32>,
+}
+
+/// The calling thread's end of the pipe.
+struct ChannelPipe {
+    building: Batch,
+    /// Requests the batch being built is sent with.
+    batch: usize,
+    /// Requests sent whose records have not come back.
+    outstanding: usize,
+    requests: Sender<Batch>,
+    answers: Receiver<Vec<Result<SplitRecord, Error>>>,
+    /// Records come back and not taken yet, oldest first.
+    ready: VecDeque<Result<SplitRecord, Error>>,
+}
+
+impl ChannelPipe {
+    fn flush(&mut self) {
+        if !self.building.requests.is_empty() {
+            self.outstanding += self.building.requests.len();
+            self.batch = (2 * self.batch).min(BATCH);
+            // A closed channel shows as a closed answer channel in `take`.
+            let _ = self.requests.send(std::mem::take(&mut self.building));
+        }
+    }
+}
+
+impl RecordPipe for ChannelPipe {
+    fn send(&mut self, r: u32, c: u32, vertices: &[u32], eligible: &WingCandidates) {
+        let b = &mut self.building;
+        b.requests.push(Request {
+            r,
+            c,
+            eligible: *eligible,
+            ring_start: b.vertices.len() as u32,
+            ring_len: vertices.len() as u32,
+        });
+        b.vertices.extend_from_slice(vertices);
+        if b.requests.len() >= self.batch {
+            self.flush();
+        }
+    }
+
+    fn take(&mut self, wait: bool) -> Option<Result<SplitRecord, Error>> {
+        if let Some(record) = self.ready.pop_front() {
+            return Some(record);
+        }
+        let batch = if wait {
+            // The oldest request may still be in the batch being built.
+            self.flush();
+            receive(&self.answers)?
+        } else {
+            match self.answers.try_recv() {
+                Ok(batch) => batch,
+                Err(TryRecvError::Empty | TryRecvError::Disconnected) => return None,
+            }
+        };
+        self.outstanding -= batch.len();
+        if self.outstanding == 0 && self.building.requests.is_empty() {
+            // The records thread has caught up: the next batch is small.
+            self.batch = FIRST_BATCH;
+        }
+        self.ready.extend(batch);
+        self.ready.pop_front()
+    }
+}
+
+/// The records thread: reads each batch's records in order and sends them
+/// back, until the requests close; returns the records half.
+fn serve<'l, 'b>(
+    mut records: RecordsHalf<'l, 'b>,
+    requests: Receiver<Batch>,
+    answers: Sender<Vec<Result<SplitRecord, Error>>>,
+) -> RecordsHalf<'l, 'b> {
+    while let Some(batch) = receive(&requests) {
+        let out = batch
+            .requests
+            .iter()
+            .map(|q| {
+                let start = q.ring_start as usize;
+                let ring = &batch.vertices[start..start + q.ring_len as usize];
+                records.read(q.r, q.c, ring, &q.eligible)
+            })
+            .collect();
+        if answers.send(out).is_err() {
+            break;
+        }
+    }
+    records
+}
+
+/// How many times a thread polls an empty channel before it sleeps on it.
+/// Sleeping and being woken costs tens of microseconds, about what a batch
+/// of records takes to read, so a thread that waits for the other polls
+/// first.
+const POLLS: u32 = 1 << 14;
+
+/// The next message of `from`, polling before sleeping; `None` once the
+/// sender is gone.
+fn receive<T>(from: &Receiver<T>) -> Option<T> {
+    for _ in 0..POLLS {
+        match from.try_recv() {
+            Ok(message) => return Some(message),
+            Err(TryRecvError::Empty) => std::hint::spin_loop(),
+            Err(TryRecvError::Disconnected) => return None,
+        }
+    }
+    from.recv().ok()
+}
