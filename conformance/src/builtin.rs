@@ -120,6 +120,8 @@ pub fn two_threads(stream: &[u8]) -> Outcome {
         let mut ws = OwnedWorkspace::for_stream(stream)?;
         let mut decoder = ws.decoder(stream)?;
         let mut memory = TwoThreadMemory::new(decoder.state().vertex_capacity());
+        // Every level through the second thread, however small.
+        memory.set_two_threads_from(0);
         while let Some(k) = decoder.next_level() {
             let range = decoder.level_range(k);
             let bytes = usize::try_from(range.start)

@@ -33,12 +33,18 @@ pub const BATCH: usize = 256;
 /// walks the next batch while the records of the one before come back).
 pub const PENDING: usize = 3 * BATCH;
 
+/// By default a level adding fewer splits than this decodes on the calling
+/// thread alone: starting the second thread and meeting it at every round
+/// costs more than it saves (see the README's "On two cores").
+pub const TWO_THREADS_FROM_SPLITS: u32 = 4096;
+
 /// The memory a two-thread decode needs beside the decoder's workspace,
-/// kept from level to level.
+/// kept from level to level, and from how many splits a level uses it.
 pub struct TwoThreadMemory {
     inflater: Box<Inflater>,
     positions: Vec<[u32; 3]>,
     pending: Vec<PendingSplit>,
+    from_splits: u32,
 }
 
 impl TwoThreadMemory {
@@ -48,7 +54,15 @@ impl TwoThreadMemory {
             inflater: Box::default(),
             positions: vec![[0; 3]; vertex_capacity as usize],
             pending: vec![PendingSplit::default(); PENDING],
+            from_splits: TWO_THREADS_FROM_SPLITS,
         }
+    }
+
+    /// Levels adding at least `splits` splits use the second thread; the
+    /// others decode on the calling thread alone (default
+    /// [`TWO_THREADS_FROM_SPLITS`]; 0: every level, as the tests do).
+    pub fn set_two_threads_from(&mut self, splits: u32) {
+        self.from_splits = splits;
     }
 
     /// Bytes it holds (besides the allocator's own).
@@ -87,9 +101,17 @@ where
     if memory.positions.len() < capacity {
         memory.positions.resize(capacity, [0; 3]);
     }
+    let level_vertices = decoder.level_table().get(level).vertex_count;
     let mut level_decoder = decoder.begin_level(level, bytes)?;
     if level == 0 {
         after(None, level_decoder.state());
+    }
+    let splits = level_vertices.saturating_sub(level_decoder.state().vertex_count());
+    if splits < memory.from_splits {
+        while let Some(info) = level_decoder.next_round()? {
+            after(Some(&info), level_decoder.state());
+        }
+        return Ok(());
     }
     let records = level_decoder.split_records(&mut memory.inflater, &mut memory.positions)?;
     let Some(mut pending) = PendingSplits::new(&mut memory.pending) else {
@@ -236,15 +258,20 @@ fn serve<'l, 'b>(
 /// How many times a thread polls an empty channel before it sleeps on it.
 /// Sleeping and being woken costs tens of microseconds, about what a batch
 /// of records takes to read, so a thread that waits for the other polls
-/// first.
+/// first, for some hundreds of microseconds.
 const POLLS: u32 = 1 << 14;
+/// Polls between yields: if the other thread shares this core (the
+/// scheduler has not moved a new thread yet, or the machine is busy), it
+/// runs instead of waiting for this one's time slice to end.
+const POLLS_PER_YIELD: u32 = 256;
 
 /// The next message of `from`, polling before sleeping; `None` once the
 /// sender is gone.
 fn receive<T>(from: &Receiver<T>) -> Option<T> {
-    for _ in 0..POLLS {
+    for i in 1..=POLLS {
         match from.try_recv() {
             Ok(message) => return Some(message),
+            Err(TryRecvError::Empty) if i % POLLS_PER_YIELD == 0 => std::thread::yield_now(),
             Err(TryRecvError::Empty) => std::hint::spin_loop(),
             Err(TryRecvError::Disconnected) => return None,
         }

@@ -63,6 +63,8 @@ fn level<'a>(s: &Session, stream: &'a [u8], k: u16) -> &'a [u8] {
 /// the error's class if it fails.
 fn decode(stream: &[u8], two: bool) -> Result<Session, String> {
     let mut s = Session::open(stream).map_err(|e| e.class().to_string())?;
+    // The vectors are small: every level through the second thread.
+    s.set_two_threads_from(0);
     while let Some(k) = s.next_level() {
         let bytes = level(&s, stream, k);
         let result = if two {
@@ -85,6 +87,7 @@ fn two_threads_give_the_manifest_hashes_after_every_round() {
         let mut ws = OwnedWorkspace::for_stream(&stream).unwrap();
         let mut decoder = ws.decoder(&stream).unwrap();
         let mut memory = TwoThreadMemory::new(decoder.state().vertex_capacity());
+        memory.set_two_threads_from(0);
         let mut hashes = Vec::new();
         while let Some(k) = decoder.next_level() {
             let r = decoder.level_range(k);
@@ -131,6 +134,7 @@ fn two_threads_while_a_level_is_open_is_misuse() {
         .find(|(_, b, valid, _)| *valid && Session::open(b).unwrap().level_count() >= 2)
         .expect("a vector with two levels");
     let mut s = Session::open(&stream).unwrap();
+    s.set_two_threads_from(0);
     s.begin_level(0, level(&s, &stream, 0)).unwrap();
     let l1 = level(&s, &stream, 1);
     let e = s.decode_level_two_threads(1, l1).unwrap_err();

@@ -55,6 +55,8 @@ pub struct Session {
     /// What [`Session::decode_level_two_threads`] needs besides the
     /// workspace, made at its first call.
     two_threads: Option<Box<TwoThreadMemory>>,
+    /// [`TwoThreadMemory::set_two_threads_from`] for it.
+    two_threads_from: u32,
 }
 
 impl Session {
@@ -114,6 +116,7 @@ impl Session {
             workspace_bytes,
             done_while_open: 0,
             two_threads: None,
+            two_threads_from: threaded::TWO_THREADS_FROM_SPLITS,
         })
     }
 
@@ -221,9 +224,11 @@ impl Session {
 
     /// [`Session::decode_level`] on two cores: the rounds here, the split
     /// records on a second thread (see [`crate::threaded`]), to the same
-    /// state. The first call allocates 12 bytes per vertex of the
-    /// session's capacity and about 200 KiB more, kept until the session
-    /// is dropped.
+    /// state. A level adding fewer splits than
+    /// [`threaded::TWO_THREADS_FROM_SPLITS`] (or the number set with
+    /// [`Session::set_two_threads_from`]) decodes on this thread alone. The
+    /// first call allocates 12 bytes per vertex of the session's capacity
+    /// and about 200 KiB more, kept until the session is dropped.
     pub fn decode_level_two_threads(&mut self, k: u16, bytes: &[u8]) -> Result<(), Error> {
         if self.level.is_some() {
             return Err(self.misuse(k));
@@ -233,9 +238,16 @@ impl Session {
             .two_threads
             .take()
             .unwrap_or_else(|| Box::new(TwoThreadMemory::new(capacity)));
+        memory.set_two_threads_from(self.two_threads_from);
         let result = threaded::decode_level(self.decoder_mut(), k, bytes, &mut memory);
         self.two_threads = Some(memory);
         result
+    }
+
+    /// From how many splits a level decoded by
+    /// [`Session::decode_level_two_threads`] uses the second thread.
+    pub fn set_two_threads_from(&mut self, splits: u32) {
+        self.two_threads_from = splits;
     }
 
     /// Starts level `k` (its bytes are copied); decode its rounds with
