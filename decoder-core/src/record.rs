@@ -104,7 +104,6 @@ impl RecordSource for StreamSource<'_, '_, '_> {
     /// level's deficit contexts),
     /// then (constrained) the placement code and one residual vector, or
     /// (optimal) two residual vectors.
-    #[inline]
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
         let eligible = state.wing_candidates(ring);
         let coding = self.coding();
@@ -145,7 +144,7 @@ pub(crate) struct RecordFan<'a> {
 /// policy), split valences of P and C (in the level's deficit contexts),
 /// then (constrained) the placement code and one residual vector, or
 /// (optimal) two residual vectors.
-#[inline(always)]
+#[inline]
 pub(crate) fn read_record(
     s: &mut Substreams<'_, '_>,
     coding: &RecordCoding,
