@@ -93,12 +93,7 @@ pub fn decoder_core(stream: &[u8]) -> Outcome {
         let mut ws = OwnedWorkspace::for_stream(stream)?;
         let mut decoder = ws.decoder(stream)?;
         while let Some(k) = decoder.next_level() {
-            let range = decoder.level_range(k);
-            let bytes = usize::try_from(range.start)
-                .ok()
-                .zip(usize::try_from(range.end).ok())
-                .and_then(|(s, e)| stream.get(s..e))
-                .ok_or(Error::Truncated)?;
+            let bytes = decoder.level_bytes(k, stream)?;
             let mut level = decoder.begin_level(k, bytes)?;
             if k == 0 {
                 hashes.push(level.state().state_hash());
@@ -123,12 +118,7 @@ pub fn two_threads(stream: &[u8]) -> Outcome {
         // Every level through the second thread, however small.
         memory.set_two_threads_from(0);
         while let Some(k) = decoder.next_level() {
-            let range = decoder.level_range(k);
-            let bytes = usize::try_from(range.start)
-                .ok()
-                .zip(usize::try_from(range.end).ok())
-                .and_then(|(s, e)| stream.get(s..e))
-                .ok_or(Error::Truncated)?;
+            let bytes = decoder.level_bytes(k, stream)?;
             threaded::decode_level_observed(&mut decoder, k, bytes, &mut memory, |_, state| {
                 hashes.push(state.state_hash())
             })?;

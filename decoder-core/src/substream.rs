@@ -43,7 +43,8 @@ struct Reader<'b> {
 }
 
 impl Reader<'_> {
-    /// A reader with nothing to read: its slot is read elsewhere.
+    /// A reader with nothing to read (its slot is read elsewhere), or the
+    /// start of one that `Substreams::open` gives its buffer and chunks.
     fn idle(id: u8) -> Self {
         Reader {
             id,
@@ -102,20 +103,10 @@ impl<'l, 'b> Substreams<'l, 'b> {
                 (buf, None)
             };
             Reader {
-                id,
-                next_chunk: 0,
-                end_chunk: 0,
-                payload_at: 0,
                 buf,
                 chunk,
                 rans,
-                len: 0,
-                pos: 0,
-                bit_byte: 0,
-                bit_index: 8,
-                ahead: 0,
-                ahead_len: 0,
-                ahead_error: None,
+                ..Reader::idle(id)
             }
         });
         // Chunks are ordered by substream id (validated), so each substream's

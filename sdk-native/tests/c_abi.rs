@@ -4,10 +4,13 @@
 //! and on synthetic grid tiles. Without a C compiler it skips with a note,
 //! unless `CI` is set.
 
+mod vectors;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use serde_json::Value;
+use vectors::newest_vectors;
 
 /// The crate's static library, freshly built. `cargo test` builds the
 /// library for its tests as an rlib only (a `libsplitstream_sdk_native.a`
@@ -67,24 +70,6 @@ fn run(exe: &Path, args: &[&str]) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout).unwrap()
-}
-
-fn newest_vectors() -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../conformance/vectors");
-    let mut sets: Vec<PathBuf> = std::fs::read_dir(&root)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.join("manifest.json").is_file())
-        .collect();
-    sets.sort_by_key(|p| {
-        p.file_name()
-            .unwrap()
-            .to_string_lossy()
-            .split('.')
-            .map(|n| n.parse::<u32>().unwrap_or(0))
-            .collect::<Vec<_>>()
-    });
-    sets.pop().expect("a vector set")
 }
 
 #[test]

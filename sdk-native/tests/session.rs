@@ -6,28 +6,11 @@
 //! `MIRIFLAGS=-Zmiri-disable-isolation cargo +nightly miri test -p
 //! splitstream-sdk-native --test session`.
 
-use std::path::{Path, PathBuf};
+mod vectors;
 
 use serde_json::Value;
 use splitstream_sdk_native::Session;
-
-fn newest_vectors() -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../conformance/vectors");
-    let mut sets: Vec<PathBuf> = std::fs::read_dir(&root)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.join("manifest.json").is_file())
-        .collect();
-    sets.sort_by_key(|p| {
-        p.file_name()
-            .unwrap()
-            .to_string_lossy()
-            .split('.')
-            .map(|n| n.parse::<u32>().unwrap_or(0))
-            .collect::<Vec<_>>()
-    });
-    sets.pop().expect("a vector set")
-}
+use vectors::newest_vectors;
 
 /// The valid vectors, smallest first (Miri is slow).
 fn valid_vectors(limit: usize) -> Vec<(String, Vec<u8>, Vec<String>)> {

@@ -3,30 +3,13 @@
 //! vector the same hash after every round (the manifest's), the same final
 //! mesh, and on the invalid ones the same error class.
 
-use std::path::{Path, PathBuf};
+mod vectors;
 
 use serde_json::Value;
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_sdk_native::Session;
 use splitstream_sdk_native::threaded::{self, TwoThreadMemory};
-
-fn newest_vectors() -> PathBuf {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../conformance/vectors");
-    let mut sets: Vec<PathBuf> = std::fs::read_dir(&root)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.join("manifest.json").is_file())
-        .collect();
-    sets.sort_by_key(|p| {
-        p.file_name()
-            .unwrap()
-            .to_string_lossy()
-            .split('.')
-            .map(|n| n.parse::<u32>().unwrap_or(0))
-            .collect::<Vec<_>>()
-    });
-    sets.pop().expect("a vector set")
-}
+use vectors::newest_vectors;
 
 /// Every vector: name, bytes, whether valid, and the round hashes.
 fn vectors() -> Vec<(String, Vec<u8>, bool, Vec<String>)> {

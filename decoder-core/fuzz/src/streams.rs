@@ -635,7 +635,7 @@ pub fn frame(params: &StreamParams, levels: &[LevelPayload], seeded: bool) -> Ve
 }
 
 /// What a round-by-round decode of a stream saw.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Decoded {
     /// State hash after the base and after every round.
     pub hashes: Vec<u64>,
@@ -647,6 +647,17 @@ pub struct Decoded {
     pub triangles: Vec<[u32; 3]>,
     pub positions: Vec<[u32; 3]>,
     pub deficits: Vec<u8>,
+}
+
+impl Decoded {
+    /// The outcome and the decoder's final mesh.
+    fn end(&mut self, result: Result<(), Error>, decoder: &Decoder<'_, '_>) {
+        self.error = result.err();
+        self.levels = decoder.levels_done();
+        self.triangles = decoder.triangles().to_vec();
+        self.positions = decoder.positions().to_vec();
+        self.deficits = decoder.state().deficits().to_vec();
+    }
 }
 
 /// Decodes `stream` round by round with the no-alloc API into `workspace`.
@@ -662,16 +673,7 @@ pub fn decode_rounds_with(
     inflater: &mut Inflater,
     fans_ahead_from: u32,
 ) -> Decoded {
-    let mut out = Decoded {
-        hashes: Vec::new(),
-        level_hashes: Vec::new(),
-        error: None,
-        levels: 0,
-        levels_that_fit: 0,
-        triangles: Vec::new(),
-        positions: Vec::new(),
-        deficits: Vec::new(),
-    };
+    let mut out = Decoded::default();
     let mut decoder = match Decoder::new(stream, workspace, inflater) {
         Ok(d) => d,
         Err(e) => {
@@ -698,11 +700,7 @@ pub fn decode_rounds_with(
         }
         Ok(())
     })();
-    out.error = result.err();
-    out.levels = decoder.levels_done();
-    out.triangles = decoder.triangles().to_vec();
-    out.positions = decoder.positions().to_vec();
-    out.deficits = decoder.state().deficits().to_vec();
+    out.end(result, &decoder);
     out
 }
 
@@ -773,16 +771,7 @@ pub fn check_piped(stream: &[u8], d: &Decoded) -> Result<(), String> {
 /// Decodes `stream` round by round with each level's records split off and
 /// read through an [`InPlacePipe`].
 pub fn decode_piped(stream: &[u8], lag: bool, pending: usize) -> Decoded {
-    let mut out = Decoded {
-        hashes: Vec::new(),
-        level_hashes: Vec::new(),
-        error: None,
-        levels: 0,
-        levels_that_fit: 0,
-        triangles: Vec::new(),
-        positions: Vec::new(),
-        deficits: Vec::new(),
-    };
+    let mut out = Decoded::default();
     let len = workspace_len(stream).unwrap_or(0).min(64 << 20);
     let mut ws = vec![0u8; len];
     let mut inflater = Box::new(Inflater::new());
@@ -828,11 +817,7 @@ pub fn decode_piped(stream: &[u8], lag: bool, pending: usize) -> Decoded {
         }
         Ok(())
     })();
-    out.error = result.err();
-    out.levels = decoder.levels_done();
-    out.triangles = decoder.triangles().to_vec();
-    out.positions = decoder.positions().to_vec();
-    out.deficits = decoder.state().deficits().to_vec();
+    out.end(result, &decoder);
     out
 }
 
