@@ -123,6 +123,7 @@ where
         let worker = scope.spawn(move || serve(records, requests_in, answers_out));
         let mut pipe = ChannelPipe {
             building: Batch::default(),
+            spare: Vec::new(),
             batch: FIRST_BATCH,
             outstanding: 0,
             requests,
@@ -161,21 +162,26 @@ struct Request {
     ring_len: u32,
 }
 
+/// Requests going to the records thread, and their records coming back in
+/// the same batch, whose buffers then serve again.
 #[derive(Default)]
 struct Batch {
     requests: Vec<Request>,
     vertices: Vec<u32>,
+    records: Vec<Result<SplitRecord, Error>>,
 }
 
 /// The calling thread's end of the pipe.
 struct ChannelPipe {
     building: Batch,
+    /// Batches back from the records thread, emptied, to build again.
+    spare: Vec<Batch>,
     /// Requests the batch being built is sent with.
     batch: usize,
     /// Requests sent whose records have not come back.
     outstanding: usize,
     requests: Sender<Batch>,
-    answers: Receiver<Vec<Result<SplitRecord, Error>>>,
+    answers: Receiver<Batch>,
     /// Records come back and not taken yet, oldest first.
     ready: VecDeque<Result<SplitRecord, Error>>,
 }
@@ -185,8 +191,11 @@ impl ChannelPipe {
         if !self.building.requests.is_empty() {
             self.outstanding += self.building.requests.len();
             self.batch = (2 * self.batch).min(BATCH);
+            let next = self.spare.pop().unwrap_or_default();
             // A closed channel shows as a closed answer channel in `take`.
-            let _ = self.requests.send(std::mem::take(&mut self.building));
+            let _ = self
+                .requests
+                .send(std::mem::replace(&mut self.building, next));
         }
     }
 }
@@ -211,7 +220,7 @@ impl RecordPipe for ChannelPipe {
         if let Some(record) = self.ready.pop_front() {
             return Some(record);
         }
-        let batch = if wait {
+        let mut batch = if wait {
             // The oldest request may still be in the batch being built.
             self.flush();
             receive(&self.answers)?
@@ -221,34 +230,37 @@ impl RecordPipe for ChannelPipe {
                 Err(TryRecvError::Empty | TryRecvError::Disconnected) => return None,
             }
         };
-        self.outstanding -= batch.len();
+        self.outstanding -= batch.records.len();
         if self.outstanding == 0 && self.building.requests.is_empty() {
             // The records thread has caught up: the next batch is small.
             self.batch = FIRST_BATCH;
         }
-        self.ready.extend(batch);
+        self.ready.extend(batch.records.drain(..));
+        batch.requests.clear();
+        batch.vertices.clear();
+        self.spare.push(batch);
         self.ready.pop_front()
     }
 }
 
 /// The records thread: reads each batch's records in order and sends them
-/// back, until the requests close; returns the records half.
+/// back in the same batch, until the requests close; returns the records
+/// half.
 fn serve<'l, 'b>(
     mut records: RecordsHalf<'l, 'b>,
     requests: Receiver<Batch>,
-    answers: Sender<Vec<Result<SplitRecord, Error>>>,
+    answers: Sender<Batch>,
 ) -> RecordsHalf<'l, 'b> {
-    while let Some(batch) = receive(&requests) {
-        let out = batch
-            .requests
-            .iter()
-            .map(|q| {
-                let start = q.ring_start as usize;
-                let ring = &batch.vertices[start..start + q.ring_len as usize];
-                records.read(q.r, q.c, ring, &q.eligible)
-            })
-            .collect();
-        if answers.send(out).is_err() {
+    while let Some(mut batch) = receive(&requests) {
+        batch.records.clear();
+        for q in &batch.requests {
+            let start = q.ring_start as usize;
+            let ring = &batch.vertices[start..start + q.ring_len as usize];
+            batch
+                .records
+                .push(records.read(q.r, q.c, ring, &q.eligible));
+        }
+        if answers.send(batch).is_err() {
             break;
         }
     }
