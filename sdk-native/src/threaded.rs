@@ -16,9 +16,11 @@
 use std::collections::VecDeque;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError, channel};
 
-use splitstream_decoder_core::pipe::{PendingSplit, PendingSplits, RecordPipe, RecordsHalf};
+use splitstream_decoder_core::pipe::{
+    InPlacePipe, PendingSplit, PendingSplits, RecordPipe, RecordsHalf,
+};
 use splitstream_decoder_core::{
-    Decoder, Error, Inflater, MeshState, RoundInfo, SplitRecord, WingCandidates,
+    Decoder, Error, Inflater, LevelDecoder, MeshState, RoundInfo, SplitRecord, WingCandidates,
 };
 
 /// Splits sent to the records thread at once: at first, whenever the
@@ -107,20 +109,39 @@ where
         after(None, level_decoder.state());
     }
     let splits = level_vertices.saturating_sub(level_decoder.state().vertex_count());
-    if splits < memory.from_splits {
+    // A platform without threads (wasm32-unknown-unknown) or with one core
+    // decodes on the calling thread.
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    if splits < memory.from_splits || cores < 2 {
         while let Some(info) = level_decoder.next_round()? {
             after(Some(&info), level_decoder.state());
         }
         return Ok(());
     }
-    let records = level_decoder.split_records(&mut memory.inflater, &mut memory.positions)?;
+    let mut records = level_decoder.split_records(&mut memory.inflater, &mut memory.positions)?;
     let Some(mut pending) = PendingSplits::new(&mut memory.pending) else {
         return Err(Error::CapacityExceeded);
     };
     let (rounds, records) = std::thread::scope(|scope| {
         let (requests, requests_in) = channel();
         let (answers_out, answers) = channel();
-        let worker = scope.spawn(move || serve(records, requests_in, answers_out));
+        let (records_out, records_in) = channel();
+        let spawned = std::thread::Builder::new()
+            .name("splitstream-records".into())
+            .spawn_scoped(scope, move || {
+                let records = records_in.recv().ok()?;
+                Some(serve(records, requests_in, answers_out))
+            });
+        let Ok(worker) = spawned else {
+            // No second thread to be had: the same rounds, the records
+            // read on this thread.
+            let mut pipe = InPlacePipe::new(&mut records, false);
+            let rounds = run_rounds(&mut level_decoder, &mut pipe, &mut pending, &mut after);
+            drop(pipe);
+            return (rounds, Some(records));
+        };
+        // The worker waits for its records half: it cannot fail to get it.
+        let _ = records_out.send(records);
         let mut pipe = ChannelPipe {
             building: Batch::default(),
             spare: Vec::new(),
@@ -130,13 +151,7 @@ where
             answers,
             ready: VecDeque::new(),
         };
-        let rounds = loop {
-            match level_decoder.next_round_piped(&mut pipe, &mut pending) {
-                Ok(Some(info)) => after(Some(&info), level_decoder.state()),
-                Ok(None) => break Ok(()),
-                Err(e) => break Err(e),
-            }
-        };
+        let rounds = run_rounds(&mut level_decoder, &mut pipe, &mut pending, &mut after);
         // Closing the requests ends the worker, which gives the record
         // substreams back.
         drop(pipe);
@@ -145,10 +160,33 @@ where
             Err(panic) => std::panic::resume_unwind(panic),
         }
     });
+    // The records half always comes back (the worker is given it before
+    // any request); without it the level could not end.
+    let Some(records) = records else {
+        return Err(Error::Poisoned);
+    };
     level_decoder.join_records(records);
     rounds?;
     // The rounds are done: this ends the level (SPEC §7.6).
     while level_decoder.next_round()?.is_some() {}
+    Ok(())
+}
+
+/// Runs the level's rounds with their records read through `pipe`,
+/// showing `after` the state after each.
+fn run_rounds<P, F>(
+    level_decoder: &mut LevelDecoder<'_, '_, '_>,
+    pipe: &mut P,
+    pending: &mut PendingSplits<'_>,
+    after: &mut F,
+) -> Result<(), Error>
+where
+    P: RecordPipe,
+    F: FnMut(Option<&RoundInfo>, &MeshState<'_>),
+{
+    while let Some(info) = level_decoder.next_round_piped(pipe, pending)? {
+        after(Some(&info), level_decoder.state());
+    }
     Ok(())
 }
 
