@@ -166,3 +166,51 @@ fn seed_streams_are_valid_manifolds() {
         assert_eq!(chi, base_euler(g.base), "{}", g.base);
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// `RecordsHalf::read` (decoder-core's `pipe`) asked for records with
+    /// any vertex ids, ring entries and C indices: a record or a typed
+    /// error, never a panic; and after an error, that error again.
+    #[test]
+    fn records_half_answers_garbage_with_errors(
+        pick in any::<u8>(),
+        asks in proptest::collection::vec(
+            (any::<u32>(), any::<u32>(), proptest::collection::vec(any::<u32>(), 0..300)),
+            1..8,
+        ),
+    ) {
+        use splitstream_decoder_core::Inflater;
+        use splitstream_decoder_core::owned::OwnedWorkspace;
+        let seeds = seeds();
+        let stream = &seeds[pick as usize % seeds.len()].stream;
+        let mut ws = OwnedWorkspace::for_stream(stream).unwrap();
+        let mut decoder = ws.decoder(stream).unwrap();
+        let mut mirror = vec![[0u32; 3]; decoder.state().vertex_capacity() as usize];
+        let mut inflater = Box::new(Inflater::new());
+        let bytes = decoder.level_bytes(0, stream).unwrap();
+        let mut level = decoder.begin_level(0, bytes).unwrap();
+        let n = level.state().vertex_count();
+        let mut half = level.split_records(&mut inflater, &mut mirror).unwrap();
+        let mut failed = None;
+        for (r, c, vertices) in &asks {
+            // Some asks name real vertices, so that records are read too.
+            let r = if r % 2 == 0 { r % n.max(1) } else { *r };
+            let mut ring = splitstream_decoder_core::Ring::default();
+            let eligible = if ring.set_vertices(&vertices[..vertices.len().min(255)]) {
+                level.state().wing_candidates(&ring)
+            } else {
+                Default::default()
+            };
+            let got = half.read(r, *c, vertices, &eligible);
+            if let Some(e) = failed {
+                prop_assert_eq!(got, Err(e));
+            } else if let Err(e) = got {
+                prop_assert!(!e.class().is_empty());
+                failed = Some(e);
+            }
+        }
+        level.join_records(half);
+    }
+}
