@@ -650,6 +650,26 @@ pub struct Decoded {
 }
 
 impl Decoded {
+    /// Whether this decode, made another way (`how`), matches `d`: the
+    /// same hashes after every round, the same error, and with `mesh` the
+    /// same final mesh.
+    fn same_as(&self, d: &Decoded, mesh: bool, how: &str) -> Result<(), String> {
+        let same_mesh = !mesh
+            || (self.triangles == d.triangles
+                && self.positions == d.positions
+                && self.deficits == d.deficits);
+        if self.hashes != d.hashes || self.error != d.error || !same_mesh {
+            return Err(format!(
+                "{how} changed the decode: {} hashes and error {:?}, against {} and {:?}",
+                self.hashes.len(),
+                self.error,
+                d.hashes.len(),
+                d.error
+            ));
+        }
+        Ok(())
+    }
+
     /// The outcome and the decoder's final mesh.
     fn end(&mut self, result: Result<(), Error>, decoder: &Decoder<'_, '_>) {
         self.error = result.err();
@@ -721,22 +741,7 @@ pub fn decode_full_with(stream: &[u8], fans_ahead_from: u32) -> Decoded {
 /// decodes `stream` exactly as `d`, the default decode, did: the same
 /// hashes after every round, the same error, the same final mesh.
 pub fn check_fans_ahead(stream: &[u8], d: &Decoded) -> Result<(), String> {
-    let ahead = decode_full_with(stream, 0);
-    if ahead.hashes != d.hashes
-        || ahead.error != d.error
-        || ahead.triangles != d.triangles
-        || ahead.positions != d.positions
-        || ahead.deficits != d.deficits
-    {
-        return Err(format!(
-            "walking fans ahead changed the decode: {} hashes and error {:?}, against {} and {:?}",
-            ahead.hashes.len(),
-            ahead.error,
-            d.hashes.len(),
-            d.error
-        ));
-    }
-    Ok(())
+    decode_full_with(stream, 0).same_as(d, true, "walking fans ahead")
 }
 
 /// Checks that decoding with the records read through a pipe
@@ -747,23 +752,11 @@ pub fn check_fans_ahead(stream: &[u8], d: &Decoded) -> Result<(), String> {
 /// and as few as one split pending.
 pub fn check_piped(stream: &[u8], d: &Decoded) -> Result<(), String> {
     for (lag, pending) in [(false, 96), (true, 1), (true, 5)] {
-        let piped = decode_piped(stream, lag, pending);
         // After an error only the hashes reported and the error count
         // (SPEC §10.2): the failing round's splits still pending are not
         // applied, where the one-thread rounds applied them.
-        let same_mesh = d.error.is_some()
-            || (piped.triangles == d.triangles
-                && piped.positions == d.positions
-                && piped.deficits == d.deficits);
-        if piped.hashes != d.hashes || piped.error != d.error || !same_mesh {
-            return Err(format!(
-                "piped records (lag {lag}, {pending} pending) changed the decode: {} hashes and error {:?}, against {} and {:?}",
-                piped.hashes.len(),
-                piped.error,
-                d.hashes.len(),
-                d.error
-            ));
-        }
+        let what = format!("piped records (lag {lag}, {pending} pending)");
+        decode_piped(stream, lag, pending).same_as(d, d.error.is_none(), &what)?;
     }
     Ok(())
 }
