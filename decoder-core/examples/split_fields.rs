@@ -15,7 +15,9 @@
 //! vertices are leaves, the sum of the others' deficits, and whether it
 //! holds the ghost; the squared length of the edge PC; whether R was
 //! created in this level; where R lay (0 at P, 1 at C, 2 at their midpoint,
-//! 3 elsewhere: optimal mode) and that code's context (SPEC §5.5.5).
+//! 3 elsewhere: optimal mode) and that code's context (SPEC §5.5.5); the
+//! two wing ranks the stream coded (SPEC §7.4: in ring order, or in the
+//! near order of the level's wing policy).
 //! Deficits are the live ones, as the record sees them (earlier splits of
 //! the round may have decremented a wing's).
 //!
@@ -25,15 +27,16 @@
 
 use std::io::Write;
 
-use splitstream_decoder_core::limits::{LEAF, NONE};
+use splitstream_decoder_core::limits::{LEAF, MAX_SPLIT_VALENCE, NONE};
 use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_decoder_core::wing_order::{NearKeys, WingPolicy, near_keys, near_ranks};
 use splitstream_decoder_core::{
     Error, MeshState, Ring, SplitObserver, SplitRecord, arc_means, context,
 };
 
 const COLUMNS: &str = "level\tround\tk\tm\to\td\tvalence_p\tvalence_c\tsymbol_p\tsymbol_c\t\
 leaves_p\tdeficits_p\tghost_p\tleaves_c\tdeficits_c\tghost_c\tedge2\tnew\tplacement\t\
-placement_context";
+placement_context\trank_o\trank_d";
 
 /// Writes one line per split record the decoder shows it.
 struct Fields<'a> {
@@ -42,6 +45,8 @@ struct Fields<'a> {
     round: u32,
     /// Vertices below this index existed when the level started.
     level_start: u32,
+    /// The level's wing policy (SPEC §5.1), which names the wings' ranks.
+    wings: WingPolicy,
     /// The first write error, reported after the round.
     failed: Option<std::io::Error>,
 }
@@ -92,13 +97,23 @@ impl SplitObserver for Fields<'_> {
             3
         };
         let means = arc_means(state.positions(), parent, ring, o, d);
+        let eligible = state.wing_candidates(ring);
+        let (rank_o, rank_d) = match self.wings {
+            WingPolicy::Ranks => eligible.ranks(o, d),
+            near => {
+                let mut keys: NearKeys = [0; MAX_SPLIT_VALENCE];
+                let m = near_keys(state.positions(), ring, &eligible, near, &mut keys);
+                near_ranks(&keys[..m], k, o, d)
+            }
+        }
+        .unwrap_or((u8::MAX, u8::MAX));
         let edge2: i64 = (0..3).map(|a| (c[a] as i64 - p[a] as i64).pow(2)).sum();
         let written = writeln!(
             self.out,
-            "{}\t{}\t{k}\t{}\t{o}\t{d}\t{valence_p}\t{valence_c}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{edge2}\t{}\t{placement}\t{}",
+            "{}\t{}\t{k}\t{}\t{o}\t{d}\t{valence_p}\t{valence_c}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{}\t{edge2}\t{}\t{placement}\t{}\t{rank_o}\t{rank_d}",
             self.level,
             self.round,
-            state.wing_candidates(ring).count(),
+            eligible.count(),
             symbol(rec.deficit_p, valence_p),
             symbol(rec.deficit_c, valence_c),
             arc_p.0,
@@ -151,10 +166,16 @@ fn write_fields(stream: &[u8], out: &mut dyn Write) -> Result<std::io::Result<()
         level: 0,
         round: 0,
         level_start: 0,
+        wings: WingPolicy::Ranks,
         failed: None,
     };
     while let Some(k) = decoder.next_level() {
         let bytes = decoder.level_bytes(k, stream)?;
+        let max_chunk_len = decoder.header().max_chunk_len;
+        fields.wings = decoder
+            .level_table()
+            .level_header(k, bytes, max_chunk_len)?
+            .wing_policy;
         let mut level = decoder.begin_level(k, bytes)?;
         // Level 0's seed is decoded by now: its vertices are old too.
         fields.level = k;
