@@ -20,7 +20,8 @@ use splitstream_decoder_core::pipe::{
     InPlacePipe, PendingSplit, PendingSplits, RecordPipe, RecordsHalf,
 };
 use splitstream_decoder_core::{
-    Decoder, Error, Inflater, LevelDecoder, MeshState, RoundInfo, SplitRecord, WingCandidates,
+    Decoder, Error, Inflater, LevelDecoder, MeshState, Ring, RoundInfo, SplitObserver, SplitRecord,
+    WingCandidates,
 };
 
 /// Splits sent to the records thread at once: at first, whenever the
@@ -94,27 +95,73 @@ pub fn decode_level_observed<F>(
     level: u16,
     bytes: &[u8],
     memory: &mut TwoThreadMemory,
-    mut after: F,
+    after: F,
 ) -> Result<(), Error>
 where
     F: FnMut(Option<&RoundInfo>, &MeshState<'_>),
 {
+    decode_level_tapped(decoder, level, bytes, memory, &mut AfterRounds(after))
+}
+
+/// What a two-thread decode shows of a level besides its result: the
+/// state after level 0's seed and after every round, and every split.
+pub trait RoundTap {
+    /// The level has begun (its header read, and level 0's seed mesh):
+    /// `state` is where its first round starts.
+    fn begin_level(&mut self, _state: &MeshState<'_>) {}
+    /// The state after level 0's seed mesh (`info` `None`) and after every
+    /// round (with the round's counts).
+    fn after(&mut self, info: Option<&RoundInfo>, state: &MeshState<'_>);
+    /// The split of vertex `r` with its `record`, in split order, once the
+    /// record is read (on either thread) and before the split is applied;
+    /// a round that fails may have shown some of its splits.
+    fn split(&mut self, _r: u32, _record: &SplitRecord) {}
+}
+
+/// A [`RoundTap`] that shows `after` the rounds only.
+struct AfterRounds<F>(F);
+
+impl<F: FnMut(Option<&RoundInfo>, &MeshState<'_>)> RoundTap for AfterRounds<F> {
+    fn after(&mut self, info: Option<&RoundInfo>, state: &MeshState<'_>) {
+        (self.0)(info, state);
+    }
+}
+
+/// A level's rounds read on one thread show their splits to the tap.
+struct SplitsTo<'t, T>(&'t mut T);
+
+impl<T: RoundTap> SplitObserver for SplitsTo<'_, T> {
+    fn record(&mut self, _: &MeshState<'_>, r: u32, _: &Ring, record: &SplitRecord) {
+        self.0.split(r, record);
+    }
+}
+
+/// [`decode_level`], showing `tap` the states after the seed and the
+/// rounds and every split with its record.
+pub fn decode_level_tapped<T: RoundTap>(
+    decoder: &mut Decoder<'_, '_>,
+    level: u16,
+    bytes: &[u8],
+    memory: &mut TwoThreadMemory,
+    tap: &mut T,
+) -> Result<(), Error> {
     let capacity = decoder.state().vertex_capacity() as usize;
     if memory.positions.len() < capacity {
         memory.positions.resize(capacity, [0; 3]);
     }
     let level_vertices = decoder.level_table().get(level).vertex_count;
     let mut level_decoder = decoder.begin_level(level, bytes)?;
+    tap.begin_level(level_decoder.state());
     if level == 0 {
-        after(None, level_decoder.state());
+        tap.after(None, level_decoder.state());
     }
     let splits = level_vertices.saturating_sub(level_decoder.state().vertex_count());
     // A platform without threads (wasm32-unknown-unknown) or with one core
     // decodes on the calling thread.
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     if splits < memory.from_splits || cores < 2 {
-        while let Some(info) = level_decoder.next_round()? {
-            after(Some(&info), level_decoder.state());
+        while let Some(info) = level_decoder.next_round_observed(&mut SplitsTo(tap))? {
+            tap.after(Some(&info), level_decoder.state());
         }
         return Ok(());
     }
@@ -135,14 +182,14 @@ where
         let Ok(worker) = spawned else {
             // No second thread to be had: the same rounds, the records
             // read on this thread.
-            let mut pipe = InPlacePipe::new(&mut records, false);
-            let rounds = run_rounds(&mut level_decoder, &mut pipe, &mut pending, &mut after);
+            let mut pipe = Tapped::new(InPlacePipe::new(&mut records, false), &mut *tap);
+            let rounds = run_rounds(&mut level_decoder, &mut pipe, &mut pending);
             drop(pipe);
             return (rounds, Some(records));
         };
         // The worker waits for its records half: it cannot fail to get it.
         let _ = records_out.send(records);
-        let mut pipe = ChannelPipe {
+        let channels = ChannelPipe {
             building: Batch::default(),
             spare: Vec::new(),
             batch: FIRST_BATCH,
@@ -151,7 +198,8 @@ where
             answers,
             ready: VecDeque::new(),
         };
-        let rounds = run_rounds(&mut level_decoder, &mut pipe, &mut pending, &mut after);
+        let mut pipe = Tapped::new(channels, &mut *tap);
+        let rounds = run_rounds(&mut level_decoder, &mut pipe, &mut pending);
         // Closing the requests ends the worker, which gives the record
         // substreams back.
         drop(pipe);
@@ -173,21 +221,51 @@ where
 }
 
 /// Runs the level's rounds with their records read through `pipe`,
-/// showing `after` the state after each.
-fn run_rounds<P, F>(
+/// showing its tap the state after each.
+fn run_rounds<P: RecordPipe, T: RoundTap>(
     level_decoder: &mut LevelDecoder<'_, '_, '_>,
-    pipe: &mut P,
+    pipe: &mut Tapped<'_, P, T>,
     pending: &mut PendingSplits<'_>,
-    after: &mut F,
-) -> Result<(), Error>
-where
-    P: RecordPipe,
-    F: FnMut(Option<&RoundInfo>, &MeshState<'_>),
-{
+) -> Result<(), Error> {
     while let Some(info) = level_decoder.next_round_piped(pipe, pending)? {
-        after(Some(&info), level_decoder.state());
+        pipe.tap.after(Some(&info), level_decoder.state());
     }
     Ok(())
+}
+
+/// A pipe that shows each split and its record to a [`RoundTap`] as the
+/// record is taken: records come back in the order their splits were
+/// sent, so the vertices sent wait here until then.
+struct Tapped<'t, P, T> {
+    pipe: P,
+    tap: &'t mut T,
+    sent: VecDeque<u32>,
+}
+
+impl<'t, P, T> Tapped<'t, P, T> {
+    fn new(pipe: P, tap: &'t mut T) -> Self {
+        Tapped {
+            pipe,
+            tap,
+            sent: VecDeque::with_capacity(PENDING),
+        }
+    }
+}
+
+impl<P: RecordPipe, T: RoundTap> RecordPipe for Tapped<'_, P, T> {
+    fn send(&mut self, r: u32, c: u32, vertices: &[u32], eligible: &WingCandidates) {
+        self.sent.push_back(r);
+        self.pipe.send(r, c, vertices, eligible);
+    }
+
+    fn take(&mut self, wait: bool) -> Option<Result<SplitRecord, Error>> {
+        let record = self.pipe.take(wait)?;
+        let r = self.sent.pop_front();
+        if let (Some(r), Ok(record)) = (r, &record) {
+            self.tap.split(r, record);
+        }
+        Some(record)
+    }
 }
 
 /// One split's request: R, C's index, the eligible wing entries and where

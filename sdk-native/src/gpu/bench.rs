@@ -6,7 +6,8 @@ use std::time::Instant;
 use super::device::GpuDevice;
 use super::error::GpuDecodeError;
 use super::refiner::GpuRefiner;
-use super::stream::{CapturedStream, capture_stream};
+use super::stream::{CapturedStream, capture_stream, capture_stream_two_threads};
+use crate::threaded::TWO_THREADS_FROM_SPLITS;
 
 /// Timings of one stream, best of the repeats, in seconds.
 #[derive(Clone, Debug, PartialEq)]
@@ -21,8 +22,11 @@ pub struct BenchReport {
     /// splits), one thread.
     pub cpu_decode: f64,
     /// The same with the capture of every round for the GPU (phase 1: the
-    /// CPU still reads the records).
+    /// CPU still reads the records), one thread.
     pub cpu_capture: f64,
+    /// The capture with a large level's records read on a second thread
+    /// (what [`super::decode`] does).
+    pub cpu_capture_two_threads: f64,
     /// Pipelines, base upload, every round's upload and kernels, up to the
     /// device being idle.
     pub gpu_total: f64,
@@ -69,6 +73,11 @@ impl core::fmt::Display for BenchReport {
         )?;
         writeln!(
             f,
+            "CPU capture, 2 threads:        {:9.1} ms",
+            ms(self.cpu_capture_two_threads)
+        )?;
+        writeln!(
+            f,
             "GPU refinement, all uploads:   {:9.1} ms  {:12.0} splits/s",
             ms(self.gpu_total),
             self.gpu_splits_per_second()
@@ -92,6 +101,7 @@ pub fn bench(
     let best = |a: &mut f64, s: f64| *a = a.min(s);
     let mut cpu_decode = f64::INFINITY;
     let mut cpu_capture = f64::INFINITY;
+    let mut cpu_capture_two_threads = f64::INFINITY;
     let mut gpu_total = f64::INFINITY;
     let mut gpu_rounds = f64::INFINITY;
     let mut captured = CapturedStream::default();
@@ -106,6 +116,12 @@ pub fn bench(
         let t = Instant::now();
         captured = capture_stream(stream, false);
         best(&mut cpu_capture, t.elapsed().as_secs_f64());
+        if let Some(e) = captured.error {
+            return Err(e.into());
+        }
+        let t = Instant::now();
+        captured = capture_stream_two_threads(stream, false, TWO_THREADS_FROM_SPLITS);
+        best(&mut cpu_capture_two_threads, t.elapsed().as_secs_f64());
         if let Some(e) = captured.error {
             return Err(e.into());
         }
@@ -150,6 +166,7 @@ pub fn bench(
         splits: captured.splits(),
         cpu_decode,
         cpu_capture,
+        cpu_capture_two_threads,
         gpu_total,
         gpu_rounds,
     })

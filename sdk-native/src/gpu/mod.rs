@@ -5,7 +5,9 @@
 //!
 //! Phase 1 (this module): the CPU reads the stream with decoder-core
 //! ([`capture_stream`]: headers, chunks, entropy decoding, records with
-//! resolved positions), the GPU replays every round from its flags and
+//! resolved positions; [`capture_stream_two_threads`], which [`decode`] and
+//! [`verify`] use, reads a large level's records on a second thread), the
+//! GPU replays every round from its flags and
 //! records ([`GpuRefiner`], [`replay`]) and its state hash is read back
 //! after every round. Faults of a stream are found by decoder-core while
 //! reading (ring offsets included: its record reader checks `o + d < k`
@@ -36,14 +38,16 @@ pub use error::GpuDecodeError;
 pub use refiner::{GpuRefiner, snapshot_hash};
 pub use replay::{GpuRun, ReplayOptions, replay};
 pub use splitstream_kernels::gpu::Api;
-pub use stream::{BaseState, CapturedStream, capture_stream};
+
+use crate::threaded::TWO_THREADS_FROM_SPLITS;
+pub use stream::{BaseState, CapturedStream, capture_stream, capture_stream_two_threads};
 
 /// Decodes `stream`: decoder-core reads it, the GPU refines it; the hashes
 /// are the GPU's, after the seed and after every round.
 pub fn decode(device: &GpuDevice, stream: &[u8]) -> GpuRun {
     replay(
         device,
-        &capture_stream(stream, false),
+        &capture_stream_two_threads(stream, false, TWO_THREADS_FROM_SPLITS),
         ReplayOptions::default(),
     )
 }
@@ -56,5 +60,6 @@ pub fn verify(device: &GpuDevice, stream: &[u8], check_adjacency: bool) -> GpuRu
         compare: true,
         check_adjacency,
     };
-    replay(device, &capture_stream(stream, true), options)
+    let captured = capture_stream_two_threads(stream, true, TWO_THREADS_FROM_SPLITS);
+    replay(device, &captured, options)
 }

@@ -3,16 +3,26 @@
 //! applies every round itself; a [`Capture`] keeps each round's flags and
 //! records so that the GPU can replay the same rounds ([`super::replay`]).
 //!
-//! The level framing follows decoder-core's `Decoder` (SPEC §10.3 order),
-//! rebuilt from its public pieces because `Decoder` does not let a caller
-//! wrap the record source of its rounds.
+//! [`capture_stream`] reads on one thread, with the level framing of
+//! decoder-core's `Decoder` (SPEC §10.3 order) rebuilt from its public
+//! pieces so that a [`Capture`] wraps the record source of its rounds.
+//! [`capture_stream_two_threads`] reads with `Decoder` itself, the records
+//! on a second thread ([`crate::threaded`]), and sees each round's splits
+//! through a [`RoundTap`]: the same capture, about as much faster as the
+//! two-thread decode (sdk-native/README.md, "On two cores"), which is what
+//! a GPU decode of a large stream waits for.
 
 use splitstream_decoder_core::limits::substream;
+use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::record::{StreamSource, read_base};
 use splitstream_decoder_core::substream::Substreams;
-use splitstream_decoder_core::{Error, Header, Inflater, LevelTable, MeshState, Ring, layout_for};
+use splitstream_decoder_core::{
+    Error, Header, Inflater, LevelTable, MeshState, Ring, RoundInfo, SplitRecord, declared_layout,
+    layout_for,
+};
 
-use super::capture::{Capture, CapturedRound};
+use super::capture::{Capture, CapturedRound, gpu_record};
+use crate::threaded::{RoundTap, TwoThreadMemory, decode_level_tapped};
 
 /// The seed mesh as decoder-core holds it after reading it (SPEC §6.3).
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
@@ -199,4 +209,129 @@ fn capture_into(
         }
     }
     Ok(())
+}
+
+/// [`capture_stream`] with the records read on a second thread for every
+/// level adding at least `two_threads_from` splits
+/// ([`crate::threaded::TWO_THREADS_FROM_SPLITS`] by default; 0: every
+/// level). The same capture: the same rounds, flags, records and hashes,
+/// and on a bad stream the same rounds before the same fault.
+pub fn capture_stream_two_threads(
+    stream: &[u8],
+    hash_rounds: bool,
+    two_threads_from: u32,
+) -> CapturedStream {
+    let mut out = CapturedStream::default();
+    if let Err(e) = capture_two_threads_into(stream, hash_rounds, two_threads_from, &mut out) {
+        out.error = Some(e);
+    }
+    out
+}
+
+fn capture_two_threads_into(
+    stream: &[u8],
+    hash_rounds: bool,
+    two_threads_from: u32,
+    out: &mut CapturedStream,
+) -> Result<(), CaptureError> {
+    let mut workspace = OwnedWorkspace::for_stream(stream)?;
+    let mut decoder = workspace.decoder(stream)?;
+    let layout = declared_layout(decoder.header(), decoder.level_table())?;
+    out.vertex_capacity = layout.vertex_capacity;
+    out.triangle_capacity = layout.triangle_capacity;
+    let mut memory = TwoThreadMemory::new(layout.vertex_capacity);
+    memory.set_two_threads_from(two_threads_from);
+    let mut tap = CaptureTap {
+        out,
+        hash_rounds,
+        triangle_limit: 0,
+        candidates: Vec::new(),
+        round: CapturedRound::default(),
+        cursor: 0,
+        out_of_order: false,
+    };
+    while let Some(k) = decoder.next_level() {
+        tap.triangle_limit = decoder.level_table().get(k).triangle_count;
+        let bytes = decoder.level_bytes(k, stream)?;
+        decode_level_tapped(&mut decoder, k, bytes, &mut memory, &mut tap)?;
+        if tap.out_of_order {
+            return Err(CaptureError::FlagOrder);
+        }
+    }
+    Ok(())
+}
+
+/// Captures the rounds of a two-thread decode from what it shows: the
+/// round-start candidates come from the state after the seed or the round
+/// before, and each split marks its vertex's flag (a split vertex is a
+/// flagged candidate; every other candidate's flag reads 0, as in
+/// [`Capture`]) and adds its record.
+struct CaptureTap<'o> {
+    out: &'o mut CapturedStream,
+    hash_rounds: bool,
+    /// The triangle count of the level being decoded.
+    triangle_limit: u32,
+    /// The round's candidates, ascending.
+    candidates: Vec<u32>,
+    round: CapturedRound,
+    cursor: usize,
+    /// A split vertex was not a candidate of its round.
+    out_of_order: bool,
+}
+
+impl CaptureTap<'_> {
+    /// A round starts from `state`: its candidates are the vertices of
+    /// deficit 0.
+    fn begin_round(&mut self, state: &MeshState<'_>) {
+        self.candidates.clear();
+        self.candidates.extend(
+            state
+                .deficits()
+                .iter()
+                .enumerate()
+                .filter(|&(_, &d)| d == 0)
+                .map(|(v, _)| v as u32),
+        );
+        let count = self.candidates.len();
+        self.round = CapturedRound {
+            candidates: count as u32,
+            flags: vec![0; count.div_ceil(32)],
+            records: Vec::new(),
+        };
+        self.cursor = 0;
+    }
+}
+
+impl RoundTap for CaptureTap<'_> {
+    fn begin_level(&mut self, state: &MeshState<'_>) {
+        self.out.levels.push(CapturedLevel {
+            triangle_limit: self.triangle_limit,
+            rounds: Vec::new(),
+        });
+        self.begin_round(state);
+    }
+
+    fn after(&mut self, info: Option<&RoundInfo>, state: &MeshState<'_>) {
+        if info.is_none() {
+            self.out.base = Some(BaseState::of(state));
+        } else if let Some(level) = self.out.levels.last_mut() {
+            level.rounds.push(core::mem::take(&mut self.round));
+        }
+        if self.hash_rounds {
+            self.out.cpu_hashes.push(state.state_hash());
+        }
+        self.begin_round(state);
+    }
+
+    fn split(&mut self, r: u32, record: &SplitRecord) {
+        while self.candidates.get(self.cursor).is_some_and(|&c| c < r) {
+            self.cursor += 1;
+        }
+        if self.candidates.get(self.cursor) == Some(&r) {
+            self.round.flags[self.cursor / 32] |= 1 << (self.cursor % 32);
+        } else {
+            self.out_of_order = true;
+        }
+        self.round.records.push(gpu_record(record));
+    }
 }
