@@ -53,20 +53,30 @@ impl<S> Capture<S> {
 
     fn start(&mut self, state: &MeshState<'_>) {
         // Flags are read before any split of the round: the state is the
-        // round's starting state, whose candidates are the deficit-0 vertices.
-        self.candidates.clear();
-        self.candidates.extend(
-            state
-                .deficits()
-                .iter()
-                .enumerate()
-                .filter(|&(_, &d)| d == 0)
-                .map(|(v, _)| v as u32),
-        );
-        let count = self.candidates.len();
-        self.round.candidates = count as u32;
-        self.round.flags = vec![0; count.div_ceil(32)];
+        // round's starting state.
+        self.round = round_start(state, &mut self.candidates);
         self.started = true;
+    }
+}
+
+/// A round starting from `state`: its candidates, the deficit-0 vertices,
+/// into `candidates` (ascending), and its capture with every flag 0 and no
+/// record yet.
+pub(super) fn round_start(state: &MeshState<'_>, candidates: &mut Vec<u32>) -> CapturedRound {
+    candidates.clear();
+    candidates.extend(
+        state
+            .deficits()
+            .iter()
+            .enumerate()
+            .filter(|&(_, &d)| d == 0)
+            .map(|(v, _)| v as u32),
+    );
+    let count = candidates.len();
+    CapturedRound {
+        candidates: count as u32,
+        flags: vec![0; count.div_ceil(32)],
+        records: Vec::new(),
     }
 }
 

@@ -21,7 +21,7 @@ use splitstream_decoder_core::{
     layout_for,
 };
 
-use super::capture::{Capture, CapturedRound, gpu_record};
+use super::capture::{Capture, CapturedRound, gpu_record, round_start};
 use crate::threaded::{RoundTap, TwoThreadMemory, decode_level_tapped};
 
 /// The seed mesh as decoder-core holds it after reading it (SPEC §6.3).
@@ -283,21 +283,7 @@ impl CaptureTap<'_> {
     /// A round starts from `state`: its candidates are the vertices of
     /// deficit 0.
     fn begin_round(&mut self, state: &MeshState<'_>) {
-        self.candidates.clear();
-        self.candidates.extend(
-            state
-                .deficits()
-                .iter()
-                .enumerate()
-                .filter(|&(_, &d)| d == 0)
-                .map(|(v, _)| v as u32),
-        );
-        let count = self.candidates.len();
-        self.round = CapturedRound {
-            candidates: count as u32,
-            flags: vec![0; count.div_ceil(32)],
-            records: Vec::new(),
-        };
+        self.round = round_start(state, &mut self.candidates);
         self.cursor = 0;
     }
 }
