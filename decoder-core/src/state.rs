@@ -183,6 +183,25 @@ impl<'ws> MeshState<'ws> {
         self.bits
     }
 
+    /// The candidates of the next round (SPEC §7.3 step 1: the vertices of
+    /// deficit 0), ascending: read from the bitmap the splits keep up to
+    /// date, so a caller need not scan [`MeshState::deficits`].
+    pub fn candidates(&self) -> impl Iterator<Item = u32> + '_ {
+        let n = self.vertex_count as usize;
+        let third = self.candidates.len() / 3;
+        self.candidates[..third.min(n.div_ceil(64))]
+            .iter()
+            .enumerate()
+            .flat_map(move |(w, &word)| {
+                let below_n = if (w + 1) * 64 <= n {
+                    u64::MAX
+                } else {
+                    (1u64 << (n - w * 64)) - 1
+                };
+                BitsOf(word & below_n).map(move |b| (64 * w) as u32 + b)
+            })
+    }
+
     /// Whether `v` is a leaf (`false` for a vertex that does not exist).
     pub fn is_leaf(&self, v: u32) -> bool {
         v < self.vertex_count && self.deficit[v as usize] == LEAF
@@ -211,6 +230,23 @@ impl<'ws> MeshState<'ws> {
     #[inline]
     pub(crate) fn vertex_at(&self, corner: u32) -> u32 {
         self.corners[corner as usize]
+    }
+}
+
+/// The set bits of a word, lowest first.
+struct BitsOf(u64);
+
+impl Iterator for BitsOf {
+    type Item = u32;
+
+    #[inline]
+    fn next(&mut self) -> Option<u32> {
+        if self.0 == 0 {
+            return None;
+        }
+        let b = self.0.trailing_zeros();
+        self.0 &= self.0 - 1;
+        Some(b)
     }
 }
 

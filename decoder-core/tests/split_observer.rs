@@ -55,3 +55,34 @@ fn the_observer_sees_every_applied_split_and_decoding_is_unchanged() {
         assert_eq!(d.state_hash(), *g.hashes.last().unwrap(), "{}", g.base);
     }
 }
+
+/// The deficit-0 vertices, scanned.
+fn scanned(state: &MeshState<'_>) -> Vec<u32> {
+    (0..state.vertex_count())
+        .filter(|&v| state.deficits()[v as usize] == 0)
+        .collect()
+}
+
+#[test]
+fn the_candidates_are_the_deficit_zero_vertices_before_every_round() {
+    for g in streams::seed_generated() {
+        let stream = &g.stream;
+        let mut ws = vec![0u8; workspace_len(stream).unwrap()];
+        let mut inflater = Box::new(Inflater::new());
+        let mut d = Decoder::new(stream, &mut ws, &mut inflater).unwrap();
+        let mut rounds = 0;
+        while let Some(k) = d.next_level() {
+            let bytes = d.level_bytes(k, stream).unwrap();
+            let mut level = d.begin_level(k, bytes).unwrap();
+            loop {
+                let state = level.state();
+                assert_eq!(state.candidates().collect::<Vec<_>>(), scanned(state));
+                if level.next_round().unwrap().is_none() {
+                    break;
+                }
+                rounds += 1;
+            }
+        }
+        assert!(rounds > 0, "{}", g.base);
+    }
+}

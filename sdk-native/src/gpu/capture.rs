@@ -53,25 +53,28 @@ impl<S> Capture<S> {
 
     fn start(&mut self, state: &MeshState<'_>) {
         // Flags are read before any split of the round: the state is the
-        // round's starting state.
-        self.round = round_start(state, &mut self.candidates);
-        self.started = true;
-    }
-}
-
-/// A round starting from `state`: its candidates, the deficit-0 vertices,
-/// into `candidates` (ascending), and its capture with every flag 0 and no
-/// record yet.
-pub(super) fn round_start(state: &MeshState<'_>, candidates: &mut Vec<u32>) -> CapturedRound {
-    candidates.clear();
-    candidates.extend(
-        state
+        // round's starting state, whose candidates are the deficit-0
+        // vertices (scanned here; the two-thread capture reads them from
+        // decoder-core's bitmap, and the tests compare the two).
+        let scanned = state
             .deficits()
             .iter()
             .enumerate()
             .filter(|&(_, &d)| d == 0)
-            .map(|(v, _)| v as u32),
-    );
+            .map(|(v, _)| v as u32);
+        self.round = round_start(scanned, &mut self.candidates);
+        self.started = true;
+    }
+}
+
+/// A round whose candidates, ascending, are `from` (copied into
+/// `candidates`): its capture with every flag 0 and no record yet.
+pub(super) fn round_start(
+    from: impl Iterator<Item = u32>,
+    candidates: &mut Vec<u32>,
+) -> CapturedRound {
+    candidates.clear();
+    candidates.extend(from);
     let count = candidates.len();
     CapturedRound {
         candidates: count as u32,

@@ -283,7 +283,7 @@ impl CaptureTap<'_> {
     /// A round starts from `state`: its candidates are the vertices of
     /// deficit 0.
     fn begin_round(&mut self, state: &MeshState<'_>) {
-        self.round = round_start(state, &mut self.candidates);
+        self.round = round_start(state.candidates(), &mut self.candidates);
         self.cursor = 0;
     }
 }
