@@ -128,3 +128,12 @@ fn two_threads_while_a_level_is_open_is_misuse() {
     assert!(s.decode_level_two_threads(0, l2).is_err());
     s.decode_level_two_threads(1, l2).unwrap();
 }
+
+/// What the README and the C header say the second thread costs besides
+/// the positions: a second inflater and `PENDING` waiting rings.
+#[test]
+fn two_thread_memory_beyond_the_positions_is_about_1_6_mb() {
+    let fixed = TwoThreadMemory::new(0).bytes();
+    assert_eq!(TwoThreadMemory::new(1000).bytes(), fixed + 12 * 1000);
+    assert!((1_500_000..1_700_000).contains(&fixed), "{fixed} bytes");
+}

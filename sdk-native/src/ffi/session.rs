@@ -228,7 +228,7 @@ impl Session {
     /// [`threaded::TWO_THREADS_FROM_SPLITS`] (or the number set with
     /// [`Session::set_two_threads_from`]) decodes on this thread alone. The
     /// first call allocates 12 bytes per vertex of the session's capacity
-    /// and about 200 KiB more, kept until the session is dropped.
+    /// and about 1.6 MB more, kept until the session is dropped.
     pub fn decode_level_two_threads(&mut self, k: u16, bytes: &[u8]) -> Result<(), Error> {
         if self.level.is_some() {
             return Err(self.misuse(k));

@@ -332,7 +332,7 @@ pub unsafe extern "C" fn ss_decoder_decode_level(
 /// `ss_decoder_decode_level` on two cores: the rounds on the calling
 /// thread, the split records on a second thread that lives as long as the
 /// call; the same state, the same statuses. The first call allocates 12
-/// bytes per vertex of the decoder's capacity and about 200 KiB more, kept
+/// bytes per vertex of the decoder's capacity and about 1.6 MB more, kept
 /// until `ss_decoder_free`.
 ///
 /// # Safety
