@@ -225,9 +225,11 @@ pub enum Command {
         /// with range requests), instead of failing on a truncated file.
         #[arg(long)]
         available: bool,
-        /// 2: read each level's split records on a second thread while the
-        /// rounds run on this one (sdk-native `threaded`); the same mesh.
-        #[arg(long, default_value_t = 1)]
+        /// 2 (the default): read a large level's split records on a second
+        /// thread while the rounds run on this one (sdk-native `threaded`;
+        /// a level under 4,096 splits, or a machine with one core, decodes
+        /// on one); 1: everything on this thread. The same mesh either way.
+        #[arg(long, default_value_t = 2)]
         threads: u32,
     },
     /// Header, level table (with the decoder memory each prefix of levels
