@@ -106,6 +106,9 @@ where
 /// What a two-thread decode shows of a level besides its result: the
 /// state after level 0's seed and after every round, and every split.
 pub trait RoundTap {
+    /// Whether [`RoundTap::split`] wants the splits: if not, the pipe does
+    /// not keep their vertices for it.
+    const SPLITS: bool = true;
     /// The level has begun (its header read, and level 0's seed mesh):
     /// `state` is where its first round starts.
     fn begin_level(&mut self, _state: &MeshState<'_>) {}
@@ -122,6 +125,8 @@ pub trait RoundTap {
 struct AfterRounds<F>(F);
 
 impl<F: FnMut(Option<&RoundInfo>, &MeshState<'_>)> RoundTap for AfterRounds<F> {
+    const SPLITS: bool = false;
+
     fn after(&mut self, info: Option<&RoundInfo>, state: &MeshState<'_>) {
         (self.0)(info, state);
     }
@@ -247,22 +252,26 @@ impl<'t, P, T> Tapped<'t, P, T> {
         Tapped {
             pipe,
             tap,
-            sent: VecDeque::with_capacity(PENDING),
+            sent: VecDeque::new(),
         }
     }
 }
 
 impl<P: RecordPipe, T: RoundTap> RecordPipe for Tapped<'_, P, T> {
     fn send(&mut self, r: u32, c: u32, vertices: &[u32], eligible: &WingCandidates) {
-        self.sent.push_back(r);
+        if T::SPLITS {
+            self.sent.push_back(r);
+        }
         self.pipe.send(r, c, vertices, eligible);
     }
 
     fn take(&mut self, wait: bool) -> Option<Result<SplitRecord, Error>> {
         let record = self.pipe.take(wait)?;
-        let r = self.sent.pop_front();
-        if let (Some(r), Ok(record)) = (r, &record) {
-            self.tap.split(r, record);
+        if T::SPLITS {
+            let r = self.sent.pop_front();
+            if let (Some(r), Ok(record)) = (r, &record) {
+                self.tap.split(r, record);
+            }
         }
         Some(record)
     }
