@@ -335,3 +335,15 @@ fn gpu_bench_can_leave_out_the_decoder_table() {
     let err = one_line_error(&splitstream(&["gpu-bench", "--sides", "1"]));
     assert!(err.contains("--sides: 1"), "{err}");
 }
+
+#[test]
+fn verify_prints_the_state_hash_after_the_last_round() {
+    let (_, stream) = encoded_raster("for-verify.sps");
+    let out = succeeded(&splitstream(&["verify", stream.to_str().unwrap()]));
+    let bytes = std::fs::read(&stream).unwrap();
+    let mesh = splitstream_decoder_core::owned::decode_all(&bytes, true).unwrap();
+    let hash = format!("state hash {:016x}", mesh.round_hashes.last().unwrap());
+    assert!(out.contains(&hash), "{out}");
+    let rounds = format!("{} rounds", mesh.round_hashes.len() - 1);
+    assert!(out.contains(&rounds), "{out}");
+}
