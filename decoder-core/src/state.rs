@@ -184,12 +184,20 @@ impl<'ws> MeshState<'ws> {
     }
 
     /// The candidates of the next round (SPEC §7.3 step 1: the vertices of
-    /// deficit 0), ascending: read from the bitmap the splits keep up to
-    /// date, so a caller need not scan [`MeshState::deficits`].
+    /// deficit 0) as a bitmap, bit `v % 64` of word `v / 64`, kept up to
+    /// date by the splits: `vertex_count().div_ceil(64)` words, whose bits
+    /// at or above `vertex_count()` mean nothing.
+    pub fn candidate_words(&self) -> &[u64] {
+        let third = self.candidates.len() / 3;
+        let words = (self.vertex_count as usize).div_ceil(64);
+        &self.candidates[..third.min(words)]
+    }
+
+    /// The candidates of the next round, ascending ([`MeshState::candidate_words`]),
+    /// so that a caller need not scan [`MeshState::deficits`].
     pub fn candidates(&self) -> impl Iterator<Item = u32> + '_ {
         let n = self.vertex_count as usize;
-        let third = self.candidates.len() / 3;
-        self.candidates[..third.min(n.div_ceil(64))]
+        self.candidate_words()
             .iter()
             .enumerate()
             .flat_map(move |(w, &word)| {

@@ -21,7 +21,7 @@ use splitstream_decoder_core::{
     layout_for,
 };
 
-use super::capture::{Capture, CapturedRound, gpu_record, round_start};
+use super::capture::{Capture, CapturedRound, gpu_record};
 use crate::threaded::{RoundTap, TwoThreadMemory, decode_level_tapped};
 
 /// The seed mesh as decoder-core holds it after reading it (SPEC §6.3).
@@ -246,8 +246,10 @@ fn capture_two_threads_into(
         hash_rounds,
         triangle_limit: 0,
         candidates: Vec::new(),
+        word: 0,
+        before: 0,
         round: CapturedRound::default(),
-        cursor: 0,
+        last: None,
         out_of_order: false,
     };
     while let Some(k) = decoder.next_level() {
@@ -271,20 +273,57 @@ struct CaptureTap<'o> {
     hash_rounds: bool,
     /// The triangle count of the level being decoded.
     triangle_limit: u32,
-    /// The round's candidates, ascending.
-    candidates: Vec<u32>,
+    /// The round's candidates as a bitmap (decoder-core's, copied at the
+    /// round's start: the splits change it), bits from the vertex count on
+    /// cleared.
+    candidates: Vec<u64>,
+    /// Candidates in the words of `candidates` before word `word`.
+    word: usize,
+    before: u32,
     round: CapturedRound,
-    cursor: usize,
-    /// A split vertex was not a candidate of its round.
+    /// The last split vertex, to check that they come in ascending order.
+    last: Option<u32>,
+    /// A split vertex was not a candidate of its round, or came out of
+    /// order.
     out_of_order: bool,
 }
 
 impl CaptureTap<'_> {
     /// A round starts from `state`: its candidates are the vertices of
-    /// deficit 0.
+    /// deficit 0, which the round's flags follow in ascending order.
     fn begin_round(&mut self, state: &MeshState<'_>) {
-        self.round = round_start(state.candidates(), &mut self.candidates);
-        self.cursor = 0;
+        let n = state.vertex_count() as usize;
+        self.candidates.clear();
+        self.candidates.extend_from_slice(state.candidate_words());
+        if let Some(last) = self.candidates.last_mut()
+            && !n.is_multiple_of(64)
+        {
+            *last &= (1u64 << (n % 64)) - 1;
+        }
+        let count: u32 = self.candidates.iter().map(|w| w.count_ones()).sum();
+        self.round = CapturedRound {
+            candidates: count,
+            flags: vec![0; count.div_ceil(32) as usize],
+            records: Vec::new(),
+        };
+        (self.word, self.before, self.last) = (0, 0, None);
+    }
+
+    /// The index of `r` among the round's candidates, if it is one; `r`
+    /// grows from call to call within a round.
+    fn rank(&mut self, r: u32) -> Option<u32> {
+        if self.last.is_some_and(|last| r <= last) {
+            return None;
+        }
+        self.last = Some(r);
+        let w = (r / 64) as usize;
+        let word = *self.candidates.get(w)?;
+        while self.word < w {
+            self.before += self.candidates[self.word].count_ones();
+            self.word += 1;
+        }
+        let bit = 1u64 << (r % 64);
+        (word & bit != 0).then(|| self.before + (word & (bit - 1)).count_ones())
     }
 }
 
@@ -310,13 +349,9 @@ impl RoundTap for CaptureTap<'_> {
     }
 
     fn split(&mut self, r: u32, record: &SplitRecord) {
-        while self.candidates.get(self.cursor).is_some_and(|&c| c < r) {
-            self.cursor += 1;
-        }
-        if self.candidates.get(self.cursor) == Some(&r) {
-            self.round.flags[self.cursor / 32] |= 1 << (self.cursor % 32);
-        } else {
-            self.out_of_order = true;
+        match self.rank(r) {
+            Some(i) => self.round.flags[i as usize / 32] |= 1 << (i % 32),
+            None => self.out_of_order = true,
         }
         self.round.records.push(gpu_record(record));
     }
