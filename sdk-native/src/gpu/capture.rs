@@ -56,30 +56,22 @@ impl<S> Capture<S> {
         // round's starting state, whose candidates are the deficit-0
         // vertices (scanned here; the two-thread capture reads them from
         // decoder-core's bitmap, and the tests compare the two).
-        let scanned = state
-            .deficits()
-            .iter()
-            .enumerate()
-            .filter(|&(_, &d)| d == 0)
-            .map(|(v, _)| v as u32);
-        self.round = round_start(scanned, &mut self.candidates);
+        self.candidates.clear();
+        self.candidates.extend(
+            state
+                .deficits()
+                .iter()
+                .enumerate()
+                .filter(|&(_, &d)| d == 0)
+                .map(|(v, _)| v as u32),
+        );
+        let count = self.candidates.len();
+        self.round = CapturedRound {
+            candidates: count as u32,
+            flags: vec![0; count.div_ceil(32)],
+            records: Vec::new(),
+        };
         self.started = true;
-    }
-}
-
-/// A round whose candidates, ascending, are `from` (copied into
-/// `candidates`): its capture with every flag 0 and no record yet.
-pub(super) fn round_start(
-    from: impl Iterator<Item = u32>,
-    candidates: &mut Vec<u32>,
-) -> CapturedRound {
-    candidates.clear();
-    candidates.extend(from);
-    let count = candidates.len();
-    CapturedRound {
-        candidates: count as u32,
-        flags: vec![0; count.div_ceil(32)],
-        records: Vec::new(),
     }
 }
 
