@@ -43,6 +43,8 @@ pub mod pipe;
 pub mod predict;
 mod rans;
 #[cfg(feature = "alloc")]
+mod rans_segments;
+#[cfg(feature = "alloc")]
 mod rans_writer;
 pub mod record;
 mod ring;

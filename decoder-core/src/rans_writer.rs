@@ -5,6 +5,7 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
+use crate::limits::CHUNK_ENTRY_LEN;
 use crate::limits::rans::{PROB_BITS, RAW_BITS_STEP, STATE_LOW, TOKENS};
 use crate::rans::{normalise, token_of};
 
@@ -34,6 +35,13 @@ fn varint_len(v: u32) -> usize {
 /// Counts sent for one context, scaled down so the table stays small.
 /// Tries a few scales and keeps the cheapest (table bytes + estimated code).
 fn choose_counts(histogram: &[u32]) -> Vec<u32> {
+    scaled_counts(histogram).1
+}
+
+/// [`choose_counts`] and the bits it was chosen for: the table's count
+/// bytes and the values' tokens under it (raw bits left out: they do not
+/// depend on the table).
+fn scaled_counts(histogram: &[u32]) -> (f64, Vec<u32>) {
     let n = histogram.iter().rposition(|&c| c > 0).map_or(0, |i| i + 1);
     let histogram = &histogram[..n];
     let max = histogram.iter().copied().max().unwrap_or(0);
@@ -72,7 +80,21 @@ fn choose_counts(histogram: &[u32]) -> Vec<u32> {
             break;
         }
     }
-    best.map(|(_, c)| c).unwrap_or_default()
+    best.unwrap_or_default()
+}
+
+/// Estimated bits of one rANS chunk coding `values` values whose tokens
+/// fall into `histograms` (one per context), beside their raw bits: its
+/// directory entry, every context's table, the tokens under those tables
+/// (as [`encode_chunk`] chooses them) and the lanes' lengths and final
+/// states. What [`crate::writer`] weighs when it decides where to cut a
+/// substream into chunks.
+pub fn chunk_cost_bits(histograms: &[[u32; TOKENS]], values: usize, lanes: usize) -> f64 {
+    // Directory entry, then per lane a length varint (about 2 bytes) and
+    // its 4-byte state.
+    let fixed_bytes = CHUNK_ENTRY_LEN + 6 * lanes.min(values.max(1));
+    let tables: f64 = histograms.iter().map(|h| 8.0 + scaled_counts(h).0).sum();
+    8.0 * fixed_bytes as f64 + tables
 }
 
 /// log2 without std: exact enough for choosing a table scale.

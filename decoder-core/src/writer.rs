@@ -14,6 +14,7 @@ use crate::limits::{
     VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_WINGS, codec, substream,
 };
 use crate::predict::PlanePolicy;
+use crate::rans_segments::rans_segments;
 use crate::rans_writer::{Symbol, encode_chunk};
 use crate::wing_order::WingPolicy;
 
@@ -166,6 +167,12 @@ pub struct LevelPayload {
     pub geometric_error: f32,
 }
 
+/// The reference encoder's longest rANS chunk, in values. Chunks are cut
+/// shorter where their own tables pay for themselves (`rans_segments`);
+/// on a 1M-vertex terrain the longest substream of the last level holds 3
+/// million values.
+pub const DEFAULT_RANS_CHUNK_LIMIT: u32 = 1 << 18;
+
 /// Stream-wide parameters.
 #[derive(Clone, Copy, Debug)]
 pub struct StreamParams {
@@ -187,7 +194,8 @@ pub struct StreamParams {
 
 impl Default for StreamParams {
     /// The reference encoder's defaults on a unit grid: optimal positions,
-    /// 14 bits, rANS in 4 lanes, chunks of 16 KiB and of 16,384 values.
+    /// 14 bits, rANS in 4 lanes, byte-codec chunks of 16 KiB and rANS
+    /// chunks of up to [`DEFAULT_RANS_CHUNK_LIMIT`] values.
     fn default() -> Self {
         StreamParams {
             position_mode: PositionMode::Optimal,
@@ -196,7 +204,7 @@ impl Default for StreamParams {
             scale: [1.0; 3],
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
-            rans_chunk_limit: 16 * 1024,
+            rans_chunk_limit: DEFAULT_RANS_CHUNK_LIMIT,
         }
     }
 }
@@ -544,11 +552,11 @@ pub fn coded_len_in(
 /// [`coded_len_in`] of a substream that is still being written, costed
 /// chunk by chunk as its chunks fill up: an encoder weighing alternatives
 /// costs them while it writes them, off its critical path, and only the
-/// last chunk is left when the substream is complete. Under every codec but
-/// `Rans`, whose deflate trial weighs the whole substream (and which
-/// [`GrowingCodedLen::advance`] therefore leaves to
-/// [`GrowingCodedLen::finish`]), each chunk is coded on its own, so the sum
-/// is the same number.
+/// last chunk is left when the substream is complete. Under the byte codecs
+/// each chunk is coded on its own, so the sum is the same number. The rANS
+/// codecs are left to [`GrowingCodedLen::finish`]: where their chunks end
+/// depends on the whole substream (`rans_segments`), and `Rans`'s deflate
+/// trial weighs the whole substream too.
 #[derive(Clone, Debug, Default)]
 pub struct GrowingCodedLen {
     /// Chunks costed so far (the first ones).
@@ -562,27 +570,22 @@ impl GrowingCodedLen {
     pub fn advance(
         &mut self,
         sub: &SubstreamWriter,
-        id: u8,
-        deficits: DeficitContexts,
+        _id: u8,
+        _deficits: DeficitContexts,
         params: &StreamParams,
     ) {
         let (units, limit) = match params.codec {
-            ChunkCodec::Rans { .. } => return,
-            ChunkCodec::RansAlways { .. } => {
-                (sub.symbols.len(), params.rans_chunk_limit.max(1) as usize)
-            }
+            // Where rANS chunks end depends on the whole substream
+            // (`rans_segments`).
+            ChunkCodec::Rans { .. } | ChunkCodec::RansAlways { .. } => return,
             // A bit substream's last byte takes more bits.
             ChunkCodec::Stored | ChunkCodec::Deflate(_) => (
                 sub.bytes.len() - usize::from(sub.bit_count != 0),
                 params.chunk_limit.max(1) as usize,
             ),
         };
-        let contexts = context::count(id, deficits);
         while (self.chunks + 1) * limit <= units {
-            self.bytes += single_chunk(sub, self.chunks, contexts, params)
-                .stored
-                .len()
-                + CHUNK_ENTRY_LEN;
+            self.bytes += single_chunk(sub, self.chunks, params).stored.len() + CHUNK_ENTRY_LEN;
             self.chunks += 1;
         }
     }
@@ -595,39 +598,30 @@ impl GrowingCodedLen {
         deficits: DeficitContexts,
         params: &StreamParams,
     ) -> usize {
-        let contexts = context::count(id, deficits);
         let count = match params.codec {
-            ChunkCodec::Rans { .. } => return coded_len_in(sub, id, deficits, params),
-            ChunkCodec::RansAlways { .. } => sub
-                .symbols
-                .len()
-                .div_ceil(params.rans_chunk_limit.max(1) as usize),
+            ChunkCodec::Rans { .. } | ChunkCodec::RansAlways { .. } => {
+                return coded_len_in(sub, id, deficits, params);
+            }
             ChunkCodec::Stored | ChunkCodec::Deflate(_) => {
                 sub.bytes.len().div_ceil(params.chunk_limit.max(1) as usize)
             }
         };
         self.bytes
             + (self.chunks..count)
-                .map(|i| single_chunk(sub, i, contexts, params).stored.len() + CHUNK_ENTRY_LEN)
+                .map(|i| single_chunk(sub, i, params).stored.len() + CHUNK_ENTRY_LEN)
                 .sum::<usize>()
     }
 }
 
-/// Chunk `i` of `sub` under a codec that codes each chunk on its own (not
-/// `Rans`).
-fn single_chunk(sub: &SubstreamWriter, i: usize, contexts: usize, params: &StreamParams) -> Chunk {
+/// Chunk `i` of `sub` under a byte codec (stored or deflate: each chunk is
+/// coded on its own, `limit` bytes long but the last).
+fn single_chunk(sub: &SubstreamWriter, i: usize, params: &StreamParams) -> Chunk {
     let limit = params.chunk_limit.max(1) as usize;
-    match params.codec {
-        ChunkCodec::Stored => byte_chunk(&sub.bytes, limit, None, i),
-        ChunkCodec::Deflate(l) => byte_chunk(&sub.bytes, limit, Some(l), i),
-        ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } => rans_chunk(
-            &sub.symbols,
-            params.rans_chunk_limit.max(1) as usize,
-            contexts,
-            lanes as usize,
-            i,
-        ),
-    }
+    let level = match params.codec {
+        ChunkCodec::Deflate(l) => Some(l),
+        _ => None,
+    };
+    byte_chunk(&sub.bytes, limit, level, i)
 }
 
 /// One coded chunk before framing.
@@ -664,7 +658,8 @@ fn byte_chunk(bytes: &[u8], limit: usize, level: Option<u8>, i: usize) -> Chunk 
 }
 
 /// rANS chunks of at most `limit` values each, `contexts` tables each
-/// (SPEC §5.5).
+/// (SPEC §5.5), cut where [`rans_segments`] estimates the substream
+/// smallest.
 fn rans_chunks(
     symbols: &[Symbol],
     limit: usize,
@@ -672,17 +667,13 @@ fn rans_chunks(
     lanes: usize,
     map: ChunkMap<'_>,
 ) -> Vec<Chunk> {
-    map(symbols.len().div_ceil(limit), &|i| {
-        rans_chunk(symbols, limit, contexts, lanes, i)
+    let segments = rans_segments(symbols, contexts, lanes, limit);
+    map(segments.len(), &|i| {
+        let values = &symbols[segments[i].clone()];
+        Chunk {
+            codec: codec::RANS,
+            raw_len: values.len() as u32,
+            stored: encode_chunk(values, contexts, lanes),
+        }
     })
-}
-
-/// Chunk `i` of [`rans_chunks`].
-fn rans_chunk(symbols: &[Symbol], limit: usize, contexts: usize, lanes: usize, i: usize) -> Chunk {
-    let values = &symbols[i * limit..symbols.len().min((i + 1) * limit)];
-    Chunk {
-        codec: codec::RANS,
-        raw_len: values.len() as u32,
-        stored: encode_chunk(values, contexts, lanes),
-    }
 }

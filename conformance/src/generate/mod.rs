@@ -180,6 +180,15 @@ fn describe(spec: &Spec, file: &str) -> Vector {
             let mesh = decode_all(&spec.stream, true).expect("valid");
             assert_eq!(mesh.round_hashes, outcome.hashes, "{}", spec.name);
             let (result, tags) = final_mesh(&spec.stream);
+            // A vector that names a feature `final_mesh` derives must have it.
+            for derived in DERIVED_TAGS {
+                assert!(
+                    !spec.features.iter().any(|f| f == derived)
+                        || tags.iter().any(|t| t == derived),
+                    "{}: declared {derived}, the stream does not have it",
+                    spec.name
+                );
+            }
             features.extend(tags);
             (mesh.round_hashes, Some(result))
         }
@@ -209,6 +218,10 @@ fn describe(spec: &Spec, file: &str) -> Vector {
     }
 }
 
+/// Tags [`final_mesh`] derives that a vector may also declare (the
+/// generator then checks that its stream has them).
+const DERIVED_TAGS: [&str; 1] = ["rans-chunks-uneven"];
+
 /// Decodes a valid stream round by round for the manifest's summary, and
 /// derives feature tags from what the stream really contains.
 fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
@@ -231,6 +244,7 @@ fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
             tags.push("seed-rounds".to_string());
         }
         let mut per_substream = BTreeMap::new();
+        let mut rans_lengths: BTreeMap<u8, Vec<u32>> = BTreeMap::new();
         for c in 0..lh.chunk_count {
             let e = lh.chunk(c).expect("valid");
             tags.push(
@@ -247,9 +261,24 @@ fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
                 tags.push("rans-chunk-above-max".to_string());
             }
             *per_substream.entry(e.substream).or_insert(0) += 1;
+            if e.codec == codec::RANS {
+                rans_lengths.entry(e.substream).or_default().push(e.raw_len);
+            }
         }
         if per_substream.values().any(|&n| n > 1) {
             tags.push("multi-chunk-substreams".to_string());
+        }
+        // rANS chunks of one substream cut at different lengths, as the
+        // reference encoder cuts them (SPEC §5.2, §11), not every chunk but
+        // the last one length.
+        let uneven = |lengths: &Vec<u32>| match lengths.split_last() {
+            Some((last, rest)) if !rest.is_empty() => {
+                rest.iter().any(|&l| l != rest[0]) || *last > rest[0]
+            }
+            _ => false,
+        };
+        if rans_lengths.values().any(uneven) {
+            tags.push("rans-chunks-uneven".to_string());
         }
     }
     let mut ws = OwnedWorkspace::for_stream(stream).expect("valid");

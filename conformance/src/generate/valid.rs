@@ -258,6 +258,18 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
             stream
         },
     );
+    // The reference encoder cuts each substream into rANS chunks where
+    // their own tables pay (SPEC §5.2: chunk boundaries carry no meaning;
+    // §11): chunks of one substream of different lengths.
+    s.valid(
+        "grid160-rans-chunks-uneven",
+        "Height field of 160 x 160 samples (25,600 vertices), the encoder's defaults (constrained positions, rANS): a substream's rANS chunks are cut at different lengths (multiples of 4,096 values, SPEC §11), as the reference encoder cuts long substreams.",
+        &["encoded", "rans", "rans-chunks-uneven"],
+        {
+            let grid = meshes::checked(meshes::grid(160, 160, 3, None), "grid(160)");
+            encoded(&grid, EncodeOptions::default())
+        },
+    );
     s.valid(
         "handmade-tetra-split-rans",
         "SPEC Appendix A's split with every substream rANS-coded (1 lane).",

@@ -19,9 +19,12 @@ pub struct CodingArgs {
     /// buffers (7 chunks, or 1,856 bytes each at least, SPEC §9).
     #[arg(long, default_value_t = 16384)]
     pub chunk_size: u32,
-    /// Largest rANS chunk in values (each chunk has its own tables; no
-    /// effect on the decoder's memory, format 3.4).
-    #[arg(long, default_value_t = 16384)]
+    /// Longest rANS chunk in values. Each chunk has its own tables: the
+    /// encoder cuts a substream where tables fitted to its parts cost less
+    /// than one table for the whole (at 4,096-value steps; a limit of
+    /// 4,096 or less cuts every chunk that long). No effect on the
+    /// decoder's memory (format 3.4).
+    #[arg(long, default_value_t = splitstream_decoder_core::writer::DEFAULT_RANS_CHUNK_LIMIT)]
     pub rans_chunk: u32,
     /// Which axis of each position residual the split's plane predicts, or
     /// `height`: z from the surface of the split vertex's fan (terrain,

@@ -117,9 +117,9 @@ struct Recoded {
 }
 
 /// The stream re-coded with rANS and with deflate, at its own chunk sizes
-/// and lane count (4 lanes and rANS chunks of 16,384 values for a stream
-/// without rANS chunks), each level's plane, wing and deficit coding chosen
-/// again for that codec.
+/// and lane count (its longest rANS chunk as the limit; 4 lanes and the
+/// encoder's default limit for a stream without rANS chunks), each level's
+/// plane, wing and deficit coding chosen again for that codec.
 fn recode(stream: &[u8], header: &Header, sizes: &FieldSizes) -> Result<Vec<Recoded>, String> {
     let has_rans = sizes.largest_rans_chunk > 0;
     let lanes = if has_rans { header.lane_count } else { 4 };

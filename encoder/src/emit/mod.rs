@@ -93,7 +93,7 @@ impl Default for EncodeOptions {
             max_error: None,
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
-            rans_chunk_limit: 16 * 1024,
+            rans_chunk_limit: splitstream_decoder_core::writer::DEFAULT_RANS_CHUNK_LIMIT,
             lock_boundary: false,
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,

@@ -45,13 +45,14 @@ pub struct TranscodeOptions {
 }
 
 impl Default for TranscodeOptions {
-    /// The reference encoder's defaults: rANS in 4 lanes, chunks of 16 KiB
-    /// and of 16,384 values, every policy chosen by size.
+    /// The reference encoder's defaults: rANS in 4 lanes, byte-codec chunks
+    /// of 16 KiB, rANS chunks of up to 262,144 values
+    /// (`DEFAULT_RANS_CHUNK_LIMIT`), every policy chosen by size.
     fn default() -> Self {
         TranscodeOptions {
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
-            rans_chunk_limit: 16 * 1024,
+            rans_chunk_limit: splitstream_decoder_core::writer::DEFAULT_RANS_CHUNK_LIMIT,
             plane: None,
             wings: None,
             deficits: None,
