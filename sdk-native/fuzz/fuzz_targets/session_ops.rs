@@ -2,7 +2,11 @@
 //! arbitrary sequences of calls over the conformance suite's valid streams:
 //! levels begun, decoded whole or round by round, in order or not, with
 //! their bytes right, cut short or with a byte changed; the mesh read
-//! between any two calls; the session dropped half way through a level.
+//! between any two calls; the session dropped half way through a level;
+//! levels decoded on two threads (`decode_level_two_threads`, from as few
+//! as 0 splits, so that every level of these small streams takes the
+//! second thread), each compared with the same call on a twin session
+//! decoding on one thread: the same result and the same state.
 //! cargo-fuzz builds with AddressSanitizer, so a use after free or a stray
 //! read of the session's pointers is a finding, as is a panic. While the
 //! calls are right, the session must end where decoder-core's own decode
@@ -56,6 +60,62 @@ fn streams() -> &'static [Stream] {
     })
 }
 
+/// Decodes level `k` from `level` on two threads, from `from` splits
+/// (mostly 0: every level takes the second thread), and checks it against
+/// the same call on one thread: a twin session opened on `bytes` and
+/// brought to the same point. Only where `session` is `clean` (no call of
+/// it failed) and at the start of a level whose predecessors decoded
+/// right: otherwise the twin cannot be rebuilt cheaply, and only the
+/// absence of panics and hangs is checked.
+fn two_threads(
+    session: &mut Session,
+    bytes: &[u8],
+    k: u16,
+    level: &[u8],
+    from: u8,
+    clean: bool,
+) -> Result<(), splitstream_decoder_core::Error> {
+    session.set_two_threads_from(if from < 192 { 0 } else { u32::from(from) * 64 });
+    let twin = if clean { twin_at(session, bytes) } else { None };
+    let result = session.decode_level_two_threads(k, level);
+    if let Some(mut twin) = twin {
+        let expected = twin.decode_level(k, level);
+        assert_eq!(
+            result.map_err(|e| e.class()),
+            expected.map_err(|e| e.class()),
+            "level {k}: two threads and one disagree"
+        );
+        if result.is_ok() {
+            assert_eq!(
+                session.state_hash(),
+                twin.state_hash(),
+                "level {k}: states differ"
+            );
+        }
+        assert_eq!(session.levels_done(), twin.levels_done());
+    }
+    result
+}
+
+/// A session on one thread at the point `session` is at, where that point
+/// is the end of its levels done, each of them decoded from the stream's
+/// right bytes (checked by the state hash); `None` otherwise.
+fn twin_at(session: &Session, bytes: &[u8]) -> Option<Session> {
+    if session.open_level().is_some() {
+        return None;
+    }
+    let mut twin = Session::open(bytes).ok()?;
+    for k in 0..session.levels_done() {
+        let range = twin.level_range(k)?;
+        twin.decode_level(k, &bytes[range.start as usize..range.end as usize])
+            .ok()?;
+    }
+    let same = twin.state_hash() == session.state_hash()
+        && twin.workspace_bytes() == session.workspace_bytes()
+        && twin.levels_that_fit() == session.levels_that_fit();
+    same.then_some(twin)
+}
+
 /// Reads the whole mesh the session shows, as a viewer would between two
 /// calls, and checks that it is a mesh.
 fn look(session: &Session) {
@@ -91,6 +151,9 @@ fuzz_target!(|data: &[u8]| {
     };
     // Whether every call so far was a right one, in order.
     let mut faithful = session.levels_that_fit() == session.level_count();
+    // Whether no call has failed since the session was opened (a failed
+    // call may poison the decoder, SPEC §10.3).
+    let mut clean = true;
     while !b.done() {
         match b.u8() % 8 {
             // Begin or decode the next level (or another one), with its
@@ -120,18 +183,30 @@ fuzz_target!(|data: &[u8]| {
                     _ => {}
                 }
                 faithful &= Some(k) == next;
-                let result = if op == 0 {
-                    session.decode_level(k, &level)
-                } else {
-                    session.begin_level(k, &level)
+                let result = match op {
+                    0 => session.decode_level(k, &level),
+                    1 => session.begin_level(k, &level),
+                    _ => two_threads(&mut session, bytes, k, &level, b.u8(), clean),
                 };
                 faithful &= result.is_ok();
+                clean &= result.is_ok();
             }
             // One round, or the rest of the open level.
             3 => {
-                faithful &= session.next_round().is_ok();
+                let ok = session.next_round().is_ok();
+                faithful &= ok;
+                clean &= ok;
             }
-            4 => while let Ok(Some(_)) = session.next_round() {},
+            4 => loop {
+                match session.next_round() {
+                    Ok(Some(_)) => {}
+                    Ok(None) => break,
+                    Err(_) => {
+                        clean = false;
+                        break;
+                    }
+                }
+            },
             // Read everything, as a viewer drawing a frame.
             5 => look(&session),
             // The questions a viewer asks.
@@ -155,6 +230,7 @@ fuzz_target!(|data: &[u8]| {
                 };
                 session = again;
                 faithful = session.levels_that_fit() == session.level_count();
+                clean = true;
             }
         }
     }
