@@ -260,6 +260,32 @@ fn info_gives_the_memory_each_prefix_of_levels_needs() {
 }
 
 #[test]
+fn info_counts_each_fields_chunks() {
+    let (_, stream) = encoded_raster("for-chunks.sps");
+    let s = stream.to_str().unwrap();
+    let doc: serde_json::Value =
+        serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();
+    let levels = doc["levels"].as_array().unwrap().len() as u64;
+    let fields = doc["fields"].as_object().unwrap();
+    for (name, field) in fields {
+        let (bytes, chunks) = (field["bytes"].as_u64(), field["chunks"].as_u64());
+        match bytes {
+            // A field with bytes has at least one chunk in every level
+            // that codes it: the seed mesh's in level 0 only, the rounds'
+            // in at most every level.
+            Some(b) if b > 0 => {
+                let chunks = chunks.unwrap();
+                assert!((1..=levels * 64).contains(&chunks), "{name}: {field}");
+            }
+            _ => assert_eq!(chunks, Some(0), "{name}: {field}"),
+        }
+    }
+    // The text form has the column too.
+    let text = succeeded(&splitstream(&["info", s]));
+    assert!(text.contains("raw bytes/values  chunks  codecs"), "{text}");
+}
+
+#[test]
 fn a_decoded_glb_encodes_back_to_the_same_stream() {
     // Geographic-sized coordinates: the GLB keeps them in the node's
     // translation (f64 JSON) and positions relative to it (f32), so at 14

@@ -22,6 +22,9 @@ pub struct FieldSizes {
     pub raw: [u64; FIELDS],
     /// Per id, a bit per codec id seen (1 stored, 2 deflate, 4 rANS).
     pub codecs: [u8; FIELDS],
+    /// Chunks per id, over every level (rANS substreams are cut where
+    /// their tables pay, so their counts vary).
+    pub chunks: [u64; FIELDS],
     pub framing: u64,
     /// Values of the longest rANS chunk (0 if none).
     pub largest_rans_chunk: u32,
@@ -93,6 +96,7 @@ fn field_sizes_of(
             sizes.stored[chunk.substream as usize] += chunk.stored_len as u64;
             sizes.raw[chunk.substream as usize] += chunk.raw_len as u64;
             sizes.codecs[chunk.substream as usize] |= 1 << chunk.codec.min(7);
+            sizes.chunks[chunk.substream as usize] += 1;
             if chunk.codec == codec::RANS {
                 sizes.largest_rans_chunk = sizes.largest_rans_chunk.max(chunk.raw_len);
             }
@@ -255,7 +259,7 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
             .collect();
         let fields: serde_json::Map<String, serde_json::Value> = (1..FIELDS)
             .map(|i| {
-                let mut field = serde_json::json!({"bytes": sizes.stored[i], "raw_bytes_or_values": sizes.raw[i], "codecs": sizes.codec_names(i), "bits_per_vertex": bpv(sizes.stored[i])});
+                let mut field = serde_json::json!({"bytes": sizes.stored[i], "raw_bytes_or_values": sizes.raw[i], "chunks": sizes.chunks[i], "codecs": sizes.codec_names(i), "bits_per_vertex": bpv(sizes.stored[i])});
                 if !recoded.is_empty() {
                     field["recoded_bytes"] = recoded
                         .iter()
@@ -378,7 +382,7 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
         .map(|r| format!(" {:>10}", format!("as {}", r.codec)))
         .collect();
     println!(
-        "  field            bytes  raw bytes/values  codecs          bits/vertex{recoded_header}"
+        "  field            bytes  raw bytes/values  chunks  codecs          bits/vertex{recoded_header}"
     );
     for (i, name) in NAMES.iter().enumerate().skip(1) {
         let recoded_bits: String = recoded
@@ -386,10 +390,11 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
             .map(|r| format!(" {:>10.3}", bpv(r.sizes.stored[i])))
             .collect();
         println!(
-            "  {:<14} {:>9} {:>17}  {:<14} {:>10.3}{recoded_bits}",
+            "  {:<14} {:>9} {:>17} {:>7}  {:<14} {:>10.3}{recoded_bits}",
             name,
             sizes.stored[i],
             sizes.raw[i],
+            sizes.chunks[i],
             sizes.codec_names(i),
             bpv(sizes.stored[i])
         );
@@ -400,9 +405,10 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
             .map(|r| format!(" {:>10.3}", bpv(r.bytes)))
             .collect();
         println!(
-            "  {:<14} {:>9} {:>17}  {:<14} {:>10.3}{totals}",
+            "  {:<14} {:>9} {:>17} {:>7}  {:<14} {:>10.3}{totals}",
             "all",
             stream.len(),
+            "",
             "",
             "",
             bpv(stream.len() as u64)

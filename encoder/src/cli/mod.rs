@@ -233,7 +233,7 @@ pub enum Command {
         threads: u32,
     },
     /// Header, level table (with the decoder memory each prefix of levels
-    /// needs), bits per field and per vertex.
+    /// needs), bits and chunks per field, bits per vertex.
     Info {
         input: PathBuf,
         #[arg(long)]
