@@ -423,6 +423,7 @@ mod tests {
     use crate::context::SINGLE;
     use crate::header::PositionMode;
     use crate::limits::rans::TABLE_WORDS;
+    use crate::limits::substream;
     use crate::rans::LANE_WORDS;
     use crate::writer::{ChunkCodec, LevelPayload, StreamParams, SubstreamWriter, frame_level};
     use alloc::vec;
@@ -555,6 +556,108 @@ mod tests {
                 let read: Vec<bool> = plain.iter().filter_map(|r| r.ok()).collect();
                 prop_assert_eq!(&read[..bits.len()], &bits[..]);
             }
+        }
+    }
+
+    /// A level whose edge substream (id 6, 3 contexts) holds `values`,
+    /// rANS-coded with chunks cut by the writer (`rans_segments`) up to
+    /// `limit` values, and the lengths of its chunks.
+    fn edge_level(values: &[(u8, i32)], lanes: u8, limit: u32) -> (Vec<u8>, Vec<u32>) {
+        let mut substreams = vec![SubstreamWriter::default(); SLOTS];
+        for &(context, v) in values {
+            substreams[(substream::EDGE - 1) as usize].signed_in(context % 3, v);
+        }
+        let payload = LevelPayload {
+            round_splits: vec![1],
+            substreams,
+            ..LevelPayload::default()
+        };
+        let params = StreamParams {
+            codec: ChunkCodec::RansAlways { lanes },
+            rans_chunk_limit: limit,
+            ..StreamParams::default()
+        };
+        let bytes = frame_level(&payload, None, &params).bytes;
+        let header = LevelHeader::parse(&bytes, false, 1 << 16).expect("level header");
+        let lengths = (0..header.chunk_count)
+            .map(|c| header.chunk(c).expect("chunk").raw_len)
+            .collect();
+        (bytes, lengths)
+    }
+
+    /// Values of a narrow spread, then a wide one, then narrow again: the
+    /// writer cuts the substream where the spread changes.
+    #[test]
+    fn the_writer_cuts_where_the_values_change() {
+        let values: Vec<(u8, i32)> = (0..3 * 40_960)
+            .map(|i: usize| {
+                let wide = (40_960..81_920).contains(&i);
+                let v = (i.wrapping_mul(2_654_435_761) >> 7) as i32;
+                ((i % 3) as u8, if wide { v % 4000 } else { v % 3 })
+            })
+            .collect();
+        let (_, lengths) = edge_level(&values, 4, 1 << 18);
+        // Cuts at the two changes (runs of 2^h aligned blocks of 4,096
+        // values meet there), fewer chunks than blocks.
+        let cuts: Vec<u32> = lengths
+            .iter()
+            .scan(0, |at, &l| {
+                *at += l;
+                Some(*at)
+            })
+            .collect();
+        assert!(
+            cuts.contains(&40_960) && cuts.contains(&81_920),
+            "{lengths:?}"
+        );
+        assert_eq!(cuts.last(), Some(&122_880));
+        assert!(lengths.len() < 30, "{lengths:?}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(24))]
+
+        /// Chunks cut at different lengths read back every value: their
+        /// lengths add up, none passes the limit, and the values drift
+        /// (their spread changes every `drift` values) so that cuts fall
+        /// in the middle of the substream.
+        #[test]
+        fn values_cut_into_uneven_rans_chunks_read_back(
+            n in 1usize..40_000,
+            drift in 500usize..20_000,
+            lanes in 1u8..6,
+            limit in prop_oneof![Just(1u32 << 18), 4_097u32..40_000, 1u32..5_000],
+            seed in any::<u64>(),
+        ) {
+            let mut x = seed | 1;
+            let values: Vec<(u8, i32)> = (0..n)
+                .map(|i| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    let spread = if (i / drift).is_multiple_of(2) { 4 } else { 3000 };
+                    ((i % 3) as u8, (x % spread) as i32 - (spread / 2) as i32)
+                })
+                .collect();
+            let (bytes, lengths) = edge_level(&values, lanes, limit);
+            prop_assert_eq!(lengths.iter().map(|&l| l as usize).sum::<usize>(), n);
+            prop_assert!(lengths.iter().all(|&l| l >= 1 && l <= limit));
+            let header = LevelHeader::parse(&bytes, false, 1 << 16).expect("level header");
+            let words = (TABLE_WORDS + LANE_WORDS * lanes as usize).max(1 << 14);
+            let mut memory = vec![0u32; SLOTS * words];
+            let mut inflater = Inflater::new();
+            let mut rest: &mut [u32] = &mut memory;
+            let buffers: [&mut [u8]; SLOTS] = core::array::from_fn(|_| {
+                let (mine, tail) = core::mem::take(&mut rest).split_at_mut(words);
+                rest = tail;
+                bytemuck::cast_slice_mut(mine)
+            });
+            let mut subs = Substreams::open(&bytes, header, 1, buffers, &mut inflater, lanes);
+            let slot = (substream::EDGE - 1) as usize;
+            for (i, &(context, v)) in values.iter().enumerate() {
+                prop_assert_eq!(subs.signed(slot, context % 3), Ok(v), "value {}", i);
+            }
+            prop_assert_eq!(subs.finish(), Ok(()));
         }
     }
 }
