@@ -455,20 +455,32 @@ mod tests {
         frame_level(&payload, None, &params).bytes
     }
 
+    /// Memory for the substream slots of a level read with `lanes` lanes:
+    /// room in each for a rANS chunk's tables and lanes or a byte chunk of
+    /// 64 KiB.
+    fn slot_memory(lanes: u8) -> Vec<u32> {
+        vec![0u32; SLOTS * (TABLE_WORDS + LANE_WORDS * lanes as usize).max(1 << 14)]
+    }
+
+    /// `memory` ([`slot_memory`]) cut into the slots' buffers.
+    fn slot_buffers(memory: &mut [u32]) -> [&mut [u8]; SLOTS] {
+        let words = memory.len() / SLOTS;
+        let mut rest: &mut [u32] = memory;
+        core::array::from_fn(|_| {
+            let (mine, tail) = core::mem::take(&mut rest).split_at_mut(words);
+            rest = tail;
+            bytemuck::cast_slice_mut(mine)
+        })
+    }
+
     /// Reads every flag of `bytes`, peeking before each read when `peek`
     /// says so; returns what was read, up to and including the first error,
     /// and whether the peeks always showed the bits that followed.
     fn read_all(bytes: &[u8], lanes: u8, peeks: &[bool]) -> (Vec<Result<bool, Error>>, bool) {
         let header = LevelHeader::parse(bytes, false, 1 << 16).expect("level header");
-        let words = TABLE_WORDS + LANE_WORDS * lanes as usize;
-        let mut memory = vec![0u32; SLOTS * words.max(1 << 14)];
+        let mut memory = slot_memory(lanes);
         let mut inflater = Inflater::new();
-        let mut rest: &mut [u32] = &mut memory;
-        let buffers: [&mut [u8]; SLOTS] = core::array::from_fn(|_| {
-            let (mine, tail) = core::mem::take(&mut rest).split_at_mut(words.max(1 << 14));
-            rest = tail;
-            bytemuck::cast_slice_mut(mine)
-        });
+        let buffers = slot_buffers(&mut memory);
         let mut subs = Substreams::open(bytes, header, 1, buffers, &mut inflater, lanes);
         let mut out = Vec::new();
         let mut shown: Vec<bool> = Vec::new();
@@ -643,15 +655,9 @@ mod tests {
             prop_assert_eq!(lengths.iter().map(|&l| l as usize).sum::<usize>(), n);
             prop_assert!(lengths.iter().all(|&l| l >= 1 && l <= limit));
             let header = LevelHeader::parse(&bytes, false, 1 << 16).expect("level header");
-            let words = (TABLE_WORDS + LANE_WORDS * lanes as usize).max(1 << 14);
-            let mut memory = vec![0u32; SLOTS * words];
+            let mut memory = slot_memory(lanes);
             let mut inflater = Inflater::new();
-            let mut rest: &mut [u32] = &mut memory;
-            let buffers: [&mut [u8]; SLOTS] = core::array::from_fn(|_| {
-                let (mine, tail) = core::mem::take(&mut rest).split_at_mut(words);
-                rest = tail;
-                bytemuck::cast_slice_mut(mine)
-            });
+            let buffers = slot_buffers(&mut memory);
             let mut subs = Substreams::open(&bytes, header, 1, buffers, &mut inflater, lanes);
             let slot = (substream::EDGE - 1) as usize;
             for (i, &(context, v)) in values.iter().enumerate() {
