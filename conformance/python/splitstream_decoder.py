@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.5 decoder, in Python, written from
+"""A second splitstream 3.6 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
@@ -7,7 +7,8 @@ plane policy `height`, 3.2's wing policies, 3.3's deficit contexts and
 3.4's rANS chunks beyond max_chunk_len were added with the SPEC sections
 that define them; 3.5 added one level header check, level 0's
 seed_triangles above its table entry's triangle_count failing
-count-mismatch before the seed is read.) It speaks the conformance protocol (a stream
+count-mismatch before the seed is read; 3.6's schedule `every-vertex`,
+header flag bit 1, was added with the SPEC sections that define it.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -31,6 +32,8 @@ RANS_SLOT_BYTES = 1856
 NCTX = {1: 1, 2: 8, 3: 8, 4: 1, 5: 5, 6: 3, 7: 5, 8: 3, 9: 1, 10: 1}
 # Under the deficit contexts `valence` (3.3) deficit-p has 5, deficit-c 6.
 NCTX_VALENCE = {**NCTX, 4: 5, 5: 6}
+# Under the schedule `every-vertex` (3.6) flags has 5, by the valence.
+NCTX_EVERY = {**NCTX, 1: 5}
 
 
 class Fail(Exception):
@@ -364,7 +367,7 @@ class Decoder:
         if crc32(s[0:92]) != u32(s, 92):
             raise Fail("checksum-mismatch")
         flags = u16(s, 10)
-        if flags & 0xFFFE:
+        if flags & 0xFFFC:  # bit 1: schedule (3.6)
             raise Fail("malformed")
         if not (1 <= s[12] <= 31):
             raise Fail("malformed")
@@ -390,6 +393,7 @@ class Decoder:
             if not finite(sc) or sc <= 0:
                 raise Fail("malformed")
         self.constrained = flags & 1
+        self.every = (flags >> 1) & 1  # schedule: 0 split-valences, 1 every-vertex (3.6)
         self.bits = s[12]
         self.lane_count = s[13]
         L = u16(s, 14)
@@ -473,6 +477,8 @@ class Decoder:
             raise Fail("malformed")
         if lvl[10] > 1:  # deficit contexts (3.3)
             raise Fail("malformed")
+        if lvl[10] != 0 and self.every:  # no split-valence symbols (3.6)
+            raise Fail("malformed")
         if lvl[11]:
             raise Fail("malformed")
         if li == 0 and (SV == 0 or ST == 0):
@@ -530,7 +536,7 @@ class Decoder:
         subs = {}
         for sid in range(1, 11):
             lst = [(c, rl, crc, bytes(lvl[off:off + sl])) for (c, rl, crc, off, sl) in chunks.get(sid, [])]
-            nctx = (NCTX_VALENCE if lvl[10] == 1 else NCTX)[sid]
+            nctx = (NCTX_EVERY if self.every else NCTX_VALENCE if lvl[10] == 1 else NCTX)[sid]
             subs[sid] = Sub(sid, lst, self.lane_count, nctx)
         self.subs = subs
         self.policy = lvl[8]
@@ -568,7 +574,9 @@ class Decoder:
             tri.append(st.varint(0))
             tri.append(st.varint(0))
         sd = subs[10]
-        deficit = [sd.byte(0) for v in range(V0)]
+        # every-vertex (3.6): base-deficits holds no values; the valences
+        # are set by the validation below (SPEC §6.3)
+        deficit = [0] * V0 if self.every else [sd.byte(0) for v in range(V0)]
         for sid in (8, 9, 10):
             subs[sid].finish()
         # validate
@@ -631,7 +639,9 @@ class Decoder:
                 if steps != cnt or cnt < 3:
                     raise Fail("non-manifold")
                 val = cnt
-            if deficit[v] != LEAF and val + deficit[v] > 255:
+            if self.every:
+                deficit[v] = min(val, 255)  # 3.6: the valence (§6.2)
+            elif deficit[v] != LEAF and val + deficit[v] > 255:
                 raise Fail("valence-overflow")
         self.emit_hash()
 
@@ -675,7 +685,10 @@ class Decoder:
         if n + s > self.vcap:
             raise Fail("capacity-exceeded")
         deficit = self.deficit
-        cand = [v for v in range(n) if deficit[v] == 0]
+        if self.every:  # 3.6: every vertex
+            cand = range(n)
+        else:
+            cand = [v for v in range(n) if deficit[v] == 0]
         candset = set(cand)
         flags = self.subs[1]
         flagged = []
@@ -684,7 +697,10 @@ class Decoder:
         for v in cand:
             if v in blocked:
                 continue
-            if flags.bit(0) == 1:
+            # context 0; every-vertex (3.6): by the valence byte, as at
+            # round start (all flags are read before any split), §5.5.5
+            fctx = min(max(deficit[v], 4), 8) - 4 if self.every else 0
+            if flags.bit(fctx) == 1:
                 flagged.append(v)
                 rg = self.ring(v)
                 rings[v] = rg
@@ -701,7 +717,10 @@ class Decoder:
     def read_record(self, R, ring, candset):
         subs = self.subs
         k = len(ring)
-        E = [i for i in range(k) if ring[i] == GHOST or ring[i] not in candset]
+        if self.every:  # 3.6: every entry is eligible
+            E = list(range(k))
+        else:
+            E = [i for i in range(k) if ring[i] == GHOST or ring[i] not in candset]
         m = len(E)
         ctx = min(max(m, 2), 9) - 2
         op = subs[2].byte(ctx)
@@ -715,16 +734,20 @@ class Decoder:
             o, d = self.near_wings(ring, E, op, dp)
         valP = d + 2
         valC = k - d + 2
-        if self.deficit_contexts == 0:  # plain
-            pctx = 0
-        else:  # valence (3.3)
-            pctx = min(max(valP, 4), 8) - 4
-        dP = self.deficit_of(subs[4].byte(pctx), valP)
-        if self.deficit_contexts == 0:
-            cctx = 4 if dP == LEAF else min(max(valC, 3), 6) - 3
+        if self.every:  # 3.6: nothing read, the bytes are the valences
+            dP = min(valP, 255)
+            dC = min(valC, 255)
         else:
-            cctx = 0 if dP == LEAF else min(max(valC, 4), 8) - 3
-        dC = self.deficit_of(subs[5].byte(cctx), valC)
+            if self.deficit_contexts == 0:  # plain
+                pctx = 0
+            else:  # valence (3.3)
+                pctx = min(max(valP, 4), 8) - 4
+            dP = self.deficit_of(subs[4].byte(pctx), valP)
+            if self.deficit_contexts == 0:
+                cctx = 4 if dP == LEAF else min(max(valC, 3), 6) - 3
+            else:
+                cctx = 0 if dP == LEAF else min(max(valC, 4), 8) - 3
+            dC = self.deficit_of(subs[5].byte(cctx), valC)
         # arc means
         pos = self.pos
         pR = pos[R]
@@ -938,21 +961,26 @@ class Decoder:
         b = ring[o + d]
         valP = d + 2
         valC = k - d + 2
-        if dP != LEAF and valP + dP > 255:
-            raise Fail("valence-overflow")
-        if dC != LEAF and valC + dC > 255:
-            raise Fail("valence-overflow")
         deficit = self.deficit
-        for w in (a, b):
-            if w != GHOST and deficit[w] == 0:
+        if not self.every:  # no check under every-vertex (3.6)
+            if dP != LEAF and valP + dP > 255:
                 raise Fail("valence-overflow")
+            if dC != LEAF and valC + dC > 255:
+                raise Fail("valence-overflow")
+            for w in (a, b):
+                if w != GHOST and deficit[w] == 0:
+                    raise Fail("valence-overflow")
         added = (a != GHOST) + (b != GHOST)
         if self.T + added > self.T_l:
             raise Fail("count-mismatch")
         if self.V + 1 > self.vcap or self.T + added > self.tcap:
             raise Fail("capacity-exceeded")
         for w in (a, b):
-            if w != GHOST and deficit[w] != LEAF:
+            if w == GHOST:
+                continue
+            if self.every:  # 3.6: the wing's valence grows by 1
+                deficit[w] = min(deficit[w] + 1, 255)
+            elif deficit[w] != LEAF:
                 deficit[w] -= 1
         tri = self.tri
         vtri = self.vtri

@@ -176,7 +176,7 @@ fn pieces(stream: &[u8], broken: bool, hashes: &mut Vec<u64>) -> Result<(), Erro
     let len = usize::try_from(layout.bytes_unaligned()).map_err(|_| Error::CapacityExceeded)?;
     let mut workspace = vec![0u8; len];
     let (memory, mut buffers) = layout.carve(&mut workspace)?;
-    let mut state = MeshState::new(memory, header.bits);
+    let mut state = MeshState::new(memory, header.bits, header.schedule);
     let mut inflater = Box::new(Inflater::new());
     let mut ring = Box::new(Ring::default());
     for k in 0..header.level_count {
@@ -187,7 +187,7 @@ fn pieces(stream: &[u8], broken: bool, hashes: &mut Vec<u64>) -> Result<(), Erro
             .ok_or(Error::Truncated)?;
         // SPEC §5.1: the level header against the table entry.
         let is_base = k == 0;
-        let level_header = table.level_header(k, bytes, header.max_chunk_len)?;
+        let level_header = table.level_header(k, bytes, header.max_chunk_len, header.schedule)?;
         // SPEC §7.6: no split may take the level past its triangle count.
         state.set_triangle_limit(info.triangle_count);
         let rounds = level_header.round_count;

@@ -8,6 +8,7 @@
 //! end.
 
 use crate::Error;
+use crate::header::Schedule;
 use crate::limits::{LEAF, MAX_SPLIT_VALENCE, NONE};
 use crate::state::{MeshState, next, prev};
 
@@ -21,7 +22,9 @@ impl MeshState<'_> {
 
     /// Starts the state as a base mesh whose positions, triangles and
     /// deficits the caller has already written through [`MeshState::base_arrays`],
-    /// then validates it and builds the adjacency (SPEC §6.3).
+    /// then validates it and builds the adjacency (SPEC §6.3). Under the
+    /// schedule `every-vertex` the deficits are not read: each vertex's
+    /// byte becomes its valence.
     pub fn finish_base(&mut self, vertices: u32, triangles: u32) -> Result<(), Error> {
         let nv = vertices as usize;
         let nt = triangles as usize;
@@ -100,6 +103,11 @@ impl MeshState<'_> {
             let count = start[v + 1] - start[v];
             let valence = fan_valence(opposite, self.vertex_corner.get(v as u32), count)
                 .ok_or(Error::NonManifold("a vertex has more than one fan"))?;
+            if self.schedule == Schedule::EveryVertex {
+                // 3.6: the byte holds the valence (SPEC §6.2, §6.3).
+                self.deficit[v] = valence.min(MAX_SPLIT_VALENCE) as u8;
+                continue;
+            }
             let deficit = self.deficit[v];
             if deficit != LEAF && valence + deficit as usize > MAX_SPLIT_VALENCE {
                 return Err(Error::ValenceOverflow);

@@ -2,6 +2,7 @@
 //! value is coded with, from what the decoder already knows. Encoders call
 //! the same functions, so both sides agree by construction.
 
+use crate::header::Schedule;
 use crate::limits::{LEAF, substream};
 use crate::predict::{ArcMeans, PlanePolicy, placement_context};
 
@@ -42,12 +43,29 @@ impl DeficitContexts {
 }
 
 /// Number of contexts (frequency tables per rANS chunk) of substream `id`
-/// in a level whose deficit contexts are `deficits` (SPEC §5.5.5).
-pub fn count(id: u8, deficits: DeficitContexts) -> usize {
-    match (id, deficits) {
-        (substream::DEFICIT_P, DeficitContexts::Valence) => 5,
-        (substream::DEFICIT_C, DeficitContexts::Valence) => 6,
+/// in a level whose deficit contexts are `deficits`, in a stream of
+/// schedule `schedule` (SPEC §5.3, §5.5.5).
+pub fn count(id: u8, deficits: DeficitContexts, schedule: Schedule) -> usize {
+    match (id, deficits, schedule) {
+        (substream::FLAGS, _, Schedule::EveryVertex) => FLAG_CONTEXTS,
+        (substream::DEFICIT_P, DeficitContexts::Valence, _) => 5,
+        (substream::DEFICIT_C, DeficitContexts::Valence, _) => 6,
         _ => substream::CONTEXTS.get(id as usize).copied().unwrap_or(0) as usize,
+    }
+}
+
+/// Contexts of the flags under the schedule `every-vertex` (SPEC §5.5.5).
+pub const FLAG_CONTEXTS: usize = 5;
+
+/// The flag of a vertex whose state byte is `byte` (SPEC §5.5.5, §7.3):
+/// under `every-vertex` the byte is the vertex's valence (capped at 255),
+/// and the context its valence 4 (or less) … 8 (or more) as 0..=4; under
+/// `split-valences`, 0.
+#[inline]
+pub fn flag(schedule: Schedule, byte: u8) -> u8 {
+    match schedule {
+        Schedule::SplitValences => SINGLE,
+        Schedule::EveryVertex => byte.clamp(4, 8) - 4,
     }
 }
 
@@ -120,8 +138,8 @@ mod tests {
     fn deficit_contexts_stay_below_the_table_count() {
         for set in DeficitContexts::ALL {
             let (p_tables, c_tables) = (
-                count(substream::DEFICIT_P, set),
-                count(substream::DEFICIT_C, set),
+                count(substream::DEFICIT_P, set, Schedule::SplitValences),
+                count(substream::DEFICIT_C, set, Schedule::SplitValences),
             );
             assert!(p_tables <= MAX_CONTEXTS && c_tables <= MAX_CONTEXTS);
             let mut p_seen = [false; MAX_CONTEXTS];

@@ -126,7 +126,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
         };
         let (memory, buffers) = layout.carve(workspace)?;
         Ok(Decoder {
-            state: MeshState::new(memory, header.bits),
+            state: MeshState::new(memory, header.bits, header.schedule),
             header,
             table,
             buffers,
@@ -223,10 +223,12 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
             });
         }
         let info = self.table.get(level);
-        let header = match self
-            .table
-            .level_header(level, bytes, self.header.max_chunk_len)
-        {
+        let header = match self.table.level_header(
+            level,
+            bytes,
+            self.header.max_chunk_len,
+            self.header.schedule,
+        ) {
             Ok(h) => h,
             Err(e) => {
                 self.poisoned = true;

@@ -13,7 +13,7 @@ use alloc::vec::Vec;
 
 use crate::Error;
 use crate::context::{self, DeficitContexts};
-use crate::header::PositionMode;
+use crate::header::{PositionMode, Schedule};
 use crate::limits::LEAF;
 use crate::owned::decode_all;
 use crate::predict::PlanePolicy;
@@ -35,6 +35,7 @@ pub fn params(codec: ChunkCodec) -> StreamParams {
         codec,
         chunk_limit: 4,
         rans_chunk_limit: 4,
+        schedule: Schedule::SplitValences,
     }
 }
 

@@ -17,11 +17,39 @@ pub enum PositionMode {
     Constrained,
 }
 
+/// How a stream says which vertices split in which round (SPEC §3.2 header
+/// flag bit 1, §6.2, §7.3; format 3.6).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Schedule {
+    /// The paper's: every vertex carries a split valence, coded when it is
+    /// created, and the candidates of a round are the vertices whose
+    /// valence has grown back to it (formats 3.0 to 3.5).
+    #[default]
+    SplitValences,
+    /// 3.6: no split valences; every vertex is a candidate of every round
+    /// and gets a flag, in a context by its valence, unless a flagged
+    /// neighbour blocks it. The state keeps each vertex's valence (capped at
+    /// 255) where `SplitValences` keeps its deficit.
+    EveryVertex,
+}
+
+impl Schedule {
+    /// The name `splitstream info` and the SPEC use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Schedule::SplitValences => "split-valences",
+            Schedule::EveryVertex => "every-vertex",
+        }
+    }
+}
+
 /// The parsed header (SPEC §3.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Header {
     pub version_minor: u8,
     pub position_mode: PositionMode,
+    /// Which vertices split in which round (header flag bit 1, 3.6).
+    pub schedule: Schedule,
     /// Quantization bits per axis: coordinates lie in `0 .. 2^bits`.
     pub bits: u8,
     /// Entries in the level table; entry 0 is the base mesh.
@@ -64,13 +92,18 @@ impl Header {
             return Err(Error::ChecksumMismatch(ChecksumScope::Header));
         }
         let flags = u16_at(bytes, 10)?;
-        if flags & !1 != 0 {
+        if flags & !3 != 0 {
             return Err(Error::InvalidHeader("reserved flag bits set"));
         }
         let position_mode = if flags & 1 == 0 {
             PositionMode::Optimal
         } else {
             PositionMode::Constrained
+        };
+        let schedule = if flags & 2 == 0 {
+            Schedule::SplitValences
+        } else {
+            Schedule::EveryVertex
         };
         let bits = u8_at(bytes, 12)?;
         if !(MIN_BITS..=MAX_BITS).contains(&bits) {
@@ -115,6 +148,7 @@ impl Header {
         let header = Header {
             version_minor: minor,
             position_mode,
+            schedule,
             bits,
             lane_count,
             level_count,
@@ -135,10 +169,15 @@ impl Header {
         out[..8].copy_from_slice(&MAGIC);
         out[8] = VERSION_MAJOR;
         out[9] = self.version_minor;
-        let flags: u16 = match self.position_mode {
+        let mode: u16 = match self.position_mode {
             PositionMode::Optimal => 0,
             PositionMode::Constrained => 1,
         };
+        let schedule: u16 = match self.schedule {
+            Schedule::SplitValences => 0,
+            Schedule::EveryVertex => 2,
+        };
+        let flags = mode | schedule;
         out[10..12].copy_from_slice(&flags.to_le_bytes());
         out[12] = self.bits;
         out[13] = self.lane_count;

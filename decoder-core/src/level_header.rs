@@ -3,6 +3,7 @@
 
 use crate::bytes::{crc32, u8_at, u16_at, u32_at};
 use crate::context::DeficitContexts;
+use crate::header::Schedule;
 use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
 use crate::predict::PlanePolicy;
 use crate::wing_order::WingPolicy;
@@ -45,6 +46,10 @@ pub struct LevelHeader<'l> {
     pub deficit_contexts: DeficitContexts,
     deficit_byte: u8,
     reserved: u8,
+    /// The stream's schedule (SPEC §3.2, 3.6): it sets how many contexts
+    /// the flags substream has, and forbids deficit contexts other than
+    /// `plain` under `every-vertex`.
+    pub schedule: Schedule,
     /// Level 0 only: vertex and triangle counts of the seed mesh its rounds
     /// start from (SPEC §5.1, §6.3); `(0, 0)` for other levels.
     pub seed_vertices: u32,
@@ -57,9 +62,15 @@ pub struct LevelHeader<'l> {
 }
 
 impl<'l> LevelHeader<'l> {
-    /// Parses and validates the level header of `level` (SPEC §5.1).
+    /// Parses and validates the level header of `level` (SPEC §5.1) of a
+    /// stream with the given `max_chunk_len` and schedule (SPEC §3.2).
     /// `is_base` selects which substream ids are allowed.
-    pub fn parse(level: &'l [u8], is_base: bool, max_chunk_len: u32) -> Result<Self, Error> {
+    pub fn parse(
+        level: &'l [u8],
+        is_base: bool,
+        max_chunk_len: u32,
+        schedule: Schedule,
+    ) -> Result<Self, Error> {
         let round_count = u32_at(level, 0)?;
         let chunk_count = u32_at(level, 4)?;
         let counts_at = split_counts_at(is_base);
@@ -100,6 +111,7 @@ impl<'l> LevelHeader<'l> {
                 .unwrap_or(DeficitContexts::Plain),
             deficit_byte,
             reserved,
+            schedule,
             seed_vertices,
             seed_triangles,
             split_counts: &level[counts_at..dir_start],
@@ -120,6 +132,11 @@ impl<'l> LevelHeader<'l> {
         }
         if DeficitContexts::from_byte(self.deficit_byte).is_none() {
             return Err(Error::InvalidLevelHeader("unknown deficit contexts"));
+        }
+        if self.schedule == Schedule::EveryVertex && self.deficit_byte != 0 {
+            return Err(Error::InvalidLevelHeader(
+                "deficit contexts other than plain under the schedule every-vertex",
+            ));
         }
         if self.reserved != 0 {
             return Err(Error::InvalidLevelHeader(

@@ -63,7 +63,7 @@ pub use corner_refs::CornerRefs;
 pub use decoder::{Decoder, LevelDecoder, RoundInfo, SplitObserver, declared_layout, layout_for};
 pub use error::{ChecksumScope, Error};
 pub use hash::Fnv1a;
-pub use header::{Header, PositionMode};
+pub use header::{Header, PositionMode, Schedule};
 pub use inflate::Inflater;
 pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader};

@@ -275,14 +275,6 @@ impl<'b> ChunkDecoder<'b> {
     /// (§5.5.1, §5.5.4); `bytes` are the level's.
     #[inline(always)]
     pub fn decode(&mut self, bytes: &[u8], context: usize) -> Result<u32, Error> {
-        // Contexts are below MAX_CONTEXTS (a power of two) by construction.
-        let context = context & (MAX_CONTEXTS - 1);
-        let n = self.tokens[context] as usize;
-        if n == 0 {
-            return Err(Error::InvalidRansChunk(
-                "value in a context without a table",
-            ));
-        }
         // lane < lane_count <= MAX_LANES, a power of two.
         let lane = &mut self.lanes[self.lane & (MAX_LANES as usize - 1)];
         self.lane = if self.lane + 1 >= self.lane_count {
@@ -290,42 +282,110 @@ impl<'b> ChunkDecoder<'b> {
         } else {
             self.lane + 1
         };
-        let cum = &self.cums[context];
-        let mut x = lane[0];
-        let slot = x & (PROB_SCALE - 1);
-        // The token t with cum[t] <= slot < cum[t + 1]: the bucket names the
-        // token of its first slot; a bucket spanning several tokens is
-        // scanned forward (cum[n] and the entries after it exceed every
-        // slot, so the scan stops below n).
-        let mut t = self.buckets[context][(slot >> BUCKET_BITS) as usize] as usize;
-        while t + 1 < CUM_LEN && cum[t + 1] as u32 <= slot {
-            t += 1;
-        }
-        if t + 1 >= CUM_LEN {
-            return Err(Error::InvalidRansChunk("slot beyond the table"));
-        }
-        let start = cum[t] as u32;
-        let freq = cum[t + 1] as u32 - start;
-        x = freq * (x >> PROB_BITS) + slot - start;
-        renormalise(bytes, lane, &mut x)?;
-        let token = t as u32;
-        let extra = token_bits(token);
-        if extra == 0 {
-            lane[0] = x;
-            return Ok(token);
-        }
-        let mut low = 0u32;
-        let mut done = 0;
-        while done < extra {
-            let step = (extra - done).min(RAW_BITS_STEP);
-            low |= (x & ((1 << step) - 1)) << done;
-            x >>= step;
-            renormalise(bytes, lane, &mut x)?;
-            done += step;
-        }
-        lane[0] = x;
-        Ok((1 << extra) | low)
+        decode_in(
+            Tables {
+                tokens: &self.tokens,
+                cums: self.cums,
+                buckets: self.buckets,
+            },
+            lane,
+            bytes,
+            context,
+        )
     }
+
+    /// The next bits as [`ChunkDecoder::decode`] would give them in
+    /// `contexts`, one context per value, without consuming anything: `(bits,
+    /// count)`, bit i the i-th next value, `count` at most 64 and at most
+    /// `remaining` (the values left in the chunk), and nothing from a value
+    /// that is not a bit or fails. Works on copies of the lanes.
+    pub fn peek_bits(&self, bytes: &[u8], contexts: &[u8], remaining: usize) -> (u64, u32) {
+        let mut lanes = [[0u32; LANE_WORDS]; MAX_LANES as usize];
+        let count = self.lane_count.min(MAX_LANES as usize);
+        lanes[..count].copy_from_slice(&self.lanes[..count]);
+        let tables = Tables {
+            tokens: &self.tokens,
+            cums: self.cums,
+            buckets: self.buckets,
+        };
+        let mut lane = self.lane;
+        let (mut bits, mut known) = (0u64, 0u32);
+        for &context in contexts.iter().take(remaining.min(64)) {
+            let l = &mut lanes[lane & (MAX_LANES as usize - 1)];
+            lane = if lane + 1 >= self.lane_count {
+                0
+            } else {
+                lane + 1
+            };
+            match decode_in(tables, l, bytes, context as usize) {
+                Ok(v @ (0 | 1)) => bits |= (v as u64) << known,
+                _ => break,
+            }
+            known += 1;
+        }
+        (bits, known)
+    }
+}
+
+/// A chunk's tables, as [`decode_in`] reads them.
+#[derive(Clone, Copy)]
+struct Tables<'a> {
+    tokens: &'a [u8; MAX_CONTEXTS],
+    cums: &'a [[u16; CUM_LEN]; MAX_CONTEXTS],
+    buckets: &'a [[u8; BUCKETS]; MAX_CONTEXTS],
+}
+
+/// Decodes one value in `context` from `lane` (§5.5.1, §5.5.4).
+#[inline(always)]
+fn decode_in(
+    tables: Tables<'_>,
+    lane: &mut [u32; LANE_WORDS],
+    bytes: &[u8],
+    context: usize,
+) -> Result<u32, Error> {
+    // Contexts are below MAX_CONTEXTS (a power of two) by construction.
+    let context = context & (MAX_CONTEXTS - 1);
+    let n = tables.tokens[context] as usize;
+    if n == 0 {
+        return Err(Error::InvalidRansChunk(
+            "value in a context without a table",
+        ));
+    }
+    let cum = &tables.cums[context];
+    let mut x = lane[0];
+    let slot = x & (PROB_SCALE - 1);
+    // The token t with cum[t] <= slot < cum[t + 1]: the bucket names the
+    // token of its first slot; a bucket spanning several tokens is
+    // scanned forward (cum[n] and the entries after it exceed every
+    // slot, so the scan stops below n).
+    let mut t = tables.buckets[context][(slot >> BUCKET_BITS) as usize] as usize;
+    while t + 1 < CUM_LEN && cum[t + 1] as u32 <= slot {
+        t += 1;
+    }
+    if t + 1 >= CUM_LEN {
+        return Err(Error::InvalidRansChunk("slot beyond the table"));
+    }
+    let start = cum[t] as u32;
+    let freq = cum[t + 1] as u32 - start;
+    x = freq * (x >> PROB_BITS) + slot - start;
+    renormalise(bytes, lane, &mut x)?;
+    let token = t as u32;
+    let extra = token_bits(token);
+    if extra == 0 {
+        lane[0] = x;
+        return Ok(token);
+    }
+    let mut low = 0u32;
+    let mut done = 0;
+    while done < extra {
+        let step = (extra - done).min(RAW_BITS_STEP);
+        low |= (x & ((1 << step) - 1)) << done;
+        x >>= step;
+        renormalise(bytes, lane, &mut x)?;
+        done += step;
+    }
+    lane[0] = x;
+    Ok((1 << extra) | low)
 }
 
 /// Pulls bytes into the state `x` of `lane` until it is normalised again.

@@ -2,7 +2,7 @@
 
 use crate::Error;
 use crate::context::{self, DeficitContexts, SINGLE};
-use crate::header::PositionMode;
+use crate::header::{PositionMode, Schedule};
 use crate::limits::MAX_SPLIT_VALENCE;
 use crate::limits::substream::{self, SLOTS};
 use crate::predict::{
@@ -40,6 +40,8 @@ pub struct StreamSource<'s, 'l, 'b> {
     pub wings: WingPolicy,
     /// The level's deficit contexts (SPEC §5.1, 3.3).
     pub deficits: DeficitContexts,
+    /// The stream's schedule (SPEC §3.2, 3.6).
+    pub schedule: Schedule,
     /// The current ring's near keys, under a near wing policy.
     keys: NearKeys,
 }
@@ -51,12 +53,14 @@ impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
         let plane = subs.level_header().plane_policy;
         let wings = subs.level_header().wing_policy;
         let deficits = subs.level_header().deficit_contexts;
+        let schedule = subs.level_header().schedule;
         StreamSource {
             subs,
             mode,
             plane,
             wings,
             deficits,
+            schedule,
             keys: [0; MAX_SPLIT_VALENCE],
         }
     }
@@ -81,21 +85,45 @@ impl StreamSource<'_, '_, '_> {
             plane: self.plane,
             wings: self.wings,
             deficits: self.deficits,
+            schedule: self.schedule,
         }
     }
 }
 
 impl RecordSource for StreamSource<'_, '_, '_> {
+    /// SPEC §7.3: one context, or under `every-vertex` the vertex's
+    /// valence at the start of the round (§5.5.5).
     #[inline]
-    fn flag(&mut self, _state: &MeshState<'_>, _v: u32) -> Result<bool, Error> {
-        self.subs.bit(slot(substream::FLAGS), SINGLE)
+    fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
+        let context = match self.schedule {
+            Schedule::SplitValences => SINGLE,
+            Schedule::EveryVertex => context::flag(
+                self.schedule,
+                state.deficits().get(v as usize).copied().unwrap_or(0),
+            ),
+        };
+        self.subs.bit(slot(substream::FLAGS), context)
     }
 
     #[inline]
-    fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
         // The next flags of the stream, as far as the loaded chunk shows
-        // them; the candidates past them are all taken as likely.
-        let (bits, known) = self.subs.peek_bits(slot(substream::FLAGS), SINGLE);
+        // them; the candidates past them are all taken as likely. Under
+        // `every-vertex` each is peeked in its vertex's context, as if no
+        // upcoming vertex blocked a later one (a hint only).
+        let (bits, known) = match self.schedule {
+            Schedule::SplitValences => self.subs.peek_bits(slot(substream::FLAGS), SINGLE),
+            Schedule::EveryVertex => {
+                let mut contexts = [0u8; 64];
+                let n = upcoming.len().min(64);
+                for (c, &v) in contexts.iter_mut().zip(&upcoming[..n]) {
+                    let byte = state.deficits().get(v as usize).copied().unwrap_or(0);
+                    *c = context::flag(self.schedule, byte);
+                }
+                self.subs
+                    .peek_bits_in(slot(substream::FLAGS), &contexts[..n])
+            }
+        };
         bits & all_ones(known as usize) | !all_ones(known as usize) & all_ones(upcoming.len())
     }
 
@@ -126,6 +154,7 @@ pub(crate) struct RecordCoding {
     pub(crate) plane: PlanePolicy,
     pub(crate) wings: WingPolicy,
     pub(crate) deficits: DeficitContexts,
+    pub(crate) schedule: Schedule,
 }
 
 /// What a split record is read against (SPEC §7.4): the positions, R and
@@ -170,21 +199,31 @@ pub(crate) fn read_record(
         }
     };
     let (valence_p, valence_c) = (d + 2, k - d + 2);
-    let contexts = coding.deficits;
-    let deficit_p = deficit_of(
-        s.byte(
-            slot(substream::DEFICIT_P),
-            context::deficit_p(contexts, valence_p),
-        )?,
-        valence_p,
-    )?;
-    let deficit_c = deficit_of(
-        s.byte(
-            slot(substream::DEFICIT_C),
-            context::deficit_c(contexts, deficit_p, valence_c),
-        )?,
-        valence_c,
-    )?;
+    let (deficit_p, deficit_c) = match coding.schedule {
+        // 3.6: no split valences; the bytes are the valences (SPEC §7.4).
+        Schedule::EveryVertex => (
+            valence_p.min(MAX_SPLIT_VALENCE) as u8,
+            valence_c.min(MAX_SPLIT_VALENCE) as u8,
+        ),
+        Schedule::SplitValences => {
+            let contexts = coding.deficits;
+            let deficit_p = deficit_of(
+                s.byte(
+                    slot(substream::DEFICIT_P),
+                    context::deficit_p(contexts, valence_p),
+                )?,
+                valence_p,
+            )?;
+            let deficit_c = deficit_of(
+                s.byte(
+                    slot(substream::DEFICIT_C),
+                    context::deficit_c(contexts, deficit_p, valence_c),
+                )?,
+                valence_c,
+            )?;
+            (deficit_p, deficit_c)
+        }
+    };
     let parent = *positions.get(r as usize).ok_or(Error::CapacityExceeded)?;
     let means = arc_means(positions, parent, ring, o, d);
     let plane = Plane::new(coding.plane, &means);
@@ -248,6 +287,9 @@ pub fn read_base(
         return Err(Error::CapacityExceeded);
     }
     let bits = state.bits();
+    // Under `every-vertex` base-deficits holds nothing: `finish_base` sets
+    // each byte to the vertex's valence (SPEC §6.3, 3.6).
+    let schedule = state.schedule();
     let (positions, corners, deficits) = state.base_arrays();
     let mut previous = [0i64; 3];
     for p in &mut positions[..vertices as usize] {
@@ -259,8 +301,10 @@ pub fn read_base(
     for c in &mut corners[..3 * triangles as usize] {
         *c = subs.varint(base_slot(substream::BASE_TRIANGLES), SINGLE)?;
     }
-    for d in &mut deficits[..vertices as usize] {
-        *d = subs.byte(base_slot(substream::BASE_DEFICITS), SINGLE)?;
+    if schedule == Schedule::SplitValences {
+        for d in &mut deficits[..vertices as usize] {
+            *d = subs.byte(base_slot(substream::BASE_DEFICITS), SINGLE)?;
+        }
     }
     subs.finish()?;
     state.finish_base(vertices, triangles)

@@ -1,6 +1,7 @@
 //! Applying one vertex split (SPEC §7.4, §7.5).
 
 use crate::Error;
+use crate::header::Schedule;
 use crate::limits::{LEAF, MAX_SPLIT_VALENCE, NONE};
 use crate::ring::Ring;
 use crate::state::{MeshState, next, prev};
@@ -13,9 +14,12 @@ pub struct SplitRecord {
     pub wing_offset: u8,
     /// Ring distance from the first wing to the second, `b = r_{o+d}`.
     pub wing_distance: u8,
-    /// Deficit of P right after the split, or [`LEAF`].
+    /// Deficit of P right after the split, or [`LEAF`]. Under the schedule
+    /// `every-vertex` (format 3.6), P's valence right after the split,
+    /// capped at 255 (the split sets it from the ring whatever this says).
     pub deficit_p: u8,
-    /// Deficit of C right after the split, or [`LEAF`].
+    /// Deficit of C right after the split, or [`LEAF`]; under
+    /// `every-vertex`, C's valence (as for P).
     pub deficit_c: u8,
     pub position_p: [u32; 3],
     pub position_c: [u32; 3],
@@ -55,14 +59,19 @@ impl MeshState<'_> {
         let (len_p, len_c) = (d, k - d);
         let valence_p = len_p + 2;
         let valence_c = len_c + 2;
-        for (deficit, valence) in [(rec.deficit_p, valence_p), (rec.deficit_c, valence_c)] {
-            if deficit != LEAF && valence + deficit as usize > MAX_SPLIT_VALENCE {
-                return Err(Error::ValenceOverflow);
+        let every_vertex = self.schedule == Schedule::EveryVertex;
+        // Under `every-vertex` no vertex has a split valence to overflow
+        // (SPEC §7.5, 3.6).
+        if !every_vertex {
+            for (deficit, valence) in [(rec.deficit_p, valence_p), (rec.deficit_c, valence_c)] {
+                if deficit != LEAF && valence + deficit as usize > MAX_SPLIT_VALENCE {
+                    return Err(Error::ValenceOverflow);
+                }
             }
-        }
-        for w in [a, b] {
-            if w != NONE && self.deficit[w as usize] == 0 {
-                return Err(Error::ValenceOverflow);
+            for w in [a, b] {
+                if w != NONE && self.deficit[w as usize] == 0 {
+                    return Err(Error::ValenceOverflow);
+                }
             }
         }
         let limit = 1u64 << self.bits;
@@ -90,7 +99,13 @@ impl MeshState<'_> {
 
         // From here on nothing can fail.
         for w in [a, b] {
-            if w != NONE && self.deficit[w as usize] != LEAF {
+            if every_vertex {
+                // The wing gains a neighbour: its valence grows by one.
+                if w != NONE {
+                    let byte = &mut self.deficit[w as usize];
+                    *byte = byte.saturating_add(1);
+                }
+            } else if w != NONE && self.deficit[w as usize] != LEAF {
                 self.deficit[w as usize] -= 1;
                 // A wing reaching deficit 0 is a candidate from the next
                 // round on (the round's candidates were fixed at its start).
@@ -164,10 +179,18 @@ impl MeshState<'_> {
         self.vertex_corner.set(c, corner_y);
         self.positions[r as usize] = rec.position_p;
         self.positions[c as usize] = rec.position_c;
-        self.deficit[r as usize] = rec.deficit_p;
-        self.deficit[c as usize] = rec.deficit_c;
-        self.set_candidate(r, rec.deficit_p);
-        self.set_candidate(c, rec.deficit_c);
+        let (byte_p, byte_c) = if every_vertex {
+            (
+                valence_p.min(MAX_SPLIT_VALENCE) as u8,
+                valence_c.min(MAX_SPLIT_VALENCE) as u8,
+            )
+        } else {
+            (rec.deficit_p, rec.deficit_c)
+        };
+        self.deficit[r as usize] = byte_p;
+        self.deficit[c as usize] = byte_c;
+        self.set_candidate(r, byte_p);
+        self.set_candidate(c, byte_c);
         self.vertex_count += 1;
         self.triangle_count = next_t;
         Ok(SplitOutcome {

@@ -12,6 +12,7 @@
 //! of walking rings quickly.
 
 use crate::corner_refs::CornerRefs;
+use crate::header::Schedule;
 use crate::limits::LEAF;
 
 /// Whether `x` is a multiple of 3: multiplying by the inverse of 3 modulo
@@ -64,6 +65,10 @@ pub struct MeshState<'ws> {
     vertex_capacity: u32,
     triangle_capacity: u32,
     pub(crate) bits: u8,
+    /// Which vertices are candidates, and what `deficit` holds (SPEC §6.2,
+    /// format 3.6): deficits under `SplitValences`, valences under
+    /// `EveryVertex`.
+    pub(crate) schedule: Schedule,
 }
 
 /// The caller-owned arrays a [`MeshState`] lives in (see [`crate::Layout`]).
@@ -86,8 +91,10 @@ pub struct StateMemory<'ws> {
 }
 
 impl<'ws> MeshState<'ws> {
-    /// An empty state over `memory`, for coordinates of `bits` bits.
-    pub fn new(memory: StateMemory<'ws>, bits: u8) -> MeshState<'ws> {
+    /// An empty state over `memory`, for coordinates of `bits` bits and the
+    /// stream's schedule (SPEC §3.2: which vertices are candidates and what
+    /// the per-vertex byte holds, §6.2).
+    pub fn new(memory: StateMemory<'ws>, bits: u8, schedule: Schedule) -> MeshState<'ws> {
         let StateMemory {
             positions,
             corners,
@@ -119,7 +126,13 @@ impl<'ws> MeshState<'ws> {
             vertex_capacity,
             triangle_capacity,
             bits,
+            schedule,
         }
+    }
+
+    /// The stream's schedule ([`MeshState::new`]).
+    pub fn schedule(&self) -> Schedule {
+        self.schedule
     }
 
     pub fn vertex_count(&self) -> u32 {
@@ -173,8 +186,11 @@ impl<'ws> MeshState<'ws> {
         &self.corners[..3 * self.triangle_count as usize]
     }
 
-    /// Valence deficit of every vertex: split valence minus current valence,
-    /// or [`LEAF`] for a vertex that never splits again (SPEC §6.2).
+    /// The byte SPEC §6.2 keeps per vertex, which the state hash covers
+    /// (§8). Under the schedule `split-valences`, the valence deficit: split
+    /// valence minus current valence, or [`LEAF`] for a vertex that never
+    /// splits again. Under `every-vertex` (format 3.6), the valence, capped
+    /// at 255.
     pub fn deficits(&self) -> &[u8] {
         &self.deficit[..self.vertex_count as usize]
     }
@@ -212,7 +228,9 @@ impl<'ws> MeshState<'ws> {
 
     /// Whether `v` is a leaf (`false` for a vertex that does not exist).
     pub fn is_leaf(&self, v: u32) -> bool {
-        v < self.vertex_count && self.deficit[v as usize] == LEAF
+        self.schedule == Schedule::SplitValences
+            && v < self.vertex_count
+            && self.deficit[v as usize] == LEAF
     }
 
     /// The candidate, round-start candidate and blocked bitmaps (SPEC §7.3, §7.4).
@@ -223,12 +241,13 @@ impl<'ws> MeshState<'ws> {
         (candidates, flagged, blocked)
     }
 
-    /// Records whether `v` is a candidate (deficit 0) for the next round.
+    /// Records whether `v` is a candidate for the next round: its deficit
+    /// is 0, or the schedule is `every-vertex` (SPEC §6.2).
     #[inline]
     pub(crate) fn set_candidate(&mut self, v: u32, deficit: u8) {
         let word = &mut self.candidates[(v / 64) as usize];
         let bit = 1u64 << (v % 64);
-        if deficit == 0 {
+        if deficit == 0 || self.schedule == Schedule::EveryVertex {
             *word |= bit;
         } else {
             *word &= !bit;

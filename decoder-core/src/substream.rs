@@ -15,7 +15,7 @@ use crate::level_header::LevelHeader;
 use crate::limits::codec;
 use crate::limits::substream::SLOTS;
 use crate::rans::ChunkDecoder;
-use crate::{ChecksumScope, Error, bytes::crc32};
+use crate::{ChecksumScope, Error, Schedule, bytes::crc32};
 
 struct Reader<'b> {
     id: u8,
@@ -191,7 +191,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
         }
         let raw = e.raw_len as usize;
         if r.rans {
-            let contexts = context::count(r.id, self.header.deficit_contexts);
+            let contexts = context::count(r.id, self.header.deficit_contexts, self.header.schedule);
             open_rans_chunk(self.level, r, e.stored_len as usize, e.raw_len, contexts)?;
         } else {
             let out = r.buf.get_mut(..raw).ok_or(Error::CapacityExceeded)?;
@@ -261,6 +261,15 @@ impl<'l, 'b> Substreams<'l, 'b> {
     #[inline]
     pub fn bit(&mut self, slot: usize, context: u8) -> Result<bool, Error> {
         if self.is_rans(slot) {
+            if self.header.schedule == Schedule::EveryVertex {
+                // Each flag has its own context (SPEC §5.5.5, 3.6): no
+                // decoding ahead in one.
+                let v = self.rans_value(slot, context)?;
+                return match v {
+                    0 | 1 => Ok(v == 1),
+                    _ => Err(Error::ValueOutOfRange(self.readers[slot].id)),
+                };
+            }
             if self.readers[slot].ahead_len == 0 {
                 if let Some(e) = self.readers[slot].ahead_error {
                     return Err(e);
@@ -331,10 +340,40 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// `count` may be 0. A decoder uses it to look ahead, never to decide.
     pub fn peek_bits(&mut self, slot: usize, context: u8) -> (u64, u32) {
         if self.is_rans(slot) {
+            if self.header.schedule == Schedule::EveryVertex {
+                // Contexts differ from flag to flag: see `peek_bits_in`.
+                return (0, 0);
+            }
             self.decode_bits_ahead(slot, context);
             let r = &self.readers[slot];
             return (r.ahead, r.ahead_len);
         }
+        self.peek_byte_bits(slot)
+    }
+
+    /// [`Substreams::peek_bits`] for bits read each in its own context,
+    /// `contexts[i]` for the i-th next one (the flags under the schedule
+    /// `every-vertex`, SPEC §5.5.5): decoded from copies of the current rANS
+    /// chunk's lanes, so nothing is consumed and nothing is loaded (`count`
+    /// is 0 at a chunk's end). A decoder uses it to look ahead, never to
+    /// decide.
+    pub fn peek_bits_in(&mut self, slot: usize, contexts: &[u8]) -> (u64, u32) {
+        if !self.is_rans(slot) {
+            return self.peek_byte_bits(slot);
+        }
+        let r = &self.readers[slot];
+        if r.ahead_len > 0 || r.ahead_error.is_some() {
+            // Bits decoded ahead in one context: not this reader's way.
+            return (0, 0);
+        }
+        match r.chunk.as_ref() {
+            Some(chunk) if r.pos < r.len => chunk.peek_bits(self.level, contexts, r.len - r.pos),
+            _ => (0, 0),
+        }
+    }
+
+    /// The next bits of a byte-codec bit substream, unconsumed.
+    fn peek_byte_bits(&self, slot: usize) -> (u64, u32) {
         let r = &self.readers[slot];
         let (mut bits, mut count) = if r.bit_index < 8 {
             ((r.bit_byte >> r.bit_index) as u64, 8 - r.bit_index as u32)
@@ -451,6 +490,7 @@ mod tests {
             codec,
             chunk_limit: chunk,
             rans_chunk_limit: chunk,
+            schedule: crate::Schedule::SplitValences,
         };
         frame_level(&payload, None, &params).bytes
     }
@@ -477,7 +517,8 @@ mod tests {
     /// says so; returns what was read, up to and including the first error,
     /// and whether the peeks always showed the bits that followed.
     fn read_all(bytes: &[u8], lanes: u8, peeks: &[bool]) -> (Vec<Result<bool, Error>>, bool) {
-        let header = LevelHeader::parse(bytes, false, 1 << 16).expect("level header");
+        let header = LevelHeader::parse(bytes, false, 1 << 16, crate::Schedule::SplitValences)
+            .expect("level header");
         let mut memory = slot_memory(lanes);
         let mut inflater = Inflater::new();
         let buffers = slot_buffers(&mut memory);
@@ -539,7 +580,7 @@ mod tests {
                 // Corrupt a payload byte and refresh its chunk's CRC, so that
                 // the damage reaches the decoders rather than the CRC check.
                 let copy = bytes.clone();
-                let header = LevelHeader::parse(&copy, false, 1 << 16).expect("header");
+                let header = LevelHeader::parse(&copy, false, 1 << 16, crate::Schedule::SplitValences).expect("header");
                 let start = header.payload_start;
                 if bytes.len() > start {
                     let at = start + at % (bytes.len() - start);
@@ -590,7 +631,8 @@ mod tests {
             ..StreamParams::default()
         };
         let bytes = frame_level(&payload, None, &params).bytes;
-        let header = LevelHeader::parse(&bytes, false, 1 << 16).expect("level header");
+        let header = LevelHeader::parse(&bytes, false, 1 << 16, crate::Schedule::SplitValences)
+            .expect("level header");
         let lengths = (0..header.chunk_count)
             .map(|c| header.chunk(c).expect("chunk").raw_len)
             .collect();
@@ -654,7 +696,7 @@ mod tests {
             let (bytes, lengths) = edge_level(&values, lanes, limit);
             prop_assert_eq!(lengths.iter().map(|&l| l as usize).sum::<usize>(), n);
             prop_assert!(lengths.iter().all(|&l| l >= 1 && l <= limit));
-            let header = LevelHeader::parse(&bytes, false, 1 << 16).expect("level header");
+            let header = LevelHeader::parse(&bytes, false, 1 << 16, crate::Schedule::SplitValences).expect("level header");
             let mut memory = slot_memory(lanes);
             let mut inflater = Inflater::new();
             let buffers = slot_buffers(&mut memory);

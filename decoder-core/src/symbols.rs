@@ -11,6 +11,7 @@
 //! [`MeshState::run_round`] keeps a copy of the round's candidate bitmap.
 
 use crate::Error;
+use crate::header::Schedule;
 use crate::limits::{LEAF, MAX_SPLIT_VALENCE};
 use crate::ring::Ring;
 use crate::state::MeshState;
@@ -32,6 +33,19 @@ impl WingCandidates {
             mask: [mask, 0, 0, 0],
             count: mask.count_ones() as usize,
         }
+    }
+
+    /// Every entry of a ring of `k` entries (at most 255): the eligible
+    /// set under the schedule `every-vertex` (SPEC §7.4).
+    pub fn all(k: usize) -> WingCandidates {
+        let mut out = WingCandidates::default();
+        let k = k.min(4 * 64);
+        for (w, word) in out.mask.iter_mut().enumerate() {
+            let bits = k.saturating_sub(64 * w).min(64);
+            *word = crate::round::all_ones(bits);
+        }
+        out.count = k;
+        out
     }
 
     /// `m`: the number of ring entries that may be wings.
@@ -124,6 +138,10 @@ impl MeshState<'_> {
     /// is eligible.
     #[inline]
     pub fn wing_candidates(&self, ring: &Ring) -> WingCandidates {
+        if self.schedule == Schedule::EveryVertex {
+            // 3.6: no split valence to overflow, every entry may be a wing.
+            return WingCandidates::all(ring.len());
+        }
         // The round-start copy of the candidate bitmap (SPEC §9, region 6).
         let third = self.candidates.len() / 3;
         let start = &self.candidates[third..2 * third];

@@ -6,12 +6,13 @@ use alloc::vec::Vec;
 
 use crate::bytes::crc32;
 use crate::context::{self, DeficitContexts};
-use crate::header::{Header, PositionMode};
+use crate::header::{Header, PositionMode, Schedule};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
     CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_BASELINE, VERSION_MINOR_DEFICITS,
-    VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_WINGS, codec, substream,
+    VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_SCHEDULE, VERSION_MINOR_WINGS,
+    codec, substream,
 };
 use crate::predict::PlanePolicy;
 use crate::rans_segments::rans_segments;
@@ -190,6 +191,9 @@ pub struct StreamParams {
     /// it may exceed `max_chunk_len` (SPEC §5.2); smaller chunks have
     /// tables fitted to fewer values and cost more table bytes.
     pub rans_chunk_limit: u32,
+    /// Which vertices split in which round (SPEC §3.2 header flag bit 1,
+    /// format 3.6).
+    pub schedule: Schedule,
 }
 
 impl Default for StreamParams {
@@ -205,6 +209,7 @@ impl Default for StreamParams {
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
             rans_chunk_limit: DEFAULT_RANS_CHUNK_LIMIT,
+            schedule: Schedule::default(),
         }
     }
 }
@@ -346,12 +351,14 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.4 only where a 3.4 feature (a rANS chunk longer than
+    // SPEC §1: 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
     // `max_chunk_len`) is used, 3.3 where a 3.3 feature (the deficit
     // contexts `valence`) is, 3.2 where a 3.2 feature (a wing policy other
     // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
     // is; every other stream stays readable by 3.0 decoders.
-    let version_minor = if rans_above {
+    let version_minor = if params.schedule == Schedule::EveryVertex {
+        VERSION_MINOR_SCHEDULE
+    } else if rans_above {
         VERSION_MINOR_RANS_CHUNKS
     } else if levels.iter().any(|l| l.deficits != DeficitContexts::Plain) {
         VERSION_MINOR_DEFICITS
@@ -365,6 +372,7 @@ pub fn assemble_stream(
     let header = Header {
         version_minor,
         position_mode: params.position_mode,
+        schedule: params.schedule,
         bits: params.bits,
         lane_count: params.codec.lane_count(),
         level_count,
@@ -427,7 +435,7 @@ pub fn frame_level_with(
         .flat_map(|s| s.substreams.iter().enumerate())
         .map(|(i, s)| (substream::BASE_POSITIONS + i as u8, s));
     for (id, sub) in rounds.chain(base) {
-        let contexts = context::count(id, level.deficits);
+        let contexts = context::count(id, level.deficits, params.schedule);
         let chunks = substream_chunks(sub, contexts, params, map);
         for chunk in chunks {
             let mut entry = [0u8; CHUNK_ENTRY_LEN];
@@ -542,7 +550,7 @@ pub fn coded_len_in(
     deficits: DeficitContexts,
     params: &StreamParams,
 ) -> usize {
-    let contexts = context::count(id, deficits);
+    let contexts = context::count(id, deficits, params.schedule);
     substream_chunks(sub, contexts, params, &one_by_one)
         .iter()
         .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)

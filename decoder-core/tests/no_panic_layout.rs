@@ -39,6 +39,7 @@ fn huge_stream() -> Vec<u8> {
         codec: ChunkCodec::Stored,
         chunk_limit: 4,
         rans_chunk_limit: 4,
+        schedule: splitstream_decoder_core::Schedule::SplitValences,
     };
     let mut base = vec![SubstreamWriter::default(); 3];
     let mut prev = [0i32; 3];

@@ -89,6 +89,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
         codec: ChunkCodec::Deflate(9),
         chunk_limit: 1 << 16,
         rans_chunk_limit: 1 << 16,
+        schedule: splitstream_decoder_core::Schedule::SplitValences,
     };
     write_stream(&params, &[base, level])
 }

@@ -112,6 +112,7 @@ proptest! {
             codec: ChunkCodec::Stored,
             chunk_limit: 5,
             rans_chunk_limit: 5,
+            schedule: splitstream_decoder_core::Schedule::SplitValences,
         };
         let stream = write_stream(&params, &[base_level, level]);
         let d = streams::decode_full(&stream);

@@ -405,7 +405,7 @@ fn run_random(base: Vec<[u32; 3]>, seed: u64) -> usize {
     let mut words = vec![0u64; layout.total as usize / 8 + 1];
     let buf: &mut [u8] = bytemuck::cast_slice_mut(&mut words);
     let (memory, _slots) = layout.carve(buf).unwrap();
-    let mut state = MeshState::new(memory, 8);
+    let mut state = MeshState::new(memory, 8, splitstream_decoder_core::Schedule::SplitValences);
     let mut rng = Rng(seed);
     let mut deficits = Vec::new();
     {
@@ -556,7 +556,7 @@ fn appendix_a_predictions() {
     let mut words = vec![0u64; layout.total as usize / 8 + 1];
     let buf: &mut [u8] = bytemuck::cast_slice_mut(&mut words);
     let (memory, _slots) = layout.carve(buf).unwrap();
-    let mut state = MeshState::new(memory, 8);
+    let mut state = MeshState::new(memory, 8, splitstream_decoder_core::Schedule::SplitValences);
     {
         let (p, c, d) = state.base_arrays();
         p[..4].copy_from_slice(&[[0, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]]);

@@ -56,15 +56,17 @@ fn the_observer_sees_every_applied_split_and_decoding_is_unchanged() {
     }
 }
 
-/// The deficit-0 vertices, scanned.
+/// The candidates, scanned (SPEC §6.2): the deficit-0 vertices, or under
+/// the schedule `every-vertex` every vertex.
 fn scanned(state: &MeshState<'_>) -> Vec<u32> {
+    let every = state.schedule() == splitstream_decoder_core::Schedule::EveryVertex;
     (0..state.vertex_count())
-        .filter(|&v| state.deficits()[v as usize] == 0)
+        .filter(|&v| every || state.deficits()[v as usize] == 0)
         .collect()
 }
 
 #[test]
-fn the_candidates_are_the_deficit_zero_vertices_before_every_round() {
+fn the_candidates_are_the_scheduled_vertices_before_every_round() {
     for g in streams::seed_generated() {
         let stream = &g.stream;
         let mut ws = vec![0u8; workspace_len(stream).unwrap()];

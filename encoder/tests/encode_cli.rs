@@ -373,3 +373,62 @@ fn verify_prints_the_state_hash_after_the_last_round() {
     let rounds = format!("{} rounds", mesh.round_hashes.len() - 1);
     assert!(out.contains(&rounds), "{out}");
 }
+
+/// `--schedule` picks how the stream says which vertices split (SPEC §3.2):
+/// both decode to the same mesh, `info` names the schedule, the default is
+/// `every-vertex` (format 3.6) and `split-valences` keeps the minor
+/// version older decoders read. `transcode` goes either way and keeps the
+/// mesh.
+#[test]
+fn both_schedules_decode_to_the_same_mesh() {
+    let (input, every) = encoded_raster("schedule-every.sps");
+    let split = input.with_file_name("schedule-split.sps");
+    let (i, e, s) = (
+        input.to_str().unwrap(),
+        every.to_str().unwrap(),
+        split.to_str().unwrap(),
+    );
+    succeeded(&splitstream(&[
+        "encode",
+        i,
+        "-o",
+        s,
+        "--schedule",
+        "split-valences",
+    ]));
+    let header =
+        |p: &PathBuf| splitstream_decoder_core::Header::parse(&std::fs::read(p).unwrap()).unwrap();
+    use splitstream_decoder_core::Schedule;
+    assert_eq!(header(&every).schedule, Schedule::EveryVertex);
+    assert_eq!(header(&every).version_minor, 6);
+    assert_eq!(header(&split).schedule, Schedule::SplitValences);
+    assert!(header(&split).version_minor < 6);
+    assert!(succeeded(&splitstream(&["info", e])).contains("schedule: every-vertex"));
+    let doc: serde_json::Value =
+        serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();
+    assert_eq!(doc["schedule"], "split-valences", "{doc}");
+    let mesh = |p: &PathBuf| {
+        let m =
+            splitstream_decoder_core::owned::decode_all(&std::fs::read(p).unwrap(), false).unwrap();
+        (m.positions, m.triangles)
+    };
+    assert_eq!(mesh(&every), mesh(&split));
+    // Across schedules in both directions.
+    let back = input.with_file_name("schedule-back.sps");
+    let b = back.to_str().unwrap();
+    succeeded(&splitstream(&[
+        "transcode",
+        e,
+        "-o",
+        b,
+        "--schedule",
+        "split-valences",
+    ]));
+    assert_eq!(header(&back).schedule, Schedule::SplitValences);
+    assert_eq!(mesh(&back), mesh(&every));
+    let forth = input.with_file_name("schedule-forth.sps");
+    let f = forth.to_str().unwrap();
+    succeeded(&splitstream(&["transcode", s, "-o", f]));
+    assert_eq!(header(&forth).schedule, Schedule::EveryVertex);
+    assert_eq!(mesh(&forth), mesh(&split));
+}

@@ -7,7 +7,7 @@ mod roundtrip_check;
 use roundtrip_check::assert_roundtrip;
 
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, Schedule, WingPolicy};
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::quantize::{Lattice, Quantization, Units};
 
@@ -107,6 +107,7 @@ fn height_policy_roundtrips_and_sets_the_minor_version() {
                     wings: Some(WingPolicy::Ranks),
                     deficits: Some(DeficitContexts::Plain),
                     position_mode: mode,
+                    schedule: Schedule::SplitValences,
                     ..EncodeOptions::default()
                 };
                 assert_roundtrip(&terrain, &options);
@@ -138,6 +139,7 @@ fn every_wing_policy_roundtrips_and_sets_the_minor_version() {
                         wings: Some(wings),
                         deficits: Some(DeficitContexts::Plain),
                         position_mode: mode,
+                        schedule: Schedule::SplitValences,
                         ..EncodeOptions::default()
                     };
                     assert_roundtrip(mesh, &options);
@@ -185,6 +187,7 @@ fn both_deficit_contexts_roundtrip_and_set_the_minor_version() {
                         wings: Some(WingPolicy::Ranks),
                         deficits: Some(deficits),
                         position_mode: mode,
+                        schedule: Schedule::SplitValences,
                         ..EncodeOptions::default()
                     };
                     assert_roundtrip(mesh, &options);
@@ -204,6 +207,7 @@ fn the_chosen_deficit_contexts_are_never_larger_than_plain() {
         let auto = encode(&mesh, &EncodeOptions::default(), |_| {}).expect("encode");
         let plain = EncodeOptions {
             deficits: Some(DeficitContexts::Plain),
+            schedule: Schedule::SplitValences,
             ..EncodeOptions::default()
         };
         let plain = encode(&mesh, &plain, |_| {}).expect("encode");
@@ -298,6 +302,7 @@ fn rans_chunks_beyond_max_chunk_len_set_minor_version_4() {
             codec,
             chunk_limit,
             position_mode: PositionMode::Constrained,
+            schedule: Schedule::SplitValences,
             ..EncodeOptions::default()
         };
         assert_roundtrip(&large, &options);
@@ -317,12 +322,59 @@ fn rans_chunks_beyond_max_chunk_len_set_minor_version_4() {
     let small = common::icosphere(2);
     let options = EncodeOptions {
         codec: ChunkCodec::RansAlways { lanes: 4 },
+        schedule: Schedule::SplitValences,
         ..EncodeOptions::default()
     };
     let stream = encode(&small, &options, |_| {}).expect("encode").stream;
     let header = Header::parse(&stream).unwrap();
     assert!(header.version_minor <= 3);
     assert!(header.max_chunk_len > 1 && header.max_chunk_len <= 1856);
+}
+
+/// The schedule `every-vertex` (format 3.6, the default) round-trips
+/// exactly on closed meshes and on terrain with a boundary, in both
+/// position modes, at 14 and 31 bits, with every codec; it marks minor
+/// version 6, and the decoded mesh is the one split valences give.
+#[test]
+fn every_vertex_roundtrips_and_sets_the_minor_version() {
+    use splitstream_decoder_core::owned::decode_all;
+    let meshes = [
+        common::icosphere(3),
+        common::bumpy_grid(21, 17, 3),
+        common::bumpy_grid(31, 23, 2),
+    ];
+    for mesh in &meshes {
+        for mode in [PositionMode::Constrained, PositionMode::Optimal] {
+            for (bits, codec) in [
+                (14, ChunkCodec::Rans { lanes: 4 }),
+                (31, ChunkCodec::RansAlways { lanes: 1 }),
+                (14, ChunkCodec::Deflate(9)),
+                (12, ChunkCodec::Stored),
+            ] {
+                let options = EncodeOptions {
+                    bits,
+                    codec,
+                    position_mode: mode,
+                    schedule: Schedule::EveryVertex,
+                    ..EncodeOptions::default()
+                };
+                assert_roundtrip(mesh, &options);
+                let every = encode(mesh, &options, |_| {}).expect("encode").stream;
+                assert_eq!(every[9], 6, "{mode:?} {bits} {codec:?}");
+                let split = EncodeOptions {
+                    schedule: Schedule::SplitValences,
+                    ..options
+                };
+                let split = encode(mesh, &split, |_| {}).expect("encode").stream;
+                assert!(split[9] < 6);
+                let (a, b) = (
+                    decode_all(&every, false).unwrap(),
+                    decode_all(&split, false).unwrap(),
+                );
+                assert_eq!((a.positions, a.triangles), (b.positions, b.triangles));
+            }
+        }
+    }
 }
 
 /// At 4 bits an icosphere of 642 vertices has coincident vertices and

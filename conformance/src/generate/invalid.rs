@@ -10,7 +10,7 @@ use splitstream_encoder::emit::EncodeOptions;
 use super::meshes;
 use super::mutate::*;
 use super::rans::rans_vectors;
-use super::{Specs, deflate_opts, encoded, opts};
+use super::{Specs, deflate_opts, encoded, every_vertex, opts};
 use crate::builtin;
 use crate::protocol::Verdict;
 use handmade::{Rec, base, level, tetra_split, tetra_split_level};
@@ -218,11 +218,11 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "reserved-header-flag",
         "malformed",
-        "Header flag bit 1 (reserved) set.",
+        "Header flag bit 2 (reserved) set.",
         &["reserved"],
         {
             let mut b = subject.clone();
-            b[10] |= 2;
+            b[10] |= 4;
             fix_header_crc(&mut b);
             b
         },
@@ -760,4 +760,67 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
                 .expect("a base level has a triangle substream (1)")]),
         );
     }
+    every_vertex_invalid(s);
+}
+
+/// Faults of the schedule `every-vertex` (SPEC §3.2, §5.1, §6.3, §7.6,
+/// format 3.6), and a stream read under the other schedule.
+fn every_vertex_invalid(s: &mut Specs) {
+    let tag = "schedule-every-vertex";
+    let every = encoded(
+        &meshes::icosphere(2),
+        every_vertex(EncodeOptions {
+            codec: ChunkCodec::Stored,
+            ..opts()
+        }),
+    );
+    let split_valences = encoded(
+        &meshes::icosphere(2),
+        EncodeOptions {
+            codec: ChunkCodec::Stored,
+            ..opts()
+        },
+    );
+    s.invalid(
+        "every-vertex-deficit-contexts-valence",
+        "malformed",
+        "A stream of the schedule every-vertex whose level 1 says deficit contexts `valence` (level header byte 10 = 1, CRC recomputed): under every-vertex, which codes no split valences, it MUST be 0 (SPEC §5.1).",
+        &["deficit-contexts", tag],
+        with_level_header_byte(&every, 1, plane_policy_at(&every, 1) + 2, 1),
+    );
+    s.invalid(
+        "every-vertex-deficit-p-value",
+        "count-mismatch",
+        "A stream of the schedule every-vertex with one value in level 1's deficit-p substream (re-framed, every checksum valid): under every-vertex nothing reads it, so it is left over at the level's end (SPEC §7.4, §7.6).",
+        &["records", tag],
+        {
+            let mut p = unframe(&every);
+            p.levels[1].substreams[3].push(6);
+            reframe(&p)
+        },
+    );
+    s.invalid(
+        "every-vertex-relabelled-split-valences",
+        "count-mismatch",
+        "A stream written with split valences whose header says every-vertex (flag bit 1 set, CRC recomputed): the seed's base-deficits substream holds values that every-vertex does not read (SPEC §6.3).",
+        &["reserved", tag],
+        {
+            let mut b = split_valences.clone();
+            b[10] |= 2;
+            fix_header_crc(&mut b);
+            b
+        },
+    );
+    s.invalid(
+        "every-vertex-relabelled-as-split-valences",
+        "count-mismatch",
+        "A stream of the schedule every-vertex whose header says split valences (flag bit 1 cleared, CRC recomputed): the seed's base-deficits substream, which split valences read, is empty (SPEC §6.3).",
+        &["reserved", tag],
+        {
+            let mut b = every.clone();
+            b[10] &= !2;
+            fix_header_crc(&mut b);
+            b
+        },
+    );
 }

@@ -14,7 +14,7 @@ use std::path::Path;
 use splitstream_decoder_core::limits::codec;
 use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{Fnv1a, Header, LevelHeader, LevelTable, PositionMode};
+use splitstream_decoder_core::{Fnv1a, Header, LevelHeader, LevelTable, PositionMode, Schedule};
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
 
@@ -87,13 +87,25 @@ fn encoded(mesh: &Mesh, options: EncodeOptions) -> Vec<u8> {
         .stream
 }
 
-/// The encoder's defaults in optimal mode, the encoder's default when the
-/// vectors were first written (constrained mode since 2026-12-03): the
-/// vectors named `position-constrained` ask for it.
+/// The encoder's defaults in optimal mode with split valences, the
+/// encoder's defaults when the vectors were first written (constrained
+/// mode since 2026-12-03, the schedule `every-vertex` since format 3.6):
+/// the vectors named `position-constrained` ask for constrained mode, and
+/// those named `every-vertex-…` for the schedule `every-vertex`
+/// ([`every_vertex`]).
 fn opts() -> EncodeOptions {
     EncodeOptions {
         position_mode: PositionMode::Optimal,
+        schedule: Schedule::SplitValences,
         ..EncodeOptions::default()
+    }
+}
+
+/// `options` under the schedule `every-vertex` (SPEC §3.2, format 3.6).
+fn every_vertex(options: EncodeOptions) -> EncodeOptions {
+    EncodeOptions {
+        schedule: Schedule::EveryVertex,
+        ..options
     }
 }
 
@@ -239,7 +251,8 @@ fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
     for k in 0..header.level_count {
         let info = table.get(k);
         let bytes = &stream[info.offset as usize..(info.offset + info.length as u64) as usize];
-        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len).expect("valid");
+        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len, header.schedule)
+            .expect("valid");
         if k == 0 && lh.round_count > 0 {
             tags.push("seed-rounds".to_string());
         }

@@ -51,7 +51,8 @@ pub fn unframe(stream: &[u8]) -> Unframed {
     for k in 0..header.level_count {
         let info = table.get(k);
         let bytes = &stream[level_range(stream, k)];
-        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len).expect("a valid level");
+        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len, header.schedule)
+            .expect("a valid level");
         // Slots 0..7: ids 1..=7 (rounds); 7..10: ids 8..=10 (seed).
         let mut substreams = vec![Vec::new(); 10];
         let mut at = lh.payload_start;
@@ -102,6 +103,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
             },
             chunk_limit: header.max_chunk_len,
             rans_chunk_limit: header.max_chunk_len,
+            schedule: header.schedule,
         },
         levels,
     }

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use super::meshes;
 use super::mutate::*;
-use super::{Specs, deflate_opts, encoded, opts};
+use super::{Specs, deflate_opts, encoded, every_vertex, opts};
 
 pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), String> {
     // The smallest legal streams, built by hand.
@@ -453,7 +453,125 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
         &["encoded", "real-mesh"],
         encoded(&bunny, opts()),
     );
+    every_vertex_vectors(s, &bunny);
     Ok(())
+}
+
+/// The schedule `every-vertex` (SPEC §3.2, §6.2, §7.3–§7.5, format 3.6):
+/// the encoder's current defaults, and the options the vectors above vary
+/// for split valences (position modes, codecs, chunks, lanes, boundaries,
+/// wing and plane policies, levels).
+fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh) {
+    let sphere3 = meshes::checked(meshes::icosphere(3), "icosphere(3)");
+    let sphere2 = meshes::checked(meshes::icosphere(2), "icosphere(2)");
+    let holed = meshes::checked(
+        meshes::grid(24, 20, 1, Some([8, 15, 6, 12])),
+        "grid with hole",
+    );
+    let small_holed = meshes::checked(
+        meshes::grid(14, 12, 4, Some([4, 9, 4, 8])),
+        "small grid with hole",
+    );
+    let cone = meshes::checked(meshes::cone(96, 4), "cone");
+    let tag = "schedule-every-vertex";
+    s.valid(
+        "every-vertex-bunny-npm",
+        "The npm `bunny` package's Stanford bunny with the encoder's defaults: constrained positions, rANS, the schedule every-vertex (a flag for every vertex in contexts by its valence, no split valences; format 3.6).",
+        &["encoded", "real-mesh", tag],
+        encoded(bunny, EncodeOptions::default()),
+    );
+    s.valid(
+        "every-vertex-icosphere-optimal-deflate",
+        "Icosphere (642 vertices, closed): optimal positions, deflate, the schedule every-vertex.",
+        &["encoded", tag],
+        encoded(&sphere3, every_vertex(deflate_opts())),
+    );
+    s.valid(
+        "every-vertex-icosphere-constrained-stored",
+        "Icosphere (162 vertices), constrained positions, stored chunks, 10 bits, the schedule every-vertex.",
+        &["encoded", tag],
+        encoded(
+            &sphere2,
+            every_vertex(EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::Stored,
+                bits: 10,
+                ..opts()
+            }),
+        ),
+    );
+    s.valid(
+        "every-vertex-grid-hole-optimal-rans",
+        "Height field with an outer boundary and a rectangular hole (ghost wings, boundary valences), optimal positions, rANS, the schedule every-vertex.",
+        &["encoded", "hole", tag],
+        encoded(&holed, every_vertex(opts())),
+    );
+    s.valid(
+        "every-vertex-grid-hole-tiny-chunks",
+        "Small height field with a hole, constrained positions, 7-byte stored chunks (flag bits straddle chunks), the schedule every-vertex.",
+        &["encoded", "hole", "tiny-chunks", tag],
+        encoded(
+            &small_holed,
+            every_vertex(EncodeOptions {
+                position_mode: PositionMode::Constrained,
+                codec: ChunkCodec::Stored,
+                chunk_limit: 7,
+                rans_chunk_limit: 7,
+                ..opts()
+            }),
+        ),
+    );
+    s.valid(
+        "every-vertex-cone-rans-1-lane",
+        "Cone of 96 sides (an apex of valence 97 and above: the flag context of the largest valences), rANS in 1 lane with 64-value chunks, the schedule every-vertex.",
+        &["encoded", "rans", tag],
+        encoded(
+            &cone,
+            every_vertex(EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 1 },
+                rans_chunk_limit: 64,
+                ..opts()
+            }),
+        ),
+    );
+    s.valid(
+        "every-vertex-icosphere-rans-32-lanes-levels-8",
+        "Icosphere (642 vertices), rANS in 32 lanes, 8 levels, the schedule every-vertex.",
+        &["encoded", "rans", tag],
+        encoded(
+            &sphere3,
+            every_vertex(EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 32 },
+                levels: 8,
+                ..opts()
+            }),
+        ),
+    );
+    // Every wing policy under every-vertex, where every ring entry may be
+    // a wing (SPEC §7.4): the ranks count the whole ring.
+    for policy in WingPolicy::ALL {
+        for (mode, what) in [
+            (PositionMode::Constrained, "constrained"),
+            (PositionMode::Optimal, "optimal"),
+        ] {
+            s.valid(
+                &format!("every-vertex-wings-{}-grid-hole-{what}", policy.name()),
+                &format!(
+                    "Small height field with a hole ({what} positions, rANS) with wing policy `{}` in every level, the schedule every-vertex: wing ranks among every ring entry.",
+                    policy.name()
+                ),
+                &["encoded", "wing-policy", tag],
+                encoded(
+                    &small_holed,
+                    every_vertex(EncodeOptions {
+                        position_mode: mode,
+                        wings: Some(policy),
+                        ..opts()
+                    }),
+                ),
+            );
+        }
+    }
 }
 
 /// A level-header choice forced in every level of a vector (SPEC §5.1):

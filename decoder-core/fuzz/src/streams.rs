@@ -31,8 +31,8 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Decoder, DeficitContexts, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane,
-    PlanePolicy, PositionMode, RecordSource, Ring, SplitFan, SplitRecord, Target, WingPolicy,
-    arc_means, constrained_positions, context, predict, wing_order, workspace_len,
+    PlanePolicy, PositionMode, RecordSource, Ring, Schedule, SplitFan, SplitRecord, Target,
+    WingPolicy, arc_means, constrained_positions, context, predict, wing_order, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -196,8 +196,10 @@ struct GenSource<'g, 'c> {
     allow_invalid: bool,
 }
 
+/// Whether `x` may still be a wing now: under split valences, with a
+/// deficit left; under `every-vertex` (3.6) always.
 fn wing_ok(state: &MeshState<'_>, x: u32) -> bool {
-    x == NONE || state.deficits()[x as usize] != 0
+    x == NONE || state.schedule() == Schedule::EveryVertex || state.deficits()[x as usize] != 0
 }
 
 /// Wing pairs `(o, d)` that a valid record may name for this ring: both
@@ -225,7 +227,7 @@ fn wing_pairs(state: &MeshState<'_>, ring: &Ring) -> Vec<(usize, usize)> {
 /// splits of the same round (each decrements a wing deficit at most once).
 fn has_robust_pair(state: &MeshState<'_>, ring: &Ring, earlier: usize) -> bool {
     let robust = |x: u32| {
-        x == NONE || {
+        x == NONE || state.schedule() == Schedule::EveryVertex || {
             let d = state.deficits()[x as usize];
             d == LEAF || d as usize > earlier
         }
@@ -293,22 +295,28 @@ impl RecordSource for GenSource<'_, '_> {
             _ => wing_order::near_wings(keys, k, o_rank, d_rank)?,
         };
         let (valence_p, valence_c) = (d + 2, k - d + 2);
-        let (deficit_p, deficit_c) = (
-            pick_deficit(c.byte(), valence_p),
-            pick_deficit(c.byte(), valence_c),
-        );
-        let (mut sp, mut sc) = (
-            split_valence_symbol(deficit_p, valence_p),
-            split_valence_symbol(deficit_c, valence_c),
-        );
-        if self.allow_invalid && c.byte() == 0xFE {
-            sp = c.byte();
-            sc = c.byte();
-        }
-        self.subs[3].byte_in(context::deficit_p(self.deficits, valence_p), sp);
-        let deficit_p = deficit_of(sp, valence_p)?;
-        self.subs[4].byte_in(context::deficit_c(self.deficits, deficit_p, valence_c), sc);
-        let deficit_c = deficit_of(sc, valence_c)?;
+        let (deficit_p, deficit_c) = if state.schedule() == Schedule::EveryVertex {
+            // 3.6: no split valences coded; the bytes are the valences.
+            (valence_p.min(255) as u8, valence_c.min(255) as u8)
+        } else {
+            let (deficit_p, deficit_c) = (
+                pick_deficit(c.byte(), valence_p),
+                pick_deficit(c.byte(), valence_c),
+            );
+            let (mut sp, mut sc) = (
+                split_valence_symbol(deficit_p, valence_p),
+                split_valence_symbol(deficit_c, valence_c),
+            );
+            if self.allow_invalid && c.byte() == 0xFE {
+                sp = c.byte();
+                sc = c.byte();
+            }
+            self.subs[3].byte_in(context::deficit_p(self.deficits, valence_p), sp);
+            let deficit_p = deficit_of(sp, valence_p)?;
+            self.subs[4].byte_in(context::deficit_c(self.deficits, deficit_p, valence_c), sc);
+            let deficit_c = deficit_of(sc, valence_c)?;
+            (deficit_p, deficit_c)
+        };
         let limit = 1i64 << self.bits;
         let in_grid = |v: &[i64; 3]| v.iter().all(|&x| (0..limit).contains(&x));
         let clamp = |v: i64| v.clamp(0, limit - 1);
@@ -410,7 +418,16 @@ impl RecordSource for GenSource<'_, '_> {
 /// Builds a stream from `choices` (any bytes; all zeros gives a deep stream).
 pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
     let bases = bases();
-    let base = bases[choices.below(bases.len())].clone();
+    let base_index = choices.below(bases.len());
+    let base = bases[base_index].clone();
+    // The schedule (SPEC §3.2) by the base's index, no choice of its own,
+    // so that existing corpora keep their meaning: both schedules on every
+    // kind of base over the corpus.
+    let schedule = if base_index % 2 == 1 {
+        Schedule::EveryVertex
+    } else {
+        Schedule::SplitValences
+    };
     let position_mode = if choices.byte() & 1 == 0 {
         PositionMode::Optimal
     } else {
@@ -448,6 +465,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         } else {
             1 << 14
         },
+        schedule,
     };
     let refinement_levels = 4 - choices.below(4);
     // With 31 bits, the base mesh is scaled towards the top of the grid.
@@ -473,7 +491,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
     let layout = Layout::new(vcap, tcap, bv, bt, 1);
     let mut memory = vec![0u8; layout.bytes_unaligned() as usize];
     let (mem, _) = layout.carve(&mut memory).expect("layout fits");
-    let mut state = MeshState::new(mem, bits);
+    let mut state = MeshState::new(mem, bits, schedule);
     {
         let (positions, corners, defs) = state.base_arrays();
         positions[..bv as usize].copy_from_slice(&base.positions);
@@ -486,7 +504,12 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         .finish_base(bv, bt)
         .expect("seed base meshes are manifold");
     let mut hashes = vec![state.state_hash()];
-    let mut levels = vec![base_level(&base, &deficits)];
+    // Under `every-vertex` the seed codes no deficits (SPEC §6.3).
+    let coded_deficits: &[u8] = match schedule {
+        Schedule::SplitValences => &deficits,
+        Schedule::EveryVertex => &[],
+    };
+    let mut levels = vec![base_level(&base, coded_deficits)];
     let mut ring = Ring::default();
     let mut error = None;
 
@@ -496,7 +519,11 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         let level_start_v = state.vertex_count();
         let plane = PlanePolicy::ALL[choices.below(PlanePolicy::ALL.len())];
         let wings = WingPolicy::ALL[choices.below(WingPolicy::ALL.len())];
-        let deficits = DeficitContexts::ALL[choices.below(DeficitContexts::ALL.len())];
+        let mut deficits = DeficitContexts::ALL[choices.below(DeficitContexts::ALL.len())];
+        if schedule == Schedule::EveryVertex {
+            // No split valences: the level header says `plain` (SPEC §5.1).
+            deficits = DeficitContexts::Plain;
+        }
         let rounds = 3 - choices.below(3);
         for _ in 0..rounds {
             let n = state.vertex_count();
@@ -508,7 +535,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                 let mut flagged: Vec<u32> = Vec::new();
                 let mut first_eligible = None;
                 for v in 0..n {
-                    if state.deficits()[v as usize] != 0 {
+                    if schedule == Schedule::SplitValences && state.deficits()[v as usize] != 0 {
                         continue;
                     }
                     let ring_ok = state.ring(v, &mut ring).is_ok();
@@ -538,7 +565,8 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                     if f {
                         flagged.push(v);
                     }
-                    flags.push(f);
+                    let byte = state.deficits()[v as usize];
+                    flags.push((f, context::flag(schedule, byte)));
                 }
                 (flags, flagged, first_eligible)
             };
@@ -549,14 +577,14 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                     None => break,
                 }
             }
-            for &f in &flags {
-                subs[0].bit(f);
+            for &(f, context) in &flags {
+                subs[0].bit_in(context, f);
             }
             let declared = flagged.len() as u32;
             round_splits.push(declared);
             let mut source = GenSource {
                 choices: &mut *choices,
-                flags,
+                flags: flags.iter().map(|&(f, _)| f).collect(),
                 next_flag: 0,
                 subs: &mut subs,
                 mode: position_mode,

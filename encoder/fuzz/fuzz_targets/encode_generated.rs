@@ -13,9 +13,9 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use splitstream_decoder_core::PositionMode;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_decoder_core::{PositionMode, Schedule};
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode, quantize_for};
 use splitstream_encoder::input::{Grid, check_mesh, grid_to_mesh, icosphere};
@@ -155,6 +155,11 @@ fn options(b: &mut Bytes<'_>, vertices: usize) -> EncodeOptions {
             Quantization::PerAxis
         },
         lattice: [None, Some(Lattice::Keep), Some(Lattice::Ignore)][b.range(0, 2)],
+        schedule: if b.flag() {
+            Schedule::SplitValences
+        } else {
+            Schedule::EveryVertex
+        },
         ..EncodeOptions::default()
     }
 }

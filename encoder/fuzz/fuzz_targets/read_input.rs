@@ -17,7 +17,8 @@ use splitstream_encoder::input::{
 fn scratch() -> &'static PathBuf {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let base = std::env::var_os("SPLITSTREAM_FUZZ_DIR").map_or_else(std::env::temp_dir, PathBuf::from);
+        let base =
+            std::env::var_os("SPLITSTREAM_FUZZ_DIR").map_or_else(std::env::temp_dir, PathBuf::from);
         let dir = base.join(format!("splitstream-read-input-{}", std::process::id()));
         std::fs::create_dir_all(&dir).expect("scratch folder");
         dir

@@ -2,9 +2,9 @@
 //! `transcode` share.
 
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{DeficitContexts, PlanePolicy, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, Schedule, WingPolicy};
 
-use super::{CliResult, Codec, DeficitsArg, PlaneArg, WingsArg};
+use super::{CliResult, Codec, DeficitsArg, PlaneArg, ScheduleArg, WingsArg};
 use splitstream_encoder::emit::check_coding;
 
 #[derive(clap::Args)]
@@ -41,6 +41,13 @@ pub struct CodingArgs {
     /// 3.3) (SPEC §5.5.5); `auto` picks the cheaper per level.
     #[arg(long, value_enum, default_value_t = DeficitsArg::Auto)]
     pub deficits: DeficitsArg,
+    /// How the stream says which vertices split in which round:
+    /// `every-vertex`, a flag for every vertex (format 3.6, smaller), or
+    /// `split-valences`, the paper's split valences (read by every 3.x
+    /// decoder) (SPEC §3.2, §7.3). `--deficits` applies to
+    /// `split-valences` only.
+    #[arg(long, value_enum, default_value_t = ScheduleArg::EveryVertex)]
+    pub schedule: ScheduleArg,
 }
 
 impl CodingArgs {
@@ -68,5 +75,9 @@ impl CodingArgs {
 
     pub fn deficits(&self) -> Option<DeficitContexts> {
         self.deficits.contexts()
+    }
+
+    pub fn schedule(&self) -> Schedule {
+        self.schedule.into()
     }
 }

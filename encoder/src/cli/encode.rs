@@ -103,6 +103,7 @@ pub fn run(a: Args) -> CliResult {
         plane: a.coding.plane(),
         wings: a.coding.wings(),
         deficits: a.coding.deficits(),
+        schedule: a.coding.schedule(),
     };
     options.check().map_err(|e| e.to_string())?;
     if options.levels == 1 && options.base_vertices.is_some() {

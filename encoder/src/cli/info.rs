@@ -88,7 +88,7 @@ fn field_sizes_of(
             )
         })?;
         let lh = table
-            .level_header(k, bytes, header.max_chunk_len)
+            .level_header(k, bytes, header.max_chunk_len, header.schedule)
             .map_err(|e| format!("level {k}: {e}"))?;
         sizes.framing += lh.payload_start as u64;
         for c in 0..lh.chunk_count {
@@ -196,7 +196,9 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
             let e = table.get(k);
             stream
                 .get(e.offset as usize..(e.offset + e.length as u64) as usize)
-                .and_then(|b| LevelHeader::parse(b, k == 0, header.max_chunk_len).ok())
+                .and_then(|b| {
+                    LevelHeader::parse(b, k == 0, header.max_chunk_len, header.schedule).ok()
+                })
                 .map_or(("?", "?", "?"), |lh| {
                     (
                         lh.plane_policy.name(),
@@ -274,6 +276,7 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
             "version": format!("{VERSION_MAJOR}.{}", header.version_minor),
             "lane_count": header.lane_count,
             "position_mode": mode,
+            "schedule": header.schedule.name(),
             "bits": header.bits,
             "origin": header.origin,
             "scale": header.scale,
@@ -348,6 +351,7 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
         "  positions: {} bits/axis, {mode} placement, origin {:?}, step {:?}",
         header.bits, header.origin, header.scale
     );
+    println!("  schedule: {} (SPEC §3.2)", header.schedule.name());
     println!(
         "  decoder memory: {} bytes ({:.1} bytes/vertex), stored and deflate chunks up to {} bytes",
         header.workspace_bytes,

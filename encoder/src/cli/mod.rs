@@ -170,6 +170,27 @@ impl DeficitsArg {
     }
 }
 
+/// How a stream says which vertices split in which round (SPEC §3.2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum ScheduleArg {
+    /// A flag for every vertex, in contexts by its valence (format 3.6).
+    #[default]
+    EveryVertex,
+    /// The paper's split valences, with flags for the candidates they make
+    /// (every 3.x decoder).
+    SplitValences,
+}
+
+impl From<ScheduleArg> for splitstream_decoder_core::Schedule {
+    fn from(s: ScheduleArg) -> Self {
+        use splitstream_decoder_core::Schedule;
+        match s {
+            ScheduleArg::EveryVertex => Schedule::EveryVertex,
+            ScheduleArg::SplitValences => Schedule::SplitValences,
+        }
+    }
+}
+
 /// Where the simplifier's data-parallel passes run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum BackendArg {

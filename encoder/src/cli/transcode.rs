@@ -30,6 +30,7 @@ pub fn run(a: Args) -> CliResult {
         plane: a.coding.plane(),
         wings: a.coding.wings(),
         deficits: a.coding.deficits(),
+        schedule: a.coding.schedule(),
     };
     let started = Instant::now();
     let done = transcode(&stream, &options).map_err(|e| format!("{}: {e}", a.input.display()))?;

@@ -12,7 +12,7 @@ mod wings;
 
 use splitstream_decoder_core::limits::rans::MAX_LANES;
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
-use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, Schedule, WingPolicy};
 
 use crate::input::{MeshError, MeshStats, check_mesh};
 use crate::mesh::Mesh;
@@ -81,6 +81,9 @@ pub struct EncodeOptions {
     /// The deficit contexts of every level (SPEC §5.5.5, format 3.3);
     /// `None`: per level, the ones whose split valences take fewest bytes.
     pub deficits: Option<DeficitContexts>,
+    /// How the stream says which vertices split in which round (SPEC
+    /// §3.2): by default `every-vertex` (format 3.6), the smaller.
+    pub schedule: Schedule,
 }
 
 impl Default for EncodeOptions {
@@ -103,6 +106,7 @@ impl Default for EncodeOptions {
             plane: None,
             wings: None,
             deficits: None,
+            schedule: Schedule::EveryVertex,
         }
     }
 }
@@ -321,6 +325,7 @@ fn encode_checked(
         codec: options.codec,
         chunk_limit: options.chunk_limit,
         rans_chunk_limit: options.rans_chunk_limit,
+        schedule: options.schedule,
     };
     let replayed = replay(
         mesh,

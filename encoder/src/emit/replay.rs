@@ -9,7 +9,7 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     CornerRefs, DeficitContexts, Error, MeshState, PlanePolicy, PositionMode, RecordSource, Ring,
-    SplitOutcome, SplitRecord, StateMemory, WingPolicy, context,
+    Schedule, SplitOutcome, SplitRecord, StateMemory, WingPolicy, context,
 };
 
 use std::sync::mpsc;
@@ -101,7 +101,7 @@ impl Memory {
         }
     }
 
-    fn state(&mut self, bits: u8) -> MeshState<'_> {
+    fn state(&mut self, bits: u8, schedule: Schedule) -> MeshState<'_> {
         MeshState::new(
             StateMemory {
                 positions: &mut self.positions,
@@ -115,6 +115,7 @@ impl Memory {
                 candidates: &mut self.candidates,
             },
             bits,
+            schedule,
         )
     }
 }
@@ -160,9 +161,11 @@ impl StepSource<'_> {
 }
 
 impl RecordSource for StepSource<'_> {
-    fn flag(&mut self, _state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
+    fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
         let flagged = self.current[v as usize] != NONE;
-        self.subs[slot(substream::FLAGS)].bit_in(context::SINGLE, flagged);
+        let byte = state.deficits().get(v as usize).copied().unwrap_or(0);
+        let context = context::flag(state.schedule(), byte);
+        self.subs[slot(substream::FLAGS)].bit_in(context, flagged);
         Ok(flagged)
     }
 
@@ -230,20 +233,28 @@ impl RecordSource for StepSource<'_> {
             }
         };
         let (valence_p, valence_c) = (len_p + 2, k - len_p + 2);
-        let (Some(dp), Some(dc)) = (deficit(sv_p, valence_p), deficit(sv_c, valence_c)) else {
-            return Err(self.fail(format!("valence of {id} grew past its split valence")));
+        let (dp, dc) = match state.schedule() {
+            Schedule::SplitValences => {
+                let (Some(dp), Some(dc)) = (deficit(sv_p, valence_p), deficit(sv_c, valence_c))
+                else {
+                    return Err(self.fail(format!("valence of {id} grew past its split valence")));
+                };
+                self.deficit_coding.write(
+                    split_valence_symbol(dp, valence_p),
+                    split_valence_symbol(dc, valence_c),
+                    dp,
+                    valence_p,
+                    valence_c,
+                );
+                (dp, dc)
+            }
+            // No split valences (SPEC §7.4, 3.6): the bytes are the valences.
+            Schedule::EveryVertex => (valence_p.min(255) as u8, valence_c.min(255) as u8),
         };
         let parent = state.positions()[r as usize];
         if parent != col.position_r {
             return Err(self.fail(format!("position of {id} differs from its collapse")));
         }
-        self.deficit_coding.write(
-            split_valence_symbol(dp, valence_p),
-            split_valence_symbol(dc, valence_c),
-            dp,
-            valence_p,
-            valence_c,
-        );
         // The rest of the record comes from the ring as it is now, at the
         // start of the round: copied out for the geometry thread.
         let positions = state.positions();
@@ -356,7 +367,7 @@ pub fn replay(
         .collect();
     let (v0, t0) = (dec2enc.len(), base_triangles.len());
     let mut memory = Memory::new(n, t_total, v0, t0);
-    let mut state = memory.state(mesh.bits);
+    let mut state = memory.state(mesh.bits, params.schedule);
     let base_positions: Vec<[u32; 3]> = dec2enc.iter().map(|&e| s.positions[e as usize]).collect();
     {
         let (positions, corners, deficits) = state.base_arrays();
@@ -369,7 +380,12 @@ pub fn replay(
     state
         .finish_base(v0 as u32, t0 as u32)
         .map_err(|e| ReplayError(format!("base mesh rejected by the decoder: {e}")))?;
-    let seed = SeedPayload::new(&base_positions, &base_triangles, &base_deficits);
+    // Under `every-vertex` the seed codes no deficits (SPEC §6.3, 3.6).
+    let seed_deficits: &[u8] = match params.schedule {
+        Schedule::SplitValences => &base_deficits,
+        Schedule::EveryVertex => &[],
+    };
+    let seed = SeedPayload::new(&base_positions, &base_triangles, seed_deficits);
     let mut current = vec![NONE; n];
     let mut flagged = Vec::new();
     let mut wings = Vec::new();
@@ -391,7 +407,12 @@ pub fn replay(
                 input_sorted = Some(scope.spawn(|| sorted_canonical(&mesh.triangles, None)));
             }
             let mut subs = vec![SubstreamWriter::default(); 7];
-            let mut deficit_coding = DeficitCoding::new(deficit_contexts);
+            // Under `every-vertex` no split valences are coded, and the
+            // level header says `plain` (SPEC §5.1, 3.6).
+            let mut deficit_coding = DeficitCoding::new(match params.schedule {
+                Schedule::SplitValences => deficit_contexts,
+                Schedule::EveryVertex => Some(DeficitContexts::Plain),
+            });
             // The level's split geometry goes round by round to a thread
             // that codes the wings and computes the residual vectors, and
             // they on to a thread that codes them under every plane policy.
@@ -599,7 +620,7 @@ mod tests {
             problem: None,
         };
         let mut memory = Memory::new(n, 8, 4, 4);
-        let state = memory.state(8);
+        let state = memory.state(8, Schedule::SplitValences);
         let upcoming: Vec<u32> = (0..n as u32).collect();
         let likely = source.likely_flags(&state, &upcoming);
         for (i, &v) in upcoming.iter().enumerate() {

@@ -16,7 +16,7 @@ use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, assemble_stream};
 use splitstream_decoder_core::{
-    DeficitContexts, MeshState, PlanePolicy, Ring, SplitObserver, SplitRecord, WingPolicy,
+    DeficitContexts, MeshState, PlanePolicy, Ring, Schedule, SplitObserver, SplitRecord, WingPolicy,
 };
 
 use super::check_coding;
@@ -42,6 +42,9 @@ pub struct TranscodeOptions {
     pub wings: Option<WingPolicy>,
     /// The deficit contexts of every level; `None`: chosen per level by size.
     pub deficits: Option<DeficitContexts>,
+    /// The schedule of the stream written (SPEC §3.2), whatever the
+    /// input's.
+    pub schedule: Schedule,
 }
 
 impl Default for TranscodeOptions {
@@ -56,6 +59,7 @@ impl Default for TranscodeOptions {
             plane: None,
             wings: None,
             deficits: None,
+            schedule: Schedule::EveryVertex,
         }
     }
 }
@@ -64,7 +68,8 @@ impl Default for TranscodeOptions {
 #[derive(Debug)]
 pub struct Transcoded {
     pub stream: Vec<u8>,
-    /// The state hash after the last round, the same for both streams.
+    /// The state hash after the last round, the same for both streams when
+    /// their schedules are (SPEC §8 hashes the per-vertex byte, §6.2).
     pub final_hash: u64,
     pub levels: usize,
     pub rounds: usize,
@@ -111,6 +116,7 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
         codec: options.codec,
         chunk_limit: options.chunk_limit,
         rans_chunk_limit: options.rans_chunk_limit,
+        schedule: options.schedule,
     };
     let simplification = refinement.simplification();
     let replayed = replay(
@@ -127,7 +133,9 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
     )
     .map_err(TranscodeError::Replay)?;
     let final_hash = replayed.final_hash.expect("asked for");
-    if final_hash != refinement.final_hash {
+    // Under another schedule the per-vertex byte the hash covers differs
+    // (SPEC §6.2, §8); the replay has checked positions and triangles.
+    if options.schedule == refinement.schedule && final_hash != refinement.final_hash {
         return Err(TranscodeError::Replay(ReplayError(format!(
             "the transcoded stream ends in state {final_hash:016x}, the input in {:016x}",
             refinement.final_hash
@@ -147,6 +155,8 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
 /// decoding order), its level structure and its final mesh.
 struct Refinement {
     position_mode: splitstream_decoder_core::PositionMode,
+    /// The input stream's schedule (SPEC §3.2).
+    schedule: Schedule,
     /// The final mesh, in the stream's vertex ids (the replay's input ids).
     mesh: QuantizedMesh,
     seed_positions: Vec<[u32; 3]>,
@@ -169,12 +179,78 @@ fn split_valence(deficit: u8, valence: usize) -> u8 {
     u8::try_from(deficit as usize + valence).unwrap_or(u8::MAX)
 }
 
+/// The split valences of a stream under the schedule `every-vertex`, which
+/// codes none (SPEC §6.2): a vertex's split valence is its valence when it
+/// next splits, the ring length of that split, or [`NO_SPLIT`] when it
+/// never splits again. Sets them on the collapses (`rounds`, whose splits
+/// have the ring lengths `ring_lengths` in order) and returns the seed's
+/// as the deficits a `split-valences` seed would code (split valence −
+/// valence, or LEAF), which [`Refinement::simplification`] turns back.
+fn derive_split_valences(
+    rounds: &mut [Vec<Collapse>],
+    ring_lengths: &[u8],
+    seed_triangles: &[[u32; 3]],
+) -> Vec<u8> {
+    #[derive(Clone, Copy)]
+    enum Owner {
+        Seed,
+        P(usize),
+        C(usize),
+    }
+    let v0 = seed_triangles
+        .iter()
+        .flatten()
+        .map(|&v| v as usize + 1)
+        .max()
+        .unwrap_or(0);
+    let splits: usize = rounds.iter().map(Vec::len).sum();
+    let mut owner = vec![Owner::Seed; v0 + splits];
+    let mut seed_split_valence = vec![NO_SPLIT; v0];
+    let (mut sv_p, mut sv_c) = (vec![NO_SPLIT; splits], vec![NO_SPLIT; splits]);
+    for (f, col) in rounds.iter().flatten().enumerate() {
+        let k = ring_lengths.get(f).copied().unwrap_or(NO_SPLIT);
+        match owner.get(col.p as usize) {
+            Some(Owner::Seed) => seed_split_valence[col.p as usize] = k,
+            Some(&Owner::P(g)) => sv_p[g] = k,
+            Some(&Owner::C(g)) => sv_c[g] = k,
+            None => {}
+        }
+        if let Some(o) = owner.get_mut(col.p as usize) {
+            *o = Owner::P(f);
+        }
+        if let Some(o) = owner.get_mut(col.c as usize) {
+            *o = Owner::C(f);
+        }
+    }
+    for (f, col) in rounds.iter_mut().flatten().enumerate() {
+        col.split_valence_p = sv_p[f];
+        col.split_valence_c = sv_c[f];
+    }
+    // Back to deficits against the seed's valences.
+    let table = CornerTable::new(v0, seed_triangles);
+    let mut fan = Fan::default();
+    (0..v0)
+        .map(|v| {
+            let sv = seed_split_valence[v];
+            if sv == NO_SPLIT {
+                return LEAF;
+            }
+            table.fan(v as u32, &mut fan);
+            let valence = fan.corners.len() + if fan.boundary { 2 } else { 0 };
+            (sv as usize).saturating_sub(valence) as u8
+        })
+        .collect()
+}
+
 /// Keeps each split record of a round as the collapse it reverses: P is
 /// the split vertex (it keeps its id), C the vertex the split adds (the
 /// next id), the wings the ring entries at `o` and `o + d` (SPEC §7.4).
 #[derive(Default)]
 struct Recorder {
     round: Vec<Collapse>,
+    /// Each split's ring length (its vertex's valence when it splits), in
+    /// decoding order: the split valences of a stream that codes none.
+    ring_lengths: Vec<u8>,
 }
 
 impl SplitObserver for Recorder {
@@ -186,7 +262,10 @@ impl SplitObserver for Recorder {
             rec.wing_distance as usize,
         );
         let c = state.vertex_count();
-        // Split valence = valence right after the split + deficit (§7.4).
+        self.ring_lengths.push(k.min(255) as u8);
+        // Split valence = valence right after the split + deficit (§7.4);
+        // under `every-vertex` the bytes are valences, and the split
+        // valences are derived after the decode (`derive_split_valences`).
         let split_valence_p = split_valence(rec.deficit_p, d + 2);
         let split_valence_c = split_valence(rec.deficit_c, k - d + 2);
         self.round.push(Collapse {
@@ -255,6 +334,11 @@ impl Refinement {
                 .collect(),
             errors,
         };
+        let mut seed_deficits = seed_deficits;
+        if header.schedule == Schedule::EveryVertex {
+            seed_deficits =
+                derive_split_valences(&mut rounds, &recorder.ring_lengths, &seed_triangles);
+        }
         let mesh = QuantizedMesh {
             positions: decoder.positions().to_vec(),
             triangles: decoder.triangles().to_vec(),
@@ -266,6 +350,7 @@ impl Refinement {
         };
         Ok(Refinement {
             position_mode: header.position_mode,
+            schedule: header.schedule,
             mesh,
             seed_positions,
             seed_triangles,

@@ -1,7 +1,10 @@
 // Step 1 of a round (SPEC §7.3): the candidates are the vertices below n
 // with deficit 0. Each is appended with an atomic counter, in no particular
 // order; bitonic_sort.wgsl then restores the ascending order the flags
-// refer to (Cellier et al. 2012, §3: atomic append + sort).
+// refer to (Cellier et al. 2012, §3: atomic append + sort). Under the
+// schedule every-vertex (3.6) every vertex below n is a candidate: v is its
+// own rank, so it is written at index v, already sorted (schedule.rs skips
+// the sort); the counter still counts, for number_splits' check.
 
 @group(0) @binding(6) var<storage, read_write> deficit: array<u32>;
 @group(0) @binding(9) var<storage, read_write> cand: array<u32>;
@@ -22,10 +25,14 @@ fn clear_candidates(@builtin(global_invocation_id) gid: vec3<u32>) {
 @compute @workgroup_size(256)
 fn append_candidates(@builtin(global_invocation_id) gid: vec3<u32>) {
     let v = gid.x;
-    if v >= params.n || deficit[v] != 0u {
+    let every = every_vertex();
+    if v >= params.n || (!every && deficit[v] != 0u) {
         return;
     }
-    let slot = atomicAdd(&counts[COUNT_CANDIDATES], 1u);
+    var slot = atomicAdd(&counts[COUNT_CANDIDATES], 1u);
+    if every {
+        slot = v;
+    }
     if slot < params.sort_len {
         cand[slot] = v;
     }

@@ -8,6 +8,8 @@
 #define WG 256u
 #define MAX_RING 255u
 #define SPLIT_WORDS 8u
+#define BYTE_MAX 255u
+#define SCHEDULE_EVERY_VERTEX 1u
 
 #define COUNT_V 0
 #define COUNT_T 1
@@ -24,7 +26,7 @@
 
 typedef struct {
     uint n, candidates, splits, sort_len, tri_limit, pos_limit;
-    uint arg0, arg1, arg2, pad0, pad1, pad2;
+    uint arg0, arg1, arg2, schedule, pad1, pad2;
 } Params;
 
 typedef struct {
@@ -42,6 +44,8 @@ typedef struct {
     __global uint *scan, __global uint *splits
 
 #define PARAMS (params_all[slot])
+// SPEC §6.2 (3.6): every vertex a candidate, the word a capped valence.
+#define EVERY_VERTEX (PARAMS.schedule == SCHEDULE_EVERY_VERTEX)
 
 inline uint next_corner(uint c) { return c % 3u == 2u ? c - 2u : c + 1u; }
 inline uint prev_corner(uint c) { return c % 3u == 0u ? c + 2u : c - 1u; }

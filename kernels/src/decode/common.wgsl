@@ -5,6 +5,11 @@
 const NONE: u32 = 0xffffffffu;
 const LEAF: u32 = 255u;
 const WG: u32 = 256u;
+// The largest value of a per-vertex byte: under the schedule every-vertex a
+// valence is kept capped at it (SPEC §6.2).
+const BYTE_MAX: u32 = 255u;
+// Params.schedule (layout.rs: Schedule::word; SPEC §3.2 header flag bit 1).
+const SCHEDULE_EVERY_VERTEX: u32 = 1u;
 
 // Slots of the `counts` buffer (layout.rs: Counts).
 const COUNT_V: u32 = 0u;
@@ -41,13 +46,21 @@ struct Params {
     arg0: u32,
     arg1: u32,
     arg2: u32,
-    _pad0: u32,
+    // 0 split-valences, 1 every-vertex (format 3.6): what `deficit` holds and
+    // which vertices are candidates (SPEC §6.2, §7.3).
+    schedule: u32,
     _pad1: u32,
     _pad2: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read_write> counts: array<atomic<u32>>;
+
+// SPEC §6.2 (3.6): every vertex is a candidate of every round, and the
+// per-vertex word holds its valence capped at 255, not a deficit.
+fn every_vertex() -> bool {
+    return params.schedule == SCHEDULE_EVERY_VERTEX;
+}
 
 fn next_corner(c: u32) -> u32 {
     if c % 3u == 2u {

@@ -2,6 +2,7 @@
 //! (`ocl_refine`, feature `opencl`) refiners, and the checks both make before a round.
 
 use super::adjacency::AdjacencyError;
+pub use super::layout::Schedule;
 use super::layout::{GpuRecord, KernelFault, WORKGROUP};
 use crate::gpu::{Api, GpuError};
 
@@ -13,6 +14,8 @@ pub const MAX_GROUPS: u64 = 65_535;
 pub struct BaseMesh<'a> {
     pub positions: &'a [[u32; 3]],
     pub triangles: &'a [[u32; 3]],
+    /// The per-vertex bytes of SPEC §6.2: deficits, or under the schedule
+    /// `every-vertex` valences (the refiner's [`Schedule`]).
     pub deficits: &'a [u8],
     /// Quantization bits per axis (SPEC §3.2).
     pub bits: u8,
@@ -21,7 +24,8 @@ pub struct BaseMesh<'a> {
 /// One round as the stream gives it.
 #[derive(Clone, Copy, Debug)]
 pub struct RoundInput<'a> {
-    /// Candidates at round start (the number of flags read).
+    /// Candidates at round start (the number of flags read): under
+    /// `every-vertex`, the vertex count.
     pub candidates: u32,
     /// One bit per candidate in ascending candidate order, LSB first.
     pub flags: &'a [u32],

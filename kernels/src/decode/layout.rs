@@ -50,7 +50,32 @@ pub struct Params {
     pub arg0: u32,
     pub arg1: u32,
     pub arg2: u32,
-    pub _pad: [u32; 3],
+    /// The stream's [`Schedule`] ([`Schedule::word`]), in every slot.
+    pub schedule: u32,
+    pub _pad: [u32; 2],
+}
+
+/// Which vertices split in which round (SPEC §3.2 header flag bit 1, §6.2,
+/// §7.3; format 3.6), as the kernels take it: the candidates, and what the
+/// per-vertex `deficit` word holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Schedule {
+    /// Deficits; the candidates are the deficit-0 vertices (formats 3.0-3.5).
+    #[default]
+    SplitValences,
+    /// Valences capped at 255; every vertex below n is a candidate.
+    EveryVertex,
+}
+
+impl Schedule {
+    /// `Params::schedule` (common.wgsl: SCHEDULE_EVERY_VERTEX): the header
+    /// flag bit's value.
+    pub const fn word(self) -> u32 {
+        match self {
+            Schedule::SplitValences => 0,
+            Schedule::EveryVertex => 1,
+        }
+    }
 }
 
 /// Bytes between two parameter slots (the minimum uniform-buffer offset
@@ -77,7 +102,7 @@ pub enum KernelFault {
     /// P or C outside `0 .. 2^bits` (position-out-of-range).
     PositionOutOfRange { split: u32 },
     /// Valence + deficit of P or C above 255, or a wing's deficit exhausted
-    /// (valence-overflow).
+    /// (valence-overflow; schedule `split-valences` only).
     ValenceOverflow { split: u32 },
     /// The split would pass the level's triangle count (count-mismatch).
     TriangleLimit { split: u32 },

@@ -2,15 +2,16 @@
 //! §3), one WGSL file per step:
 //!
 //! 1. `candidates.wgsl`: vertices with deficit 0, appended with an atomic
-//!    counter;
+//!    counter (schedule `every-vertex`, format 3.6: every vertex below n, at
+//!    its own index);
 //! 2. `bitonic_sort.wgsl`: the candidates sorted ascending, the order the
-//!    stream's flags follow;
+//!    stream's flags follow (skipped under `every-vertex`: already sorted);
 //! 3. `prefix_number.wgsl`: exclusive prefix sums number the flagged splits
 //!    (C = n + j) and their new triangles (1 or 2 per split);
 //! 4. `split_apply.wgsl`: canonical ring walk (decoder-core's ring.rs), the
 //!    checks of SPEC §7.2-§7.5, then the corner rewrites and new triangles
-//!    with their adjacency (decoder-core's split.rs), wing deficits,
-//!    positions.
+//!    with their adjacency (decoder-core's split.rs), wing deficits (or
+//!    valences), positions.
 //!
 //! The host ([`refine`], feature `wgpu`) supplies per round only what the
 //! stream says: the candidate count, one flag bit per candidate and the
@@ -18,6 +19,8 @@
 //! the sources, layouts and the host-side adjacency builder are compiled.
 
 pub mod adjacency;
+#[cfg(all(test, any(feature = "wgpu", feature = "opencl")))]
+mod every_vertex_tests;
 pub mod host;
 pub mod layout;
 #[cfg(feature = "opencl")]
@@ -27,5 +30,5 @@ pub mod refine;
 pub mod schedule;
 pub mod sources;
 
-pub use layout::{GpuRecord, KernelFault};
+pub use layout::{GpuRecord, KernelFault, Schedule};
 pub use sources::DecodeModule;

@@ -4,7 +4,7 @@
 //! pocl (kernels/tests/decode_faults.rs).
 
 use super::adjacency::build_adjacency;
-pub use super::host::{BaseMesh, RefineError, RoundInput, Snapshot};
+pub use super::host::{BaseMesh, RefineError, RoundInput, Schedule, Snapshot};
 use super::host::{StateBuffer, check_base, check_round, position_limit, round_split_capacity};
 use super::layout::*;
 use super::schedule::{Entry, round_schedule, scan_words};
@@ -45,14 +45,35 @@ pub struct OclRefiner<'c> {
     scan_scratch: u32,
     pos_limit: u32,
     vertex_count: u32,
+    /// `Params::schedule` of every dispatch.
+    schedule: u32,
 }
 
 impl<'c> OclRefiner<'c> {
     /// Uploads `base` into buffers for `vertex_capacity` vertices and
-    /// `triangle_capacity` triangles and builds the program.
+    /// `triangle_capacity` triangles and builds the program, for a stream of
+    /// the schedule `split-valences`.
     pub fn new(
         ctx: &'c OclContext,
         base: BaseMesh<'_>,
+        vertex_capacity: u32,
+        triangle_capacity: u32,
+    ) -> Result<OclRefiner<'c>, RefineError> {
+        OclRefiner::with_schedule(
+            ctx,
+            base,
+            Schedule::SplitValences,
+            vertex_capacity,
+            triangle_capacity,
+        )
+    }
+
+    /// [`OclRefiner::new`] for a stream of `schedule` (as the wgpu
+    /// `Refiner::with_schedule`).
+    pub fn with_schedule(
+        ctx: &'c OclContext,
+        base: BaseMesh<'_>,
+        schedule: Schedule,
         vertex_capacity: u32,
         triangle_capacity: u32,
     ) -> Result<OclRefiner<'c>, RefineError> {
@@ -137,6 +158,7 @@ impl<'c> OclRefiner<'c> {
             scan_scratch: scan_len,
             pos_limit: position_limit(base.bits),
             vertex_count: v0,
+            schedule: schedule.word(),
         })
     }
 
@@ -155,6 +177,7 @@ impl<'c> OclRefiner<'c> {
             sort_len: input.candidates.max(WORKGROUP).next_power_of_two(),
             tri_limit: input.triangle_limit.min(self.triangle_capacity),
             pos_limit: self.pos_limit,
+            schedule: self.schedule,
             ..Params::default()
         };
         let plan = round_schedule(common, self.scan_scratch);

@@ -39,9 +39,10 @@ __kernel void number_splits(DECODE_ARGS) {
             report(counts, 0u, ERR_COUNT);
     }
     if (i >= PARAMS.candidates || flag_bit(flags, i) == 0u) return;
-    uint j = scan[i];
-    if (j < PARAMS.splits) {
-        uint v = cand[i];
+    uint j = scan[i], v = cand[i];
+    // NONE when the host flags more candidates than the device found (the
+    // count fault above): OpenCL has no bounds checks.
+    if (j < PARAMS.splits && v < PARAMS.n) {
         splits[j * SPLIT_WORDS] = v;
         mark[v] = 1u;
     }

@@ -92,8 +92,10 @@ fn number_splits(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let j = scan[i];
-    if j < params.splits {
-        let v = cand[i];
+    let v = cand[i];
+    // A host that flags more candidates than the device found (the count
+    // fault above) leaves NONE here: no mark out of bounds.
+    if j < params.splits && v < params.n {
         splits[j * SPLIT_WORDS] = v;
         mark[v] = 1u;
     }

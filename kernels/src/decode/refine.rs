@@ -12,7 +12,7 @@ use std::sync::mpsc;
 use wgpu::util::DeviceExt;
 
 use super::adjacency::build_adjacency;
-pub use super::host::{BaseMesh, RefineError, RoundInput, Snapshot};
+pub use super::host::{BaseMesh, RefineError, RoundInput, Schedule, Snapshot};
 use super::host::{StateBuffer, check_base, check_round, position_limit, round_split_capacity};
 use super::layout::*;
 use super::schedule::{Entry, round_schedule, scan_words};
@@ -81,14 +81,35 @@ pub struct Refiner<'c> {
     pos_limit: u32,
     /// Vertex count as the host tracks it (the device has its own).
     vertex_count: u32,
+    /// `Params::schedule` of every dispatch.
+    schedule: u32,
 }
 
 impl<'c> Refiner<'c> {
     /// Uploads `base` into buffers sized for `vertex_capacity` vertices and
-    /// `triangle_capacity` triangles (the stream's header capacities).
+    /// `triangle_capacity` triangles (the stream's header capacities), for
+    /// a stream of the schedule `split-valences`.
     pub fn new(
         ctx: &'c WgpuContext,
         base: BaseMesh<'_>,
+        vertex_capacity: u32,
+        triangle_capacity: u32,
+    ) -> Result<Refiner<'c>, RefineError> {
+        Refiner::with_schedule(
+            ctx,
+            base,
+            Schedule::SplitValences,
+            vertex_capacity,
+            triangle_capacity,
+        )
+    }
+
+    /// [`Refiner::new`] for a stream of `schedule` (SPEC §3.2): `base`'s
+    /// deficits are then what decoder-core's state holds under it (§6.2).
+    pub fn with_schedule(
+        ctx: &'c WgpuContext,
+        base: BaseMesh<'_>,
+        schedule: Schedule,
         vertex_capacity: u32,
         triangle_capacity: u32,
     ) -> Result<Refiner<'c>, RefineError> {
@@ -230,6 +251,7 @@ impl<'c> Refiner<'c> {
             scan_scratch: scan_len,
             pos_limit: position_limit(base.bits),
             vertex_count: v0,
+            schedule: schedule.word(),
         })
     }
 
@@ -267,6 +289,7 @@ impl<'c> Refiner<'c> {
             sort_len,
             tri_limit: input.triangle_limit.min(self.triangle_capacity),
             pos_limit: self.pos_limit,
+            schedule: self.schedule,
             ..Params::default()
         };
         let plan = round_schedule(common, self.scan_scratch);

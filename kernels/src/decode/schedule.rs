@@ -1,7 +1,7 @@
 //! The dispatches of one round, shared by the wgpu and OpenCL hosts: which
 //! entry point runs with which parameters over how many workgroups.
 
-use super::layout::{Params, WORKGROUP};
+use super::layout::{Params, Schedule, WORKGROUP};
 use super::sources::DecodeModule;
 
 /// Every entry point of the decoder kernels, in round order.
@@ -140,7 +140,7 @@ fn groups(len: u32) -> u32 {
 }
 
 /// Every dispatch of a round whose shared parameters are `common` (n,
-/// candidates, splits, sort_len, limits); scans keep their block sums from
+/// candidates, splits, sort_len, limits, schedule); scans keep their block sums from
 /// word `scan_scratch` of the scan buffer on.
 pub fn round_schedule(common: Params, scan_scratch: u32) -> Vec<Dispatch> {
     let mut out = Vec::new();
@@ -153,7 +153,14 @@ pub fn round_schedule(common: Params, scan_scratch: u32) -> Vec<Dispatch> {
     };
     push(Entry::ClearCandidates, common, groups(common.sort_len));
     push(Entry::AppendCandidates, common, groups(common.n));
-    for (entry, k, j) in sort_schedule(common.sort_len) {
+    // Under every-vertex (SPEC §7.3, 3.6) append_candidates writes vertex v
+    // at index v: the candidates are in order without the sort.
+    let sort = if common.schedule == Schedule::EveryVertex.word() {
+        Vec::new()
+    } else {
+        sort_schedule(common.sort_len)
+    };
+    for (entry, k, j) in sort {
         let params = Params {
             arg0: k,
             arg1: j,
@@ -248,6 +255,37 @@ mod tests {
                 (Entry::MergeLocal, 1024, 0),
             ]
         );
+    }
+
+    #[test]
+    fn every_vertex_rounds_skip_the_sort() {
+        let common = Params {
+            n: 5000,
+            candidates: 5000,
+            splits: 100,
+            sort_len: 8192,
+            ..Params::default()
+        };
+        let entries = |schedule: Schedule| -> Vec<Entry> {
+            let params = Params {
+                schedule: schedule.word(),
+                ..common
+            };
+            round_schedule(params, 5000)
+                .iter()
+                .map(|d| d.entry)
+                .collect()
+        };
+        let sorting = |e: &Entry| e.module() == DecodeModule::BitonicSort;
+        let split_valences = entries(Schedule::SplitValences);
+        assert_eq!(
+            split_valences.iter().filter(|e| sorting(e)).count(),
+            sort_schedule(8192).len()
+        );
+        let every_vertex = entries(Schedule::EveryVertex);
+        assert!(!every_vertex.iter().any(sorting));
+        let unsorted: Vec<Entry> = split_valences.into_iter().filter(|e| !sorting(e)).collect();
+        assert_eq!(every_vertex, unsorted);
     }
 
     #[test]

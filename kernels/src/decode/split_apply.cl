@@ -1,5 +1,6 @@
 // OpenCL port of split_apply.wgsl: ring walk and checks, wing check,
-// parallel split apply, round finish. See the WGSL file for the reasoning.
+// parallel split apply (under every-vertex, 3.6: wing valences grow, no
+// deficit checks), round finish. See the WGSL file for the reasoning.
 
 inline uint wedge_step(__global const uint *opposite, uint c) {
     uint o = opposite[next_corner(c)];
@@ -87,12 +88,13 @@ __kernel void ring_check(DECODE_ARGS) {
     }
     uint len_p = rec.config != 0u ? k - d : d;
     uint len_c = k - len_p;
-    if ((rec.deficit_p != LEAF && len_p + 2u + rec.deficit_p > MAX_RING)
-        || (rec.deficit_c != LEAF && len_c + 2u + rec.deficit_c > MAX_RING)) {
+    bool every = EVERY_VERTEX;
+    if (!every && ((rec.deficit_p != LEAF && len_p + 2u + rec.deficit_p > MAX_RING)
+        || (rec.deficit_c != LEAF && len_c + 2u + rec.deficit_c > MAX_RING))) {
         report(counts, key, ERR_VALENCE);
         return;
     }
-    if ((a != NONE && deficit[a] == 0u) || (b != NONE && deficit[b] == 0u)) {
+    if (!every && ((a != NONE && deficit[a] == 0u) || (b != NONE && deficit[b] == 0u))) {
         report(counts, key, ERR_VALENCE);
         return;
     }
@@ -105,6 +107,7 @@ __kernel void ring_check(DECODE_ARGS) {
     splits[base + 5u] = added;
     splits[base + 6u] = 1u;
     scan[j] = added;
+    if (every) return;
     if (a != NONE && deficit[a] != LEAF) atomic_inc(&uses[a]);
     if (b != NONE && deficit[b] != LEAF) atomic_inc(&uses[b]);
 }
@@ -114,7 +117,7 @@ __kernel void wing_check(DECODE_ARGS) {
     uint base = j * SPLIT_WORDS;
     if (j >= PARAMS.splits || splits[base + 6u] == 0u) return;
     uint key = j + 1u;
-    for (uint w = 0u; w < 2u; w++) {
+    for (uint w = 0u; w < 2u && !EVERY_VERTEX; w++) {
         uint x = splits[base + 3u + w];
         if (x != NONE) {
             uint dx = deficit[x];
@@ -185,8 +188,14 @@ __kernel void apply(DECODE_ARGS) {
         vertex_corner[x] = 3u * tb + 1u;
         vertex_corner[y] = 3u * tb;
     }
-    if (a != NONE && deficit[a] != LEAF) atomic_dec(&deficit[a]);
-    if (b != NONE && deficit[b] != LEAF) atomic_dec(&deficit[b]);
+    if (EVERY_VERTEX) {
+        // Add, then clamp at 255: wings shared by splits end capped.
+        if (a != NONE) { atomic_inc(&deficit[a]); atomic_min(&deficit[a], BYTE_MAX); }
+        if (b != NONE) { atomic_inc(&deficit[b]); atomic_min(&deficit[b], BYTE_MAX); }
+    } else {
+        if (a != NONE && deficit[a] != LEAF) atomic_dec(&deficit[a]);
+        if (b != NONE && deficit[b] != LEAF) atomic_dec(&deficit[b]);
+    }
     positions[3u * r] = rec.px;
     positions[3u * r + 1u] = rec.py;
     positions[3u * r + 2u] = rec.pz;

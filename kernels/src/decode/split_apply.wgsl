@@ -2,16 +2,19 @@
 // The independence rule (§7.2) makes every split touch a disjoint part of
 // the corner table (R's wedges, the opposite entries facing them) and of the
 // vertex arrays (R, C); only a wing's deficit can be shared by two splits,
-// hence the atomics on `deficit` and `uses`.
+// hence the atomics on `deficit` and `uses`. Under the schedule every-vertex
+// (3.6) `deficit` holds valences capped at 255: a wing's grows by one, P's
+// and C's are the record's, and none of the deficit checks apply (§7.5).
 //
 // ring_check  (per split) canonical ring walk exactly as decoder-core's
 //             ring.rs, the checks of §7.2-§7.5 in the reference's order,
 //             triangles added -> scan (prefix_number.wgsl numbers them);
-// wing_check  (per split) wings shared by several splits of the round, and
-//             the level's triangle limit, once the triangle numbers are known;
+// wing_check  (per split) wings shared by several splits of the round
+//             (split-valences), and the level's triangle limit, once the
+//             triangle numbers are known;
 // apply       (per split) corner rewrites and new triangles with their
 //             opposite links exactly as decoder-core's split.rs, positions,
-//             deficits; skipped entirely when any check failed;
+//             deficits or valences; skipped entirely when any check failed;
 // finish      clears the marks and advances the vertex and triangle counts.
 
 @group(0) @binding(2) var<storage, read_write> positions: array<u32>;
@@ -211,12 +214,14 @@ fn ring_check(@builtin(global_invocation_id) gid: vec3<u32>) {
         len_p = k - d;
     }
     let len_c = k - len_p;
-    if (rec.deficit_p != LEAF && len_p + 2u + rec.deficit_p > MAX_RING)
-        || (rec.deficit_c != LEAF && len_c + 2u + rec.deficit_c > MAX_RING) {
+    // §7.5: deficits only; every-vertex (3.6) has no valence to overflow.
+    let every = every_vertex();
+    if !every && ((rec.deficit_p != LEAF && len_p + 2u + rec.deficit_p > MAX_RING)
+        || (rec.deficit_c != LEAF && len_c + 2u + rec.deficit_c > MAX_RING)) {
         report(key, ERR_VALENCE);
         return;
     }
-    if (a != NONE && load_deficit(a) == 0u) || (b != NONE && load_deficit(b) == 0u) {
+    if !every && ((a != NONE && load_deficit(a) == 0u) || (b != NONE && load_deficit(b) == 0u)) {
         report(key, ERR_VALENCE);
         return;
     }
@@ -232,6 +237,9 @@ fn ring_check(@builtin(global_invocation_id) gid: vec3<u32>) {
     splits[base + 5u] = added;
     splits[base + 6u] = 1u;
     scan[j] = added;
+    if every {
+        return; // no wing deficit to share out (wing_check)
+    }
     for (var w = 0u; w < 2u; w = w + 1u) {
         let x = select(a, b, w == 1u);
         if x != NONE && load_deficit(x) != LEAF {
@@ -242,7 +250,8 @@ fn ring_check(@builtin(global_invocation_id) gid: vec3<u32>) {
 
 // After the triangle scan: a wing used by more splits than its deficit
 // allows (decoder-core fails at the split that takes it below 0; here every
-// sharer reports and the smallest index wins), and the triangle limit.
+// sharer reports and the smallest index wins; split-valences only), and the
+// triangle limit.
 @compute @workgroup_size(256)
 fn wing_check(@builtin(global_invocation_id) gid: vec3<u32>) {
     let j = gid.x;
@@ -251,7 +260,8 @@ fn wing_check(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let key = j + 1u;
-    for (var w = 0u; w < 2u; w = w + 1u) {
+    // every-vertex (3.6): no deficit to exhaust, nothing counted in `uses`.
+    for (var w = 0u; w < 2u && !every_vertex(); w = w + 1u) {
         let x = splits[base + 3u + w];
         if x != NONE {
             let dx = load_deficit(x);
@@ -379,7 +389,16 @@ fn apply(@builtin(global_invocation_id) gid: vec3<u32>) {
     }
     for (var w = 0u; w < 2u; w = w + 1u) {
         let wing = select(a, b, w == 1u);
-        if wing != NONE && load_deficit(wing) != LEAF {
+        if wing == NONE {
+            continue;
+        }
+        if every_vertex() {
+            // §7.5 (3.6): the wing gains a neighbour, its valence saturates
+            // at 255. Splits sharing the wing each add, then clamp: the last
+            // operation on the word is a clamp, after every add.
+            atomicAdd(&deficit[wing], 1u);
+            atomicMin(&deficit[wing], BYTE_MAX);
+        } else if load_deficit(wing) != LEAF {
             atomicSub(&deficit[wing], 1u);
         }
     }
@@ -389,6 +408,7 @@ fn apply(@builtin(global_invocation_id) gid: vec3<u32>) {
     positions[3u * cv] = rec.cx;
     positions[3u * cv + 1u] = rec.cy;
     positions[3u * cv + 2u] = rec.cz;
+    // every-vertex: the record holds P's and C's valences, capped (§7.4).
     atomicStore(&deficit[r], rec.deficit_p);
     atomicStore(&deficit[cv], rec.deficit_c);
 }

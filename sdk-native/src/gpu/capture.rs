@@ -3,13 +3,16 @@
 //! candidate (in ascending candidate order) and the flagged splits' records
 //! with their final positions.
 
-use splitstream_decoder_core::{Error, MeshState, RecordSource, Ring, SplitOutcome, SplitRecord};
+use splitstream_decoder_core::{
+    Error, MeshState, RecordSource, Ring, Schedule, SplitOutcome, SplitRecord,
+};
 use splitstream_kernels::decode::GpuRecord;
 
 /// One round as the stream gave it, in the GPU's terms.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct CapturedRound {
-    /// Vertices with deficit 0 at round start.
+    /// Vertices with deficit 0 at round start; under the schedule
+    /// `every-vertex` (SPEC §7.3, 3.6), all of them.
     pub candidates: u32,
     /// Bit i (LSB first) is candidate i's flag; candidates whose flag the
     /// format infers (a neighbour flagged before them) read 0.
@@ -54,15 +57,17 @@ impl<S> Capture<S> {
     fn start(&mut self, state: &MeshState<'_>) {
         // Flags are read before any split of the round: the state is the
         // round's starting state, whose candidates are the deficit-0
-        // vertices (scanned here; the two-thread capture reads them from
-        // decoder-core's bitmap, and the tests compare the two).
+        // vertices, or under every-vertex every vertex (SPEC §7.3; scanned
+        // here; the two-thread capture reads them from decoder-core's
+        // bitmap, and the tests compare the two).
         self.candidates.clear();
+        let every_vertex = state.schedule() == Schedule::EveryVertex;
         self.candidates.extend(
             state
                 .deficits()
                 .iter()
                 .enumerate()
-                .filter(|&(_, &d)| d == 0)
+                .filter(|&(_, &d)| every_vertex || d == 0)
                 .map(|(v, _)| v as u32),
         );
         let count = self.candidates.len();

@@ -1,7 +1,9 @@
 //! GPU decoding (feature `gpu`): the refinement rounds run on a wgpu device
 //! (or, with feature `opencl`, an OpenCL device) with splitstream-kernels'
 //! decoder kernels (candidates by atomic append,
-//! bitonic sort, prefix numbering, parallel split apply).
+//! bitonic sort, prefix numbering, parallel split apply), for streams of
+//! either schedule (SPEC §3.2: `split-valences`, or `every-vertex`, whose
+//! candidates are every vertex and whose per-vertex bytes are valences).
 //!
 //! Phase 1 (this module): the CPU reads the stream with decoder-core
 //! ([`capture_stream`]: headers, chunks, entropy decoding, records with

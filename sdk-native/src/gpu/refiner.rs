@@ -1,9 +1,11 @@
 //! [`GpuRefiner`]: a base state on the device, refined round by round from
 //! the rounds' flags and records.
 
-use splitstream_decoder_core::{Fnv1a, MeshState};
+use splitstream_decoder_core::{Fnv1a, MeshState, Schedule};
 use splitstream_kernels::decode::adjacency::check_adjacency;
-use splitstream_kernels::decode::host::{BaseMesh, RefineError, RoundInput, Snapshot};
+use splitstream_kernels::decode::host::{
+    BaseMesh, RefineError, RoundInput, Schedule as GpuSchedule, Snapshot,
+};
 #[cfg(feature = "opencl")]
 use splitstream_kernels::decode::ocl_refine::OclRefiner;
 use splitstream_kernels::decode::refine::Refiner;
@@ -67,17 +69,20 @@ impl<'c> GpuRefiner<'c> {
             deficits: &base.deficits,
             bits: base.bits,
         };
+        // SPEC §3.2 (3.6): the kernels' candidates and per-vertex bytes.
+        let schedule = match base.schedule {
+            Schedule::SplitValences => GpuSchedule::SplitValences,
+            Schedule::EveryVertex => GpuSchedule::EveryVertex,
+        };
+        let (vcap, tcap) = (vertex_capacity, triangle_capacity);
         let inner = match device {
             GpuDevice::Wgpu(ctx) => {
-                Inner::Wgpu(Refiner::new(ctx, mesh, vertex_capacity, triangle_capacity)?)
+                Inner::Wgpu(Refiner::with_schedule(ctx, mesh, schedule, vcap, tcap)?)
             }
             #[cfg(feature = "opencl")]
-            GpuDevice::OpenCl(ctx) => Inner::OpenCl(OclRefiner::new(
-                ctx,
-                mesh,
-                vertex_capacity,
-                triangle_capacity,
-            )?),
+            GpuDevice::OpenCl(ctx) => {
+                Inner::OpenCl(OclRefiner::with_schedule(ctx, mesh, schedule, vcap, tcap)?)
+            }
         };
         Ok(GpuRefiner { inner, rounds: 0 })
     }
@@ -151,7 +156,8 @@ impl<'c> GpuRefiner<'c> {
 }
 
 /// SPEC §8 over a read-back state: 64-bit FNV-1a of V, T, every vertex's
-/// x, y, z and deficit, every triangle's corners.
+/// x, y, z and deficit (under `every-vertex`: valence), every triangle's
+/// corners.
 pub fn snapshot_hash(s: &Snapshot) -> u64 {
     let mut h = Fnv1a::default();
     h.u32(s.positions.len() as u32);

@@ -17,8 +17,8 @@ use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::record::{StreamSource, read_base};
 use splitstream_decoder_core::substream::Substreams;
 use splitstream_decoder_core::{
-    Error, Header, Inflater, LevelTable, MeshState, Ring, RoundInfo, SplitRecord, declared_layout,
-    layout_for,
+    Error, Header, Inflater, LevelTable, MeshState, Ring, RoundInfo, Schedule, SplitRecord,
+    declared_layout, layout_for,
 };
 
 use super::capture::{Capture, CapturedRound, gpu_record};
@@ -29,8 +29,12 @@ use crate::threaded::{RoundTap, TwoThreadMemory, decode_level_tapped};
 pub struct BaseState {
     pub positions: Vec<[u32; 3]>,
     pub triangles: Vec<[u32; 3]>,
+    /// Deficits, or under the schedule `every-vertex` valences (SPEC §6.2).
     pub deficits: Vec<u8>,
     pub bits: u8,
+    /// The stream's schedule (SPEC §3.2, format 3.6): what `deficits` hold
+    /// and which vertices the GPU takes as candidates.
+    pub schedule: Schedule,
 }
 
 impl BaseState {
@@ -41,6 +45,7 @@ impl BaseState {
             triangles: state.triangles().to_vec(),
             deficits: state.deficits().to_vec(),
             bits: state.bits(),
+            schedule: state.schedule(),
         }
     }
 }
@@ -137,7 +142,9 @@ fn capture_into(
     }
     let mut workspace = vec![0u8; len];
     let (memory, mut buffers) = full.carve(&mut workspace)?;
-    let mut state = MeshState::new(memory, header.bits);
+    // SPEC §3.2 (3.6): the seed's bytes and the rounds' candidates follow
+    // the schedule, as in decoder-core's `Decoder`.
+    let mut state = MeshState::new(memory, header.bits, header.schedule);
     let mut inflater = Box::new(Inflater::new());
     let mut ring = Box::new(Ring::default());
     for k in 0..header.level_count {
@@ -148,7 +155,7 @@ fn capture_into(
             .ok_or(Error::Truncated)?;
         // SPEC §5.1: the level header against the table entry.
         let is_base = k == 0;
-        let level_header = table.level_header(k, bytes, header.max_chunk_len)?;
+        let level_header = table.level_header(k, bytes, header.max_chunk_len, header.schedule)?;
         state.set_triangle_limit(info.triangle_count);
         if is_base {
             let slots = buffers.each_mut().map(|b| &mut **b);
@@ -290,7 +297,9 @@ struct CaptureTap<'o> {
 
 impl CaptureTap<'_> {
     /// A round starts from `state`: its candidates are the vertices of
-    /// deficit 0, which the round's flags follow in ascending order.
+    /// deficit 0 (under `every-vertex`: every vertex; decoder-core's bitmap
+    /// follows the schedule), which the round's flags follow in ascending
+    /// order.
     fn begin_round(&mut self, state: &MeshState<'_>) {
         let n = state.vertex_count() as usize;
         self.candidates.clear();
