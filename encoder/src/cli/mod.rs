@@ -288,6 +288,10 @@ pub enum Command {
         /// Also write the stream here.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// How the stream says which vertices split in which round (SPEC
+        /// §3.2; as `encode --schedule`).
+        #[arg(long, value_enum, default_value_t = ScheduleArg::EveryVertex)]
+        schedule: ScheduleArg,
     },
 }
 
@@ -319,7 +323,11 @@ pub fn run(cli: Cli) -> CliResult {
         Command::Bench(settings) => bench::run(&settings),
         Command::GpuBench(settings) => gpu_bench::run(&settings),
         Command::Grid(args) => grid::run(args),
-        Command::Demo { side, output } => demo::run(side, output.as_deref()),
+        Command::Demo {
+            side,
+            output,
+            schedule,
+        } => demo::run(side, output.as_deref(), schedule.into()),
     }
 }
 
