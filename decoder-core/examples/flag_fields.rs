@@ -55,12 +55,10 @@ fn main() {
     out.flush().unwrap_or_else(|e| fail(output, &e));
 }
 
-/// The candidates of the coming round: vertices with deficit 0 (SPEC §7.3).
+/// The candidates of the coming round (SPEC §7.3): vertices with deficit
+/// 0, or every vertex under the schedule `every-vertex`.
 fn candidates(state: &MeshState<'_>) -> Vec<u32> {
-    let n = state.vertex_count() as usize;
-    (0..n as u32)
-        .filter(|&v| state.deficits()[v as usize] == 0)
-        .collect()
+    state.candidates().collect()
 }
 
 /// Decodes `stream`, writing every coded flag; the outer error is the

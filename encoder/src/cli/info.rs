@@ -6,7 +6,9 @@ use splitstream_decoder_core::limits::VERSION_MAJOR;
 use splitstream_decoder_core::limits::codec;
 use splitstream_decoder_core::limits::substream::{self, NAMES};
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{Header, LevelHeader, LevelTable, PositionMode, layout_for};
+use splitstream_decoder_core::{
+    Header, LevelHeader, LevelTable, PositionMode, Schedule, layout_for,
+};
 use splitstream_encoder::emit::{TranscodeOptions, transcode};
 
 use super::{CliResult, read_file};
@@ -200,11 +202,13 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
                     LevelHeader::parse(b, k == 0, header.max_chunk_len, header.schedule).ok()
                 })
                 .map_or(("?", "?", "?"), |lh| {
-                    (
-                        lh.plane_policy.name(),
-                        lh.wing_policy.name(),
-                        lh.deficit_contexts.name(),
-                    )
+                    // Under `every-vertex` no split valences are coded
+                    // (SPEC §3.2): no deficit contexts to name.
+                    let deficits = match header.schedule {
+                        Schedule::SplitValences => lh.deficit_contexts.name(),
+                        Schedule::EveryVertex => "-",
+                    };
+                    (lh.plane_policy.name(), lh.wing_policy.name(), deficits)
                 })
         })
         .collect();
@@ -254,7 +258,8 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
                     "rounds": e.round_count, "geometric_error": e.geometric_error,
                     "plane_policy": policies[k as usize].0,
                     "wing_policy": policies[k as usize].1,
-                    "deficit_contexts": policies[k as usize].2,
+                    // null where the schedule codes no split valences.
+                    "deficit_contexts": (policies[k as usize].2 != "-").then_some(policies[k as usize].2),
                     "workspace_bytes": memory[k as usize],
                 })
             })

@@ -340,7 +340,8 @@ impl Session {
         self.state().triangles()
     }
 
-    /// One deficit byte per vertex (SPEC §6.2).
+    /// The byte SPEC §6.2 keeps per vertex: its deficit, or under the
+    /// schedule `every-vertex` (format 3.6) its valence, capped at 255.
     pub fn deficits(&self) -> &[u8] {
         self.state().deficits()
     }
