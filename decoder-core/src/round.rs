@@ -110,8 +110,9 @@ impl MeshState<'_> {
             return Err(Error::CapacityExceeded);
         }
         let words = (n as usize).div_ceil(64);
-        // Step 1: the candidates are the vertices below n with deficit 0;
-        // the bitmap is kept up to date by every split (SPEC §7.3). A copy
+        // Step 1: the candidates are the vertices below n with deficit 0,
+        // or every one of them under the schedule `every-vertex` (3.6); the
+        // bitmap is kept up to date by every split (SPEC §7.3). A copy
         // of it as it is now says which ring entries may be wings during
         // the round (SPEC §7.4, symbols.rs): splits change the live bitmap.
         let (candidates, round_start, _) = self.bitmaps();

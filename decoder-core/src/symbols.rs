@@ -9,6 +9,8 @@
 //! set is taken at the start of the round, not from the live deficits, so
 //! that the splits of a round stay independent of their order (SPEC §7.2):
 //! [`MeshState::run_round`] keeps a copy of the round's candidate bitmap.
+//! Under the schedule `every-vertex` (format 3.6) no vertex has a split
+//! valence, so every ring entry may be a wing ([`WingCandidates::all`]).
 
 use crate::Error;
 use crate::header::Schedule;

@@ -1,12 +1,13 @@
 //! The decoder kernels on real devices (lavapipe for WGSL, pocl for OpenCL
-//! C in CI): one valid split on an octahedron, and every fault the kernels
-//! detect, each with the SPEC §10.1 class the reference decoder gives it.
+//! C in CI): one valid split on an octahedron, every fault the kernels
+//! detect, each with the SPEC §10.1 class the reference decoder gives it,
+//! and the schedule `every-vertex` (SPEC §6.2, §7.3, §7.5; format 3.6).
 //! Each API compiled in (features `wgpu`, `opencl`) is tested; without its
 //! device a test prints a skip note, except under `CI`, where it fails.
 #![cfg(any(feature = "wgpu", feature = "opencl"))]
 
 use splitstream_kernels::decode::adjacency::check_adjacency;
-use splitstream_kernels::decode::host::{BaseMesh, RoundInput, Snapshot};
+use splitstream_kernels::decode::host::{BaseMesh, RoundInput, Schedule, Snapshot};
 use splitstream_kernels::decode::layout::LEAF;
 use splitstream_kernels::decode::{GpuRecord, KernelFault};
 use splitstream_kernels::gpu::GpuError;
@@ -89,6 +90,28 @@ fn run(
     records: &[GpuRecord],
     triangle_limit: u32,
 ) -> Snapshot {
+    run_in(
+        Schedule::SplitValences,
+        device,
+        deficits,
+        candidates,
+        flags,
+        records,
+        triangle_limit,
+    )
+}
+
+/// [`run`] under `schedule`: under `every-vertex` the per-vertex bytes are
+/// valences and every vertex below n is a candidate.
+fn run_in(
+    schedule: Schedule,
+    device: &Device,
+    deficits: [u8; 6],
+    candidates: u32,
+    flags: u32,
+    records: &[GpuRecord],
+    triangle_limit: u32,
+) -> Snapshot {
     let base = BaseMesh {
         positions: &POSITIONS,
         triangles: &OCTAHEDRON,
@@ -105,14 +128,15 @@ fn run(
         #[cfg(feature = "wgpu")]
         Device::Wgpu(ctx) => {
             use splitstream_kernels::decode::refine::Refiner;
-            let mut refiner = Refiner::new(ctx, base, 16, 32).expect("refiner");
+            let mut refiner = Refiner::with_schedule(ctx, base, schedule, 16, 32).expect("refiner");
             refiner.round(round).expect("round");
             refiner.snapshot(true).expect("snapshot")
         }
         #[cfg(feature = "opencl")]
         Device::OpenCl(ctx) => {
             use splitstream_kernels::decode::ocl_refine::OclRefiner;
-            let mut refiner = OclRefiner::new(ctx, base, 16, 32).expect("refiner");
+            let mut refiner =
+                OclRefiner::with_schedule(ctx, base, schedule, 16, 32).expect("refiner");
             refiner.round(round).expect("round");
             refiner.snapshot(true).expect("snapshot")
         }
@@ -280,5 +304,93 @@ fn buffers_over_the_device_limits_are_a_typed_error() {
             Err(e) => panic!("expected TooLarge, got {e}"),
             Ok(_) => assert!(needed <= limit, "{needed} bytes of records over {limit}"),
         }
+    }
+}
+
+/// Every octahedron vertex has valence 4.
+const VALENCES: [u8; 6] = [4; 6];
+
+/// A split with o = 0, d = 2 on a ring of 4: P and C get valence 4 (SPEC
+/// §7.4 under `every-vertex`: the record's bytes are the valences).
+fn every_vertex_record() -> GpuRecord {
+    GpuRecord {
+        deficit_p: 4,
+        deficit_c: 4,
+        position_p: [150, 150, 150],
+        position_c: [50, 50, 50],
+        ..record(0, 2)
+    }
+}
+
+/// One round of `records` on the octahedron with per-vertex `bytes`
+/// under `schedule`, on every device.
+fn every_device(
+    schedule: Schedule,
+    bytes: [u8; 6],
+    candidates: u32,
+    flags: u32,
+    records: &[GpuRecord],
+) -> Vec<Snapshot> {
+    devices()
+        .iter()
+        .map(|d| run_in(schedule, d, bytes, candidates, flags, records, 32))
+        .collect()
+}
+
+#[test]
+fn every_vertex_is_a_candidate_and_wings_gain_a_valence() {
+    // Six candidates, flag of candidate 0 = vertex 0 (ring [2, 4, 3, 5],
+    // wings 2 and 3). Under split-valences the same bytes hold no deficit-0
+    // vertex, so the GPU's candidate count differs from the host's.
+    let one = [every_vertex_record()];
+    for s in every_device(Schedule::EveryVertex, VALENCES, 6, 1, &one) {
+        assert_eq!(s.fault, None);
+        assert_eq!(s.deficits, vec![4, 4, 5, 5, 4, 4, 4]);
+        assert_eq!(s.positions[6], [50, 50, 50]);
+        assert_eq!(s.corners.len(), 30);
+    }
+    for s in every_device(Schedule::SplitValences, VALENCES, 6, 1, &one) {
+        assert_eq!(s.fault, Some(KernelFault::CountMismatch));
+    }
+    // The candidates are the vertices below n, not the deficit-0 ones.
+    for s in every_device(Schedule::EveryVertex, VALENCES, 5, 1, &one) {
+        assert_eq!(s.fault, Some(KernelFault::CountMismatch));
+    }
+}
+
+#[test]
+fn every_vertex_skips_the_deficit_checks() {
+    // A wing (2) whose byte is 0 and a P byte that would overflow as a
+    // deficit: both valence-overflow under split-valences (SPEC §7.5), not
+    // checked under every-vertex, where the bytes are stored as they come.
+    let heavy = [GpuRecord {
+        deficit_p: 254,
+        ..every_vertex_record()
+    }];
+    let bytes = [0, 4, 0, 4, 4, 4];
+    for s in every_device(Schedule::EveryVertex, bytes, 6, 1, &heavy) {
+        assert_eq!(s.fault, None);
+        assert_eq!(s.deficits, vec![254, 4, 1, 5, 4, 4, 4]);
+    }
+    for s in every_device(Schedule::SplitValences, bytes, 2, 1, &heavy) {
+        assert_eq!(s.fault.map(KernelFault::class), Some("valence-overflow"));
+    }
+}
+
+#[test]
+fn shared_wings_gain_one_per_split_up_to_255() {
+    // Poles 4 and 5 (candidates 4 and 5) share their wings 0 and 1 (rings
+    // [0, 2, 1, 3] and [0, 3, 1, 2]): each gains 2, wing 0 stops at 255
+    // from 254, wing 1 stays at 255. A split-valences deficit of 255 would
+    // be a leaf; here it is a valence and grows no further.
+    let two = [every_vertex_record(); 2];
+    let bytes = [254, 255, 4, 4, 4, 4];
+    for s in every_device(Schedule::EveryVertex, bytes, 6, 0b11_0000, &two) {
+        assert_eq!(s.fault, None);
+        assert_eq!((s.positions.len(), s.corners.len() / 3), (8, 12));
+        assert_eq!(s.deficits, vec![255, 255, 4, 4, 4, 4, 4, 4]);
+    }
+    for s in every_device(Schedule::EveryVertex, VALENCES, 6, 0b11_0000, &two) {
+        assert_eq!(s.deficits, vec![6, 6, 4, 4, 4, 4, 4, 4]);
     }
 }

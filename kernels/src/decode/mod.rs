@@ -19,8 +19,6 @@
 //! the sources, layouts and the host-side adjacency builder are compiled.
 
 pub mod adjacency;
-#[cfg(all(test, any(feature = "wgpu", feature = "opencl")))]
-mod every_vertex_tests;
 pub mod host;
 pub mod layout;
 #[cfg(feature = "opencl")]
