@@ -47,19 +47,15 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
     );
 
     // Encoded meshes.
-    let sphere3 = meshes::checked(meshes::icosphere(3), "icosphere(3)");
-    let sphere2 = meshes::checked(meshes::icosphere(2), "icosphere(2)");
-    let holed = meshes::checked(
-        meshes::grid(24, 20, 1, Some([8, 15, 6, 12])),
-        "grid with hole",
-    );
-    let small_holed = meshes::checked(
-        meshes::grid(14, 12, 4, Some([4, 9, 4, 8])),
-        "small grid with hole",
-    );
+    let Shapes {
+        sphere3,
+        sphere2,
+        holed,
+        small_holed,
+        cone,
+    } = Shapes::new();
     let bumpy = meshes::checked(meshes::grid(30, 30, 2, None), "grid");
     let locked = meshes::checked(meshes::grid(16, 16, 3, None), "grid for lock_boundary");
-    let cone = meshes::checked(meshes::cone(96, 4), "cone");
     s.valid(
         "icosphere-optimal-deflate",
         "Icosphere (642 vertices, closed): optimal positions, deflate, 5 levels.",
@@ -453,26 +449,62 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
         &["encoded", "real-mesh"],
         encoded(&bunny, opts()),
     );
-    every_vertex_vectors(s, &bunny);
+    let shapes = Shapes {
+        sphere3,
+        sphere2,
+        holed,
+        small_holed,
+        cone,
+    };
+    every_vertex_vectors(s, &bunny, &shapes);
     Ok(())
+}
+
+/// The synthetic meshes that the split-valences vectors and the
+/// every-vertex ones both encode.
+struct Shapes {
+    /// Icosphere of 642 vertices.
+    sphere3: Mesh,
+    /// Icosphere of 162 vertices.
+    sphere2: Mesh,
+    /// Height field with an outer boundary and a rectangular hole.
+    holed: Mesh,
+    /// A smaller one, with a hole too.
+    small_holed: Mesh,
+    /// Cone of 96 sides: an apex of high valence.
+    cone: Mesh,
+}
+
+impl Shapes {
+    fn new() -> Shapes {
+        Shapes {
+            sphere3: meshes::checked(meshes::icosphere(3), "icosphere(3)"),
+            sphere2: meshes::checked(meshes::icosphere(2), "icosphere(2)"),
+            holed: meshes::checked(
+                meshes::grid(24, 20, 1, Some([8, 15, 6, 12])),
+                "grid with hole",
+            ),
+            small_holed: meshes::checked(
+                meshes::grid(14, 12, 4, Some([4, 9, 4, 8])),
+                "small grid with hole",
+            ),
+            cone: meshes::checked(meshes::cone(96, 4), "cone"),
+        }
+    }
 }
 
 /// The schedule `every-vertex` (SPEC §3.2, §6.2, §7.3–§7.5, format 3.6):
 /// the encoder's current defaults, and the options the vectors above vary
 /// for split valences (position modes, codecs, chunks, lanes, boundaries,
 /// wing and plane policies, levels).
-fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh) {
-    let sphere3 = meshes::checked(meshes::icosphere(3), "icosphere(3)");
-    let sphere2 = meshes::checked(meshes::icosphere(2), "icosphere(2)");
-    let holed = meshes::checked(
-        meshes::grid(24, 20, 1, Some([8, 15, 6, 12])),
-        "grid with hole",
-    );
-    let small_holed = meshes::checked(
-        meshes::grid(14, 12, 4, Some([4, 9, 4, 8])),
-        "small grid with hole",
-    );
-    let cone = meshes::checked(meshes::cone(96, 4), "cone");
+fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh, shapes: &Shapes) {
+    let Shapes {
+        sphere3,
+        sphere2,
+        holed,
+        small_holed,
+        cone,
+    } = shapes;
     let tag = "schedule-every-vertex";
     s.valid(
         "every-vertex-bunny-npm",
@@ -484,14 +516,14 @@ fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh) {
         "every-vertex-icosphere-optimal-deflate",
         "Icosphere (642 vertices, closed): optimal positions, deflate, the schedule every-vertex.",
         &["encoded", tag],
-        encoded(&sphere3, every_vertex(deflate_opts())),
+        encoded(sphere3, every_vertex(deflate_opts())),
     );
     s.valid(
         "every-vertex-icosphere-constrained-stored",
         "Icosphere (162 vertices), constrained positions, stored chunks, 10 bits, the schedule every-vertex.",
         &["encoded", tag],
         encoded(
-            &sphere2,
+            sphere2,
             every_vertex(EncodeOptions {
                 position_mode: PositionMode::Constrained,
                 codec: ChunkCodec::Stored,
@@ -504,14 +536,14 @@ fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh) {
         "every-vertex-grid-hole-optimal-rans",
         "Height field with an outer boundary and a rectangular hole (ghost wings, boundary valences), optimal positions, rANS, the schedule every-vertex.",
         &["encoded", "hole", tag],
-        encoded(&holed, every_vertex(opts())),
+        encoded(holed, every_vertex(opts())),
     );
     s.valid(
         "every-vertex-grid-hole-tiny-chunks",
         "Small height field with a hole, constrained positions, 7-byte stored chunks (flag bits straddle chunks), the schedule every-vertex.",
         &["encoded", "hole", "tiny-chunks", tag],
         encoded(
-            &small_holed,
+            small_holed,
             every_vertex(EncodeOptions {
                 position_mode: PositionMode::Constrained,
                 codec: ChunkCodec::Stored,
@@ -526,7 +558,7 @@ fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh) {
         "Cone of 96 sides (an apex of valence 97 and above: the flag context of the largest valences), rANS in 1 lane with 64-value chunks, the schedule every-vertex.",
         &["encoded", "rans", tag],
         encoded(
-            &cone,
+            cone,
             every_vertex(EncodeOptions {
                 codec: ChunkCodec::RansAlways { lanes: 1 },
                 rans_chunk_limit: 64,
@@ -539,7 +571,7 @@ fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh) {
         "Icosphere (642 vertices), rANS in 32 lanes, 8 levels, the schedule every-vertex.",
         &["encoded", "rans", tag],
         encoded(
-            &sphere3,
+            sphere3,
             every_vertex(EncodeOptions {
                 codec: ChunkCodec::RansAlways { lanes: 32 },
                 levels: 8,
@@ -562,7 +594,7 @@ fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh) {
                 ),
                 &["encoded", "wing-policy", tag],
                 encoded(
-                    &small_holed,
+                    small_holed,
                     every_vertex(EncodeOptions {
                         position_mode: mode,
                         wings: Some(policy),

@@ -162,6 +162,10 @@ struct Refinement {
     seed_positions: Vec<[u32; 3]>,
     seed_triangles: Vec<[u32; 3]>,
     seed_deficits: Vec<u8>,
+    /// The seed's split valences where the stream codes none (the schedule
+    /// `every-vertex`: [`derive_split_valences`]); otherwise they follow
+    /// from `seed_deficits`.
+    seed_split_valences: Option<Vec<u8>>,
     /// Every round's collapses, in decoding order.
     rounds: Vec<Vec<Collapse>>,
     plan: LevelPlan,
@@ -183,26 +187,15 @@ fn split_valence(deficit: u8, valence: usize) -> u8 {
 /// codes none (SPEC §6.2): a vertex's split valence is its valence when it
 /// next splits, the ring length of that split, or [`NO_SPLIT`] when it
 /// never splits again. Sets them on the collapses (`rounds`, whose splits
-/// have the ring lengths `ring_lengths` in order) and returns the seed's
-/// as the deficits a `split-valences` seed would code (split valence −
-/// valence, or LEAF), which [`Refinement::simplification`] turns back.
-fn derive_split_valences(
-    rounds: &mut [Vec<Collapse>],
-    ring_lengths: &[u8],
-    seed_triangles: &[[u32; 3]],
-) -> Vec<u8> {
+/// have the ring lengths `ring_lengths` in order) and returns those of the
+/// `v0` seed vertices.
+fn derive_split_valences(rounds: &mut [Vec<Collapse>], ring_lengths: &[u8], v0: usize) -> Vec<u8> {
     #[derive(Clone, Copy)]
     enum Owner {
         Seed,
         P(usize),
         C(usize),
     }
-    let v0 = seed_triangles
-        .iter()
-        .flatten()
-        .map(|&v| v as usize + 1)
-        .max()
-        .unwrap_or(0);
     let splits: usize = rounds.iter().map(Vec::len).sum();
     let mut owner = vec![Owner::Seed; v0 + splits];
     let mut seed_split_valence = vec![NO_SPLIT; v0];
@@ -226,20 +219,7 @@ fn derive_split_valences(
         col.split_valence_p = sv_p[f];
         col.split_valence_c = sv_c[f];
     }
-    // Back to deficits against the seed's valences.
-    let table = CornerTable::new(v0, seed_triangles);
-    let mut fan = Fan::default();
-    (0..v0)
-        .map(|v| {
-            let sv = seed_split_valence[v];
-            if sv == NO_SPLIT {
-                return LEAF;
-            }
-            table.fan(v as u32, &mut fan);
-            let valence = fan.corners.len() + if fan.boundary { 2 } else { 0 };
-            (sv as usize).saturating_sub(valence) as u8
-        })
-        .collect()
+    seed_split_valence
 }
 
 /// Keeps each split record of a round as the collapse it reverses: P is
@@ -334,11 +314,9 @@ impl Refinement {
                 .collect(),
             errors,
         };
-        let mut seed_deficits = seed_deficits;
-        if header.schedule == Schedule::EveryVertex {
-            seed_deficits =
-                derive_split_valences(&mut rounds, &recorder.ring_lengths, &seed_triangles);
-        }
+        let seed_split_valences = (header.schedule == Schedule::EveryVertex).then(|| {
+            derive_split_valences(&mut rounds, &recorder.ring_lengths, seed_positions.len())
+        });
         let mesh = QuantizedMesh {
             positions: decoder.positions().to_vec(),
             triangles: decoder.triangles().to_vec(),
@@ -355,6 +333,7 @@ impl Refinement {
             seed_positions,
             seed_triangles,
             seed_deficits,
+            seed_split_valences,
             rounds,
             plan,
             final_hash: decoder.state_hash(),
@@ -371,11 +350,15 @@ impl Refinement {
         // The seed's split valences: deficit + valence, the ghost counted
         // on a boundary (SPEC §6.2), as the replay computes them back.
         let mut split_valences = vec![NO_SPLIT; n];
-        let mut fan = Fan::default();
-        for (v, &deficit) in self.seed_deficits.iter().enumerate() {
-            table.fan(v as u32, &mut fan);
-            let valence = fan.corners.len() + if fan.boundary { 2 } else { 0 };
-            split_valences[v] = split_valence(deficit, valence);
+        if let Some(derived) = &self.seed_split_valences {
+            split_valences[..derived.len()].copy_from_slice(derived);
+        } else {
+            let mut fan = Fan::default();
+            for (v, &deficit) in self.seed_deficits.iter().enumerate() {
+                table.fan(v as u32, &mut fan);
+                let valence = fan.corners.len() + if fan.boundary { 2 } else { 0 };
+                split_valences[v] = split_valence(deficit, valence);
+            }
         }
         let mut positions = self.mesh.positions.clone();
         positions[..v0].copy_from_slice(&self.seed_positions);
