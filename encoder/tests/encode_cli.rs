@@ -286,6 +286,52 @@ fn info_counts_each_fields_chunks() {
 }
 
 #[test]
+fn info_gives_each_fields_bytes_by_level() {
+    let (_, stream) = encoded_raster("by-level.sps");
+    let s = stream.to_str().unwrap();
+    let doc: serde_json::Value =
+        serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();
+    let levels = doc["levels"].as_array().unwrap();
+    // Each field's bytes over the levels sum to its total, and each level's
+    // fields stay within the level's bytes (the rest is its framing).
+    for (name, field) in doc["fields"].as_object().unwrap() {
+        let by_level: u64 = levels
+            .iter()
+            .map(|l| l["field_bytes"][name].as_u64().unwrap())
+            .sum();
+        assert_eq!(Some(by_level), field["bytes"].as_u64(), "{name}");
+    }
+    for level in levels {
+        let fields: u64 = level["field_bytes"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|b| b.as_u64().unwrap())
+            .sum();
+        assert!(
+            fields > 0 && fields < level["length"].as_u64().unwrap(),
+            "{level}"
+        );
+    }
+    let text = succeeded(&splitstream(&["info", s, "--by-level"]));
+    assert!(text.contains("bytes by level:    level 0"), "{text}");
+    assert!(text.contains("bits/new v"), "{text}");
+    // A prefix holding level 0 only: later levels have no field bytes.
+    let bytes = std::fs::read(&stream).unwrap();
+    let level1 = levels[1]["offset"].as_u64().unwrap() as usize;
+    let prefix = stream.with_file_name("by-level-prefix.sps");
+    std::fs::write(&prefix, &bytes[..level1]).unwrap();
+    let doc: serde_json::Value = serde_json::from_str(&succeeded(&splitstream(&[
+        "info",
+        prefix.to_str().unwrap(),
+        "--json",
+    ])))
+    .unwrap();
+    assert!(doc["levels"][0]["field_bytes"].is_object());
+    assert!(doc["levels"][1]["field_bytes"].is_null());
+}
+
+#[test]
 fn a_decoded_glb_encodes_back_to_the_same_stream() {
     // Geographic-sized coordinates: the GLB keeps them in the node's
     // translation (f64 JSON) and positions relative to it (f32), so at 14

@@ -30,6 +30,9 @@ pub struct FieldSizes {
     pub framing: u64,
     /// Values of the longest rANS chunk (0 if none).
     pub largest_rans_chunk: u32,
+    /// Stored bytes per substream id in each level counted (`stored` is
+    /// their sum).
+    pub per_level: Vec<[u64; FIELDS]>,
 }
 
 impl FieldSizes {
@@ -93,8 +96,10 @@ fn field_sizes_of(
             .level_header(k, bytes, header.max_chunk_len, header.schedule)
             .map_err(|e| format!("level {k}: {e}"))?;
         sizes.framing += lh.payload_start as u64;
+        let mut level = [0u64; FIELDS];
         for c in 0..lh.chunk_count {
             let chunk = lh.chunk(c).map_err(|e| e.to_string())?;
+            level[chunk.substream as usize] += chunk.stored_len as u64;
             sizes.stored[chunk.substream as usize] += chunk.stored_len as u64;
             sizes.raw[chunk.substream as usize] += chunk.raw_len as u64;
             sizes.codecs[chunk.substream as usize] |= 1 << chunk.codec.min(7);
@@ -103,6 +108,7 @@ fn field_sizes_of(
                 sizes.largest_rans_chunk = sizes.largest_rans_chunk.max(chunk.raw_len);
             }
         }
+        sizes.per_level.push(level);
     }
     Ok(sizes)
 }
@@ -159,7 +165,22 @@ fn recode(stream: &[u8], header: &Header, sizes: &FieldSizes) -> Result<Vec<Reco
         .collect()
 }
 
-pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
+/// What `splitstream info` prints besides the header and level table.
+pub struct InfoOptions {
+    /// One JSON document instead of text.
+    pub json: bool,
+    /// Every field coded again with rANS and with deflate.
+    pub codecs: bool,
+    /// Each field's bytes in each level (text; JSON always has them).
+    pub by_level: bool,
+}
+
+pub fn run(input: &Path, options: InfoOptions) -> CliResult {
+    let InfoOptions {
+        json,
+        codecs,
+        by_level,
+    } = options;
     let stream = read_file(input)?;
     let fail = |e: splitstream_decoder_core::Error| format!("{}: {e}", input.display());
     let header = Header::parse(&stream).map_err(fail)?;
@@ -261,6 +282,12 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
                     // null where the schedule codes no split valences.
                     "deficit_contexts": (policies[k as usize].2 != "-").then_some(policies[k as usize].2),
                     "workspace_bytes": memory[k as usize],
+                    // null for a level that is not in the file.
+                    "field_bytes": sizes.per_level.get(k as usize).map(|level| {
+                        (1..FIELDS)
+                            .map(|i| (NAMES[i].to_string(), level[i].into()))
+                            .collect::<serde_json::Map<_, _>>()
+                    }),
                 })
             })
             .collect();
@@ -427,5 +454,48 @@ pub fn run(input: &Path, json: bool, codecs: bool) -> CliResult {
              each level's coding chosen again)"
         );
     }
+    if by_level {
+        print_by_level(&sizes, &table);
+    }
     Ok(())
+}
+
+/// The bytes of each field in each level held, and each level's bits per
+/// vertex it adds (its bytes over the vertices it adds; level 0 over its
+/// own).
+fn print_by_level(sizes: &FieldSizes, table: &LevelTable<'_>) {
+    let held = sizes.per_level.len();
+    let columns: String = (0..held)
+        .map(|k| format!(" {:>10}", format!("level {k}")))
+        .collect();
+    println!("  bytes by level:{columns}");
+    for (i, name) in NAMES.iter().enumerate().skip(1) {
+        if sizes.stored[i] == 0 {
+            continue;
+        }
+        let cells: String = sizes
+            .per_level
+            .iter()
+            .map(|level| format!(" {:>10}", level[i]))
+            .collect();
+        println!("  {name:<14} {cells}");
+    }
+    let added = |k: usize| {
+        let before = if k == 0 {
+            0
+        } else {
+            table.get(k as u16 - 1).vertex_count
+        };
+        table.get(k as u16).vertex_count.saturating_sub(before)
+    };
+    let cells: String = (0..held)
+        .map(|k| match added(k) {
+            0 => format!(" {:>10}", "-"),
+            n => format!(
+                " {:>10.2}",
+                8.0 * table.get(k as u16).length as f64 / n as f64
+            ),
+        })
+        .collect();
+    println!("  {:<14} {cells}", "bits/new v");
 }

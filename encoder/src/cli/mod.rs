@@ -264,6 +264,10 @@ pub enum Command {
         /// per vertex under each.
         #[arg(long)]
         codecs: bool,
+        /// Also give each field's bytes in each level (`--json` always
+        /// has them, as each level's `field_bytes`).
+        #[arg(long)]
+        by_level: bool,
     },
     /// Decode fully, checking every checksum and rule; print the state hash.
     Verify { input: PathBuf },
@@ -318,7 +322,15 @@ pub fn run(cli: Cli) -> CliResult {
             input,
             json,
             codecs,
-        } => info::run(&input, json, codecs),
+            by_level,
+        } => info::run(
+            &input,
+            info::InfoOptions {
+                json,
+                codecs,
+                by_level,
+            },
+        ),
         Command::Verify { input } => verify::run(&input),
         Command::Bench(settings) => bench::run(&settings),
         Command::GpuBench(settings) => gpu_bench::run(&settings),
