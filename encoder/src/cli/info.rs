@@ -465,6 +465,9 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
 /// own).
 fn print_by_level(sizes: &FieldSizes, table: &LevelTable<'_>) {
     let held = sizes.per_level.len();
+    if held == 0 {
+        return; // no whole level in the file (said above)
+    }
     let columns: String = (0..held)
         .map(|k| format!(" {:>10}", format!("level {k}")))
         .collect();
