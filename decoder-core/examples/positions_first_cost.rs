@@ -7,7 +7,7 @@
 //! cargo run --release -p splitstream-decoder-core --features alloc --example positions_first_cost -- IN.sps [RUNS]
 //! ```
 //!
-//! The stream is decoded `RUNS` times (default 7) under each of three
+//! The stream is decoded `RUNS` times (default 7) under each of four
 //! observers (`LevelDecoder::next_round_observed`), alternating, and the
 //! medians are compared:
 //! - `none`: the decode alone;
@@ -17,11 +17,17 @@
 //!   enumerated a row at a time over each real wedge, ordered by distance to
 //!   the ring's centroid, the new vertex's rank found among them, then the
 //!   wing pairs that keep every new triangle counter-clockwise in xy and the
-//!   eligible entries ordered by the angle under which they see the new edge.
+//!   eligible entries ordered by the angle under which they see the new edge;
+//! - `outward`: the same, but the new vertex's rank found as a decoder
+//!   reading it would: lattice points generated outward from the centroid
+//!   in key order and counted until the new vertex comes (the two ranks
+//!   must agree; the example fails if their sums differ).
 //!
 //! Each observer folds its results into a checksum so that none of its work
 //! is optimised away. The differences to `none` are the costs per split.
 
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
 use std::time::Instant;
 
 use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, NONE};
@@ -37,6 +43,9 @@ enum Work {
     None,
     Replaced,
     PositionsFirst,
+    /// The same, the fan's points generated outward from the centroid and
+    /// stopped at the new vertex (what a decoder reading the rank would do).
+    Outward,
 }
 
 struct Observer {
@@ -45,7 +54,116 @@ struct Observer {
     splits: u64,
     /// Splits whose new vertex was among the enumerated points.
     found: u64,
+    /// The sum of the ranks found (the two searches must agree).
+    rank_sum: u64,
     candidates: Vec<u64>,
+    heap: BinaryHeap<Reverse<u64>>,
+}
+
+/// A split vertex's fan in xy, for the outward search.
+struct Fan<'a> {
+    origin: Xy,
+    entries: &'a [Option<Xy>],
+    /// Real ring entries and the sum of their positions.
+    n: i64,
+    s: Xy,
+    /// The bounding box of the fan.
+    lo: Xy,
+    hi: Xy,
+}
+
+impl Fan<'_> {
+    /// The order key: `|n p - S|^2`, then y, then x.
+    fn key(&self, p: Xy) -> u64 {
+        let d = [self.n * p[0] - self.s[0], self.n * p[1] - self.s[1]];
+        ((d[0] * d[0] + d[1] * d[1]) as u64) << 24
+            | ((p[1] - self.lo[1]) as u64) << 12
+            | (p[0] - self.lo[0]) as u64
+    }
+
+    fn point(&self, key: u64) -> Xy {
+        [
+            self.lo[0] + (key & 0xFFF) as i64,
+            self.lo[1] + (key >> 12 & 0xFFF) as i64,
+        ]
+    }
+
+    /// Whether `p` is a free lattice point of the fan: in a real wedge
+    /// (closed), neither R nor a ring entry.
+    fn holds(&self, p: Xy) -> bool {
+        if p == self.origin || self.entries.contains(&Some(p)) {
+            return false;
+        }
+        let k = self.entries.len();
+        (0..k).any(|i| {
+            let (Some(a), Some(b)) = (self.entries[i], self.entries[(i + 1) % k]) else {
+                return false;
+            };
+            let d = [
+                cross(self.origin, a, p),
+                cross(a, b, p),
+                cross(b, self.origin, p),
+            ];
+            cross(self.origin, a, b) != 0
+                && (d.iter().all(|&x| x >= 0) || d.iter().all(|&x| x <= 0))
+        })
+    }
+
+    /// The rank of `new` among the free points in key order, generating
+    /// Chebyshev shells around the rounded centroid `c` and taking a point
+    /// once no later shell can hold a smaller key: a point of shell s + 1 or
+    /// beyond is at least s + 1/2 from S / n on one axis (`|c - S/n| <= 1/2`),
+    /// so its `4 |n p - S|^2 >= n^2 (2 s + 1)^2`.
+    fn outward_rank(&self, new: Xy, heap: &mut BinaryHeap<Reverse<u64>>) -> u64 {
+        heap.clear();
+        let n = self.n;
+        let c = [
+            (2 * self.s[0] + n).div_euclid(2 * n),
+            (2 * self.s[1] + n).div_euclid(2 * n),
+        ];
+        let reach = (c[0] - self.lo[0])
+            .max(self.hi[0] - c[0])
+            .max(c[1] - self.lo[1])
+            .max(self.hi[1] - c[1]);
+        let mut count = 0u64;
+        for shell in 0..=reach + 1 {
+            if shell <= reach {
+                for y in (c[1] - shell).max(self.lo[1])..=(c[1] + shell).min(self.hi[1]) {
+                    let step = if (y - c[1]).abs() == shell {
+                        1
+                    } else {
+                        2 * shell.max(1)
+                    };
+                    let mut x = c[0] - shell;
+                    while x <= c[0] + shell {
+                        if x >= self.lo[0] && x <= self.hi[0] {
+                            heap.push(Reverse(self.key([x, y])));
+                        }
+                        x += step;
+                    }
+                }
+            }
+            let bound = if shell <= reach {
+                ((n * n * (2 * shell + 1) * (2 * shell + 1)) as u64) << 24
+            } else {
+                u64::MAX
+            };
+            while let Some(&Reverse(key)) = heap.peek() {
+                if shell <= reach && (key >> 24) * 4 >= bound >> 24 {
+                    break;
+                }
+                heap.pop();
+                let p = self.point(key);
+                if self.holds(p) {
+                    if p == new {
+                        return count;
+                    }
+                    count += 1;
+                }
+            }
+        }
+        u64::MAX
+    }
 }
 
 type Xy = [i64; 2];
@@ -66,14 +184,22 @@ fn row_span(t: [Xy; 3], y: i64) -> Option<(i64, i64)> {
             0 if k < 0 => return None,
             0 => {}
             d if d > 0 => hi = hi.min(k.div_euclid(d)),
-            d => lo = lo.max(-((-k).div_euclid(-d))),
+            // dy < 0: x >= ceil(k / dy) = -floor(k / -dy)
+            d => lo = lo.max(-(k.div_euclid(-d))),
         }
     }
     (lo <= hi).then_some((lo, hi))
 }
 
 impl Observer {
-    fn positions_first(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, rec: &SplitRecord) {
+    fn positions_first(
+        &mut self,
+        state: &MeshState<'_>,
+        r: u32,
+        ring: &Ring,
+        rec: &SplitRecord,
+        outward: bool,
+    ) {
         let positions = state.positions();
         let xy = |v: u32| -> Option<Xy> {
             positions
@@ -104,7 +230,18 @@ impl Observer {
             hi = [hi[0].max(e[0]), hi[1].max(e[1])];
         }
         let mut rank = u64::MAX;
-        if n > 0 && (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) <= CAP {
+        let in_cap = n > 0 && (hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) <= CAP;
+        if in_cap && outward {
+            let fan = Fan {
+                origin,
+                entries,
+                n,
+                s,
+                lo,
+                hi,
+            };
+            rank = fan.outward_rank(new, &mut self.heap);
+        } else if in_cap {
             self.candidates.clear();
             for i in 0..k {
                 let (Some(a), Some(b)) = (entries[i], entries[(i + 1) % k]) else {
@@ -186,7 +323,10 @@ impl Observer {
                 best = (angle, x);
             }
         }
-        self.found += u64::from(rank != u64::MAX);
+        if rank != u64::MAX {
+            self.found += 1;
+            self.rank_sum += rank;
+        }
         self.checksum = self
             .checksum
             .wrapping_mul(31)
@@ -214,7 +354,8 @@ impl SplitObserver for Observer {
         match self.work {
             Work::None => {}
             Work::Replaced => self.replaced(state, r, ring, rec),
-            Work::PositionsFirst => self.positions_first(state, r, ring, rec),
+            Work::PositionsFirst => self.positions_first(state, r, ring, rec, false),
+            Work::Outward => self.positions_first(state, r, ring, rec, true),
         }
     }
 }
@@ -250,9 +391,10 @@ fn main() {
         ("none", Work::None),
         ("replaced", Work::Replaced),
         ("positions first", Work::PositionsFirst),
+        ("outward", Work::Outward),
     ];
     let mut times = vec![Vec::new(); works.len()];
-    let (mut splits, mut found) = (0, 0);
+    let (mut splits, mut found) = (0, (0, 0));
     for _ in 0..runs {
         for (i, &(_, work)) in works.iter().enumerate() {
             let mut observer = Observer {
@@ -260,7 +402,9 @@ fn main() {
                 checksum: 0,
                 splits: 0,
                 found: 0,
+                rank_sum: 0,
                 candidates: Vec::with_capacity(CAP as usize),
+                heap: BinaryHeap::with_capacity(CAP as usize),
             };
             let seconds = decode(&stream, &mut observer).unwrap_or_else(|e| {
                 eprintln!("positions_first_cost: {input}: {e}");
@@ -269,7 +413,14 @@ fn main() {
             times[i].push(seconds);
             splits = observer.splits;
             if work == Work::PositionsFirst {
-                found = observer.found;
+                found = (observer.found, observer.rank_sum);
+            }
+            if work == Work::Outward && (observer.found, observer.rank_sum) != found {
+                eprintln!(
+                    "positions_first_cost: the outward search found {} new vertices (rank sum {}), the enumeration {found:?}",
+                    observer.found, observer.rank_sum
+                );
+                std::process::exit(1);
             }
             std::hint::black_box(observer.checksum);
         }
@@ -281,7 +432,7 @@ fn main() {
     let base = median(&mut times[0]);
     println!(
         "{input}: {splits} splits ({:.1} % of the new vertices among the enumerated points), medians of {runs} decodes",
-        100.0 * found as f64 / splits.max(1) as f64
+        100.0 * found.0 as f64 / splits.max(1) as f64
     );
     for (i, (name, _)) in works.iter().enumerate() {
         let t = median(&mut times[i]);
