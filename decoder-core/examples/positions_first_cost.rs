@@ -26,8 +26,6 @@
 //! Each observer folds its results into a checksum so that none of its work
 //! is optimised away. The differences to `none` are the costs per split.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
 use std::time::Instant;
 
 use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, NONE};
@@ -57,7 +55,7 @@ struct Observer {
     /// The sum of the ranks found (the two searches must agree).
     rank_sum: u64,
     candidates: Vec<u64>,
-    heap: BinaryHeap<Reverse<u64>>,
+    pending: Vec<u64>,
 }
 
 /// A split vertex's fan in xy, for the outward search.
@@ -114,8 +112,8 @@ impl Fan<'_> {
     /// once no later shell can hold a smaller key: a point of shell s + 1 or
     /// beyond is at least s + 1/2 from S / n on one axis (`|c - S/n| <= 1/2`),
     /// so its `4 |n p - S|^2 >= n^2 (2 s + 1)^2`.
-    fn outward_rank(&self, new: Xy, heap: &mut BinaryHeap<Reverse<u64>>) -> u64 {
-        heap.clear();
+    fn outward_rank(&self, new: Xy, pending: &mut Vec<u64>) -> u64 {
+        pending.clear();
         let n = self.n;
         let c = [
             (2 * self.s[0] + n).div_euclid(2 * n),
@@ -137,7 +135,7 @@ impl Fan<'_> {
                     let mut x = c[0] - shell;
                     while x <= c[0] + shell {
                         if x >= self.lo[0] && x <= self.hi[0] {
-                            heap.push(Reverse(self.key([x, y])));
+                            pending.push(self.key([x, y]));
                         }
                         x += step;
                     }
@@ -148,11 +146,13 @@ impl Fan<'_> {
             } else {
                 u64::MAX
             };
-            while let Some(&Reverse(key)) = heap.peek() {
+            // The smallest pending key each time: a scan, the list being short.
+            while let Some((at, key)) = pending.iter().copied().enumerate().min_by_key(|&(_, k)| k)
+            {
                 if shell <= reach && (key >> 24) * 4 >= bound >> 24 {
                     break;
                 }
-                heap.pop();
+                pending.swap_remove(at);
                 let p = self.point(key);
                 if self.holds(p) {
                     if p == new {
@@ -240,7 +240,7 @@ impl Observer {
                 lo,
                 hi,
             };
-            rank = fan.outward_rank(new, &mut self.heap);
+            rank = fan.outward_rank(new, &mut self.pending);
         } else if in_cap {
             self.candidates.clear();
             for i in 0..k {
@@ -404,7 +404,7 @@ fn main() {
                 found: 0,
                 rank_sum: 0,
                 candidates: Vec::with_capacity(CAP as usize),
-                heap: BinaryHeap::with_capacity(CAP as usize),
+                pending: Vec::with_capacity(CAP as usize),
             };
             let seconds = decode(&stream, &mut observer).unwrap_or_else(|e| {
                 eprintln!("positions_first_cost: {input}: {e}");
