@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.6 decoder, in Python, written from
+"""A second splitstream 3.7 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
@@ -8,7 +8,9 @@ plane policy `height`, 3.2's wing policies, 3.3's deficit contexts and
 that define them; 3.5 added one level header check, level 0's
 seed_triangles above its table entry's triangle_count failing
 count-mismatch before the seed is read; 3.6's schedule `every-vertex`,
-header flag bit 1, was added with the SPEC sections that define it.) It speaks the conformance protocol (a stream
+header flag bit 1, was added with the SPEC sections that define it, and
+3.7's record order `positions-first`, level header byte 11, with SPEC §7.4
+"Positions first".) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -18,6 +20,7 @@ or `error <class>`), so that .ci/test runs the vectors through it:
 Standard library only. Written for clarity against the SPEC, not speed:
 fine for the vectors, slow for large meshes.
 """
+import functools
 import struct
 import sys
 import zlib
@@ -34,6 +37,9 @@ NCTX = {1: 1, 2: 8, 3: 8, 4: 1, 5: 5, 6: 3, 7: 5, 8: 3, 9: 1, 10: 1}
 NCTX_VALENCE = {**NCTX, 4: 5, 5: 6}
 # Under the schedule `every-vertex` (3.6) flags has 5, by the valence.
 NCTX_EVERY = {**NCTX, 1: 5}
+# Under the record order `positions-first` (3.7) edge has 8, placement 7
+# (SPEC §5.3, §5.5.5); on top of whichever table above applies.
+NCTX_PF = {6: 8, 7: 7}
 
 
 class Fail(Exception):
@@ -328,6 +334,131 @@ class Sub:
             raise Fail("count-mismatch")
 
 
+# ---------------------------------------------------------------- positions first
+# SPEC §7.4 Positions first (record order `positions-first`, format 3.7).
+# Points are (x, y) pairs relative to R; a ring is given as its list `q` of
+# q_i = (pos[r_i]_x - pos[R]_x, pos[r_i]_y - pos[R]_y), None for the ghost.
+# Integers only; the SPEC's bounds keep every value below 2^52.
+ORIGIN = (0, 0)
+
+
+def orient(a, b, c):
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+
+
+def inside(p, a, b, c):
+    """The closed triangle a, b, c holds p, either orientation."""
+    s1 = orient(a, b, p)
+    s2 = orient(b, c, p)
+    s3 = orient(c, a, p)
+    return (s1 >= 0 and s2 >= 0 and s3 >= 0) or (s1 <= 0 and s2 <= 0 and s3 <= 0)
+
+
+def incircle(a, b, c, p):
+    """> 0: p inside the circle through a, b, c (a, b, c counter-clockwise);
+    the differences are taken relative to p."""
+    rows = []
+    for v in (a, b, c):
+        dx = v[0] - p[0]
+        dy = v[1] - p[1]
+        rows.append((dx, dy, dx * dx + dy * dy))
+    (ax, ay, al), (bx, by, bl), (cx, cy, cl) = rows
+    return ax * (by * cl - bl * cy) - ay * (bx * cl - bl * cx) + al * (bx * cy - by * cx)
+
+
+def free_points(q):
+    """The fan's free lattice points, nearest the ring's centroid first, or
+    None (an escape): a bounding box above 1,024 points, or no free point,
+    or more than 255."""
+    k = len(q)
+    real = [p for p in q if p is not None]
+    x0 = min([0] + [p[0] for p in real])
+    x1 = max([0] + [p[0] for p in real])
+    y0 = min([0] + [p[1] for p in real])
+    y1 = max([0] + [p[1] for p in real])
+    if (x1 - x0 + 1) * (y1 - y0 + 1) > 1024:
+        return None
+    wedges = [(q[i], q[(i + 1) % k]) for i in range(k)
+              if q[i] is not None and q[(i + 1) % k] is not None
+              and orient(ORIGIN, q[i], q[(i + 1) % k]) != 0]
+    taken = set(real)
+    F = []
+    for x in range(x0, x1 + 1):
+        for y in range(y0, y1 + 1):
+            p = (x, y)
+            if p == ORIGIN or p in taken:
+                continue
+            if any(inside(p, ORIGIN, a, b) for a, b in wedges):
+                F.append(p)
+    if len(F) == 0 or len(F) > 255:
+        return None
+    n = len(real)  # >= 1
+    Sx = sum(p[0] for p in real)
+    Sy = sum(p[1] for p in real)
+    F.sort(key=lambda p: ((n * p[0] - Sx) ** 2 + (n * p[1] - Sy) ** 2, p[1], p[0]))
+    return F
+
+
+def bucket(f):
+    """SPEC §5.5.5: the lattice rank's context is 3 + bucket(len(F))."""
+    if f <= 1:
+        return 0
+    if f == 2:
+        return 1
+    if f <= 4:
+        return 2
+    if f <= 8:
+        return 3
+    return 4
+
+
+def pair(x, y, q, Eset, kind, A, B):
+    """Ring entries x, y as wings: A owns the arc from r_x counter-clockwise
+    to r_y, B the rest, and every new triangle is counter-clockwise in xy."""
+    k = len(q)
+    if x not in Eset or y not in Eset or x == y:
+        return False
+    if kind == 1 and not x < y:
+        return False
+    if q[x] is not None and not orient(A, B, q[x]) > 0:  # triangle (A, B, r_x)
+        return False
+    if q[y] is not None and not orient(B, A, q[y]) > 0:  # triangle (B, A, r_y)
+        return False
+    for owner, first, last in ((A, x, y), (B, y, x)):  # A's wedges, then B's
+        i = first
+        while i != last:  # i = first .. last - 1 (mod k)
+            j = (i + 1) % k
+            if q[i] is not None and q[j] is not None and not orient(owner, q[i], q[j]) > 0:
+                return False
+            i = j
+    return True
+
+
+def before(a, b, q):
+    """A sort key for the ring positions: u comes before w when w is the
+    ghost and u is real, or both are real and incircle(a, b, q_w, q_u) > 0,
+    or it is 0 and u < w."""
+
+    def precedes(u, w):
+        if q[w] is None and q[u] is not None:
+            return True
+        if q[u] is None or q[w] is None:
+            return False
+        c = incircle(a, b, q[w], q[u])
+        return c > 0 or (c == 0 and u < w)
+
+    def cmp(u, w):
+        if u == w:
+            return 0
+        if precedes(u, w):
+            return -1
+        if precedes(w, u):
+            return 1
+        return 0
+
+    return functools.cmp_to_key(cmp)
+
+
 # ---------------------------------------------------------------- decoder
 class Decoder:
     def __init__(self, s, out):
@@ -479,8 +610,10 @@ class Decoder:
             raise Fail("malformed")
         if lvl[10] != 0 and self.every:  # no split-valence symbols (3.6)
             raise Fail("malformed")
-        if lvl[11]:
+        if lvl[11] > 1:  # record order (3.7)
             raise Fail("malformed")
+        if lvl[11] == 1 and (not self.constrained or lvl[8] != 5):
+            raise Fail("malformed")  # positions-first: constrained mode, plane policy height
         if li == 0 and (SV == 0 or ST == 0):
             raise Fail("malformed")
         allowed = range(1, 11) if li == 0 else range(1, 8)
@@ -537,11 +670,14 @@ class Decoder:
         for sid in range(1, 11):
             lst = [(c, rl, crc, bytes(lvl[off:off + sl])) for (c, rl, crc, off, sl) in chunks.get(sid, [])]
             nctx = (NCTX_EVERY if self.every else NCTX_VALENCE if lvl[10] == 1 else NCTX)[sid]
+            if lvl[11] == 1:  # positions-first (3.7)
+                nctx = NCTX_PF.get(sid, nctx)
             subs[sid] = Sub(sid, lst, self.lane_count, nctx)
         self.subs = subs
         self.policy = lvl[8]
         self.wing_policy = lvl[9]
         self.deficit_contexts = lvl[10]
+        self.record_order = lvl[11]  # 0 wings-first, 1 positions-first (3.7)
         self.T_l = entry["T"]
         if li == 0:
             self.read_base(SV, ST)
@@ -711,16 +847,63 @@ class Decoder:
             raise Fail("count-mismatch")
         for j, R in enumerate(flagged):
             ring, tof = self.ring(R)
-            rec = self.read_record(R, ring, candset)
+            if self.record_order == 1:  # positions-first (3.7)
+                rec = self.read_record_pf(R, ring, candset)
+            else:
+                rec = self.read_record(R, ring, candset)
             self.apply_split(R, ring, tof, rec, n + j)
+
+    def eligible(self, ring, candset):
+        """SPEC §7.4 step 1: the ring positions that may be wings, ascending."""
+        if self.every:  # 3.6: every entry is eligible
+            return list(range(len(ring)))
+        return [i for i in range(len(ring)) if ring[i] == GHOST or ring[i] not in candset]
+
+    def read_deficits(self, k, d):
+        """SPEC §7.4 step 2: the deficits of P and C from the wings' d."""
+        subs = self.subs
+        valP = d + 2
+        valC = k - d + 2
+        if self.every:  # 3.6: nothing read, the bytes are the valences
+            return min(valP, 255), min(valC, 255)
+        if self.deficit_contexts == 0:  # plain
+            pctx = 0
+        else:  # valence (3.3)
+            pctx = min(max(valP, 4), 8) - 4
+        dP = self.deficit_of(subs[4].byte(pctx), valP)
+        if self.deficit_contexts == 0:
+            cctx = 4 if dP == LEAF else min(max(valC, 3), 6) - 3
+        else:
+            cctx = 0 if dP == LEAF else min(max(valC, 4), 8) - 3
+        dC = self.deficit_of(subs[5].byte(cctx), valC)
+        return dP, dC
+
+    @staticmethod
+    def place(code, pR, X):
+        """SPEC §7.4 place(): P and C from R and the vector X."""
+        if code == 0:
+            P = list(pR)
+            Cp = [pR[ax] + X[ax] for ax in range(3)]
+        elif code == 1:
+            P = [pR[ax] + X[ax] for ax in range(3)]
+            Cp = list(pR)
+        else:
+            P = [pR[ax] - (X[ax] >> 1) for ax in range(3)]
+            Cp = [P[ax] + X[ax] for ax in range(3)]
+        return P, Cp
+
+    def check_positions(self, P, Cp):
+        """SPEC §7.4: every coordinate of P, then of C, in 0 .. 2^bits."""
+        lim = 1 << self.bits
+        for X in (P, Cp):
+            for ax in range(3):
+                if X[ax] < 0 or X[ax] >= lim:
+                    raise Fail("position-out-of-range")
 
     def read_record(self, R, ring, candset):
         subs = self.subs
         k = len(ring)
-        if self.every:  # 3.6: every entry is eligible
-            E = list(range(k))
-        else:
-            E = [i for i in range(k) if ring[i] == GHOST or ring[i] not in candset]
+        E = self.eligible(ring, candset)
         m = len(E)
         ctx = min(max(m, 2), 9) - 2
         op = subs[2].byte(ctx)
@@ -732,22 +915,7 @@ class Decoder:
             d = E[op + dp] - o
         else:
             o, d = self.near_wings(ring, E, op, dp)
-        valP = d + 2
-        valC = k - d + 2
-        if self.every:  # 3.6: nothing read, the bytes are the valences
-            dP = min(valP, 255)
-            dC = min(valC, 255)
-        else:
-            if self.deficit_contexts == 0:  # plain
-                pctx = 0
-            else:  # valence (3.3)
-                pctx = min(max(valP, 4), 8) - 4
-            dP = self.deficit_of(subs[4].byte(pctx), valP)
-            if self.deficit_contexts == 0:
-                cctx = 4 if dP == LEAF else min(max(valC, 3), 6) - 3
-            else:
-                cctx = 0 if dP == LEAF else min(max(valC, 4), 8) - 3
-            dC = self.deficit_of(subs[5].byte(cctx), valC)
+        dP, dC = self.read_deficits(k, d)
         # arc means
         pos = self.pos
         pR = pos[R]
@@ -778,7 +946,6 @@ class Decoder:
         else:
             e = None
         plane = self.plane_of(e, mI1, mI2)
-        lim = 1 << self.bits
 
         def lin(wW, wo, wt, own, oth):
             return [(wW * mW[ax] + wo * own[ax] + wt * oth[ax]) >> 4 for ax in range(3)]
@@ -808,15 +975,7 @@ class Decoder:
                 lp = lin(0, 5, -5, mI2, mI1)
             r = self.read_vector(subs[6], plane)
             X = self.vector(lp, r, code, ring, pR)
-            if code == 0:
-                P = list(pR)
-                Cp = [pR[ax] + X[ax] for ax in range(3)]
-            elif code == 1:
-                P = [pR[ax] + X[ax] for ax in range(3)]
-                Cp = list(pR)
-            else:
-                P = [pR[ax] - (X[ax] >> 1) for ax in range(3)]
-                Cp = [P[ax] + X[ax] for ax in range(3)]
+            P, Cp = self.place(code, pR, X)
         else:
             lp = lin(1, 4, -1, mI1, mI2)
             r = self.read_vector(subs[6], plane)
@@ -826,10 +985,71 @@ class Decoder:
             r = self.read_vector(subs[7], plane)
             X = self.vector(lc, r, "C", ring, pR)
             Cp = [pR[ax] + X[ax] for ax in range(3)]
-        for X in (P, Cp):
-            for ax in range(3):
-                if X[ax] < 0 or X[ax] >= lim:
-                    raise Fail("position-out-of-range")
+        self.check_positions(P, Cp)
+        return (o, d, dP, dC, P, Cp)
+
+    def read_record_pf(self, R, ring, candset):
+        """SPEC §7.4 Positions first (3.7): the new vertex as a free lattice
+        point of the fan, then the wings among the pairs that keep the new
+        triangles counter-clockwise; read_record for an escape."""
+        subs = self.subs
+        k = len(ring)
+        pos = self.pos
+        pR = pos[R]
+        q = [None if v == GHOST else (pos[v][0] - pR[0], pos[v][1] - pR[1]) for v in ring]
+        F = free_points(q)
+        if F is None:
+            return self.read_record(R, ring, candset)  # escape
+        kind = subs[7].byte(5)
+        if kind > 2:
+            raise Fail("malformed")
+        if kind == 2:
+            return self.read_record(R, ring, candset)  # escape
+        j = subs[6].varint(3 + bucket(len(F)))
+        if j >= len(F):
+            raise Fail("position-out-of-range")
+        N = F[j]
+        t = 0
+        if kind == 0:  # R stays at one end of the edge
+            A = N  # the new vertex
+            B = ORIGIN  # R
+        else:  # kind 1: R sat on the floor midpoint
+            t = subs[7].byte(6)
+            if t > 3:
+                raise Fail("malformed")
+            A = (-N[0] + (t & 1), -N[1] + (t >> 1))  # P = 2R - C + t, per axis
+            B = N  # C
+        E = self.eligible(ring, candset)
+        Eset = set(E)
+        xs = [x for x in E if any(pair(x, y, q, Eset, kind, A, B) for y in E)]
+        xs.sort(key=before(A, B, q))
+        u = subs[2].byte(min(max(len(xs), 1), 8) - 1)
+        if u >= len(xs):
+            raise Fail("ring-offset-out-of-range")
+        x = xs[u]
+        ys = [y for y in E if pair(x, y, q, Eset, kind, A, B)]
+        ys.sort(key=before(B, A, q))
+        v = subs[3].byte(min(len(ys), 8) - 1)
+        if v >= len(ys):
+            raise Fail("ring-offset-out-of-range")
+        y = ys[v]
+        if x < y:  # A owns arc 1: A is P
+            o, d = x, y - x
+        else:  # A owns arc 2: A is C (kind 0 only)
+            o, d = y, x - y
+        code = 2 if kind == 1 else (1 if x < y else 0)
+        dP, dC = self.read_deficits(k, d)
+        rz = subs[6].signed(2)
+        if code == 2:  # C - P
+            Xxy = (2 * N[0] - (t & 1), 2 * N[1] - (t >> 1))
+        else:  # C - R (code 0) or P - R (code 1)
+            Xxy = N
+        h = self.height_of(code, Xxy, ring, pR)
+        if h is None:
+            h = 0
+        X = [Xxy[0], Xxy[1], wrap(h + rz)]
+        P, Cp = self.place(code, pR, X)
+        self.check_positions(P, Cp)
         return (o, d, dP, dC, P, Cp)
 
     def vector(self, lp, r, target, ring, pR):

@@ -4,6 +4,7 @@
 
 use crate::header::Schedule;
 use crate::limits::{LEAF, substream};
+use crate::positions_first::RecordOrder;
 use crate::predict::{ArcMeans, PlanePolicy, placement_context};
 
 /// How a level's split-valence symbols are coded (SPEC §5.1, level header
@@ -43,9 +44,18 @@ impl DeficitContexts {
 }
 
 /// Number of contexts (frequency tables per rANS chunk) of substream `id`
-/// in a level whose deficit contexts are `deficits`, in a stream of
-/// schedule `schedule` (SPEC §5.3, §5.5.5).
-pub fn count(id: u8, deficits: DeficitContexts, schedule: Schedule) -> usize {
+/// in a level whose deficit contexts are `deficits` and record order
+/// `records`, in a stream of schedule `schedule` (SPEC §5.3, §5.5.5).
+pub fn count(id: u8, deficits: DeficitContexts, records: RecordOrder, schedule: Schedule) -> usize {
+    if records == RecordOrder::PositionsFirst {
+        // 3.7: the lattice rank's contexts after the axes', the kind and
+        // the midpoint offset after the placement codes'.
+        match id {
+            substream::EDGE => return 8,
+            substream::PLACEMENT => return 7,
+            _ => {}
+        }
+    }
     match (id, deficits, schedule) {
         (substream::FLAGS, _, Schedule::EveryVertex) => FLAG_CONTEXTS,
         (substream::DEFICIT_P, DeficitContexts::Valence, _) => 5,
@@ -138,8 +148,18 @@ mod tests {
     fn deficit_contexts_stay_below_the_table_count() {
         for set in DeficitContexts::ALL {
             let (p_tables, c_tables) = (
-                count(substream::DEFICIT_P, set, Schedule::SplitValences),
-                count(substream::DEFICIT_C, set, Schedule::SplitValences),
+                count(
+                    substream::DEFICIT_P,
+                    set,
+                    RecordOrder::WingsFirst,
+                    Schedule::SplitValences,
+                ),
+                count(
+                    substream::DEFICIT_C,
+                    set,
+                    RecordOrder::WingsFirst,
+                    Schedule::SplitValences,
+                ),
             );
             assert!(p_tables <= MAX_CONTEXTS && c_tables <= MAX_CONTEXTS);
             let mut p_seen = [false; MAX_CONTEXTS];

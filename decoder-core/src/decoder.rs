@@ -6,13 +6,12 @@ use crate::inflate::Inflater;
 use crate::layout::Layout;
 use crate::level_header::LevelHeader;
 use crate::level_table::{LevelInfo, LevelTable};
-use crate::limits::MAX_SPLIT_VALENCE;
 use crate::limits::substream::{self, SLOTS};
 use crate::pipe::{PendingSplits, RecordPipe, RecordsHalf};
 
 /// The flags' slot among a level's refinement substreams (ids 1..=7).
 const FLAGS_SLOT: usize = 0;
-use crate::record::{StreamSource, read_base};
+use crate::record::{RecordScratch, StreamSource, read_base};
 use crate::ring::Ring;
 use crate::round::{RecordSource, RoundStats};
 use crate::split::{SplitOutcome, SplitRecord};
@@ -228,6 +227,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
             bytes,
             self.header.max_chunk_len,
             self.header.schedule,
+            self.header.position_mode,
         ) {
             Ok(h) => h,
             Err(e) => {
@@ -427,7 +427,7 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
         Ok(RecordsHalf {
             subs: self.subs.split_off(FLAGS_SLOT, inflater),
             coding,
-            keys: [0; MAX_SPLIT_VALENCE],
+            scratch: RecordScratch::default(),
             ring: Ring::default(),
             positions,
             bits: self.state.bits(),

@@ -179,6 +179,7 @@ pub fn level_with(
         plane,
         wings: WingPolicy::Ranks,
         deficits: DeficitContexts::Plain,
+        records: crate::RecordOrder::WingsFirst,
         substreams: s,
         vertex_count: v,
         triangle_count: t,

@@ -3,14 +3,16 @@
 
 use crate::bytes::{crc32, u8_at, u16_at, u32_at};
 use crate::context::DeficitContexts;
-use crate::header::Schedule;
+use crate::header::{PositionMode, Schedule};
 use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
+use crate::positions_first::RecordOrder;
 use crate::predict::PlanePolicy;
 use crate::wing_order::WingPolicy;
 use crate::{ChecksumScope, Error};
 
 /// Offset of the plane policy byte (SPEC §5.1), followed by the wing policy
-/// byte (3.2), the deficit contexts byte (3.3) and a reserved byte.
+/// byte (3.2), the deficit contexts byte (3.3) and the record order byte
+/// (3.7).
 const PLANE_AT: usize = 8;
 /// Offset of level 0's seed counts (SPEC §5.1).
 const SEED_AT: usize = 12;
@@ -45,7 +47,13 @@ pub struct LevelHeader<'l> {
     /// §5.5.5; format 3.3); the raw byte is checked by [`LevelHeader::parse`].
     pub deficit_contexts: DeficitContexts,
     deficit_byte: u8,
-    reserved: u8,
+    /// How this level's split records are read (SPEC §5.1, §7.4; format
+    /// 3.7); the raw byte is checked by [`LevelHeader::parse`].
+    pub record_order: RecordOrder,
+    record_byte: u8,
+    /// The stream's position mode: `positions-first` needs constrained
+    /// mode.
+    mode: PositionMode,
     /// The stream's schedule (SPEC §3.2, 3.6): it sets how many contexts
     /// the flags substream has, and forbids deficit contexts other than
     /// `plain` under `every-vertex`.
@@ -63,13 +71,15 @@ pub struct LevelHeader<'l> {
 
 impl<'l> LevelHeader<'l> {
     /// Parses and validates the level header of `level` (SPEC §5.1) of a
-    /// stream with the given `max_chunk_len` and schedule (SPEC §3.2).
+    /// stream with the given `max_chunk_len`, schedule and position mode
+    /// (SPEC §3.2).
     /// `is_base` selects which substream ids are allowed.
     pub fn parse(
         level: &'l [u8],
         is_base: bool,
         max_chunk_len: u32,
         schedule: Schedule,
+        mode: PositionMode,
     ) -> Result<Self, Error> {
         let round_count = u32_at(level, 0)?;
         let chunk_count = u32_at(level, 4)?;
@@ -85,7 +95,7 @@ impl<'l> LevelHeader<'l> {
         let plane_byte = u8_at(level, PLANE_AT)?;
         let wing_byte = u8_at(level, PLANE_AT + 1)?;
         let deficit_byte = u8_at(level, PLANE_AT + 2)?;
-        let reserved = u8_at(level, PLANE_AT + 3)?;
+        let record_byte = u8_at(level, PLANE_AT + 3)?;
         let splits_len = (round_count as usize)
             .checked_mul(4)
             .ok_or(Error::Truncated)?;
@@ -110,7 +120,9 @@ impl<'l> LevelHeader<'l> {
             deficit_contexts: DeficitContexts::from_byte(deficit_byte)
                 .unwrap_or(DeficitContexts::Plain),
             deficit_byte,
-            reserved,
+            record_order: RecordOrder::from_byte(record_byte).unwrap_or_default(),
+            record_byte,
+            mode,
             schedule,
             seed_vertices,
             seed_triangles,
@@ -138,10 +150,17 @@ impl<'l> LevelHeader<'l> {
                 "deficit contexts other than plain under the schedule every-vertex",
             ));
         }
-        if self.reserved != 0 {
-            return Err(Error::InvalidLevelHeader(
-                "reserved level header byte not zero",
-            ));
+        match RecordOrder::from_byte(self.record_byte) {
+            None => return Err(Error::InvalidLevelHeader("unknown record order")),
+            Some(RecordOrder::PositionsFirst)
+                if self.mode != PositionMode::Constrained
+                    || self.plane_policy != PlanePolicy::Height =>
+            {
+                return Err(Error::InvalidLevelHeader(
+                    "record order positions-first outside constrained mode or the plane policy height",
+                ));
+            }
+            Some(_) => {}
         }
         if is_base && (self.seed_vertices == 0 || self.seed_triangles == 0) {
             return Err(Error::InvalidLevelHeader("empty seed mesh"));

@@ -2,7 +2,7 @@
 
 use crate::bytes::{crc32, f32_at, u32_at, u64_at};
 use crate::limits::{HEADER_LEN, LEVEL_ENTRY_LEN};
-use crate::{ChecksumScope, Error, Header, LevelHeader, Schedule};
+use crate::{ChecksumScope, Error, Header, LevelHeader, PositionMode, Schedule};
 
 /// One level-table entry (SPEC §4.1). Level 0 is the base mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -153,6 +153,7 @@ impl<'h> LevelTable<'h> {
         bytes: &'l [u8],
         max_chunk_len: u32,
         schedule: Schedule,
+        mode: PositionMode,
     ) -> Result<LevelHeader<'l>, Error> {
         if k >= self.count {
             return Err(Error::NoSuchLevel {
@@ -165,7 +166,7 @@ impl<'h> LevelTable<'h> {
             return Err(Error::Truncated);
         }
         let is_base = k == 0;
-        let header = LevelHeader::parse(bytes, is_base, max_chunk_len, schedule)?;
+        let header = LevelHeader::parse(bytes, is_base, max_chunk_len, schedule, mode)?;
         if header.round_count != info.round_count {
             return Err(Error::LevelCountMismatch);
         }
@@ -285,7 +286,13 @@ mod tests {
         };
         for k in 0..table.len() {
             let level = table
-                .level_header(k, bytes(k), header.max_chunk_len, header.schedule)
+                .level_header(
+                    k,
+                    bytes(k),
+                    header.max_chunk_len,
+                    header.schedule,
+                    header.position_mode,
+                )
                 .unwrap();
             assert_eq!(level.round_count, table.get(k).round_count);
         }
@@ -293,14 +300,26 @@ mod tests {
         let short = &bytes(0)[..bytes(0).len() - 1];
         assert_eq!(
             table
-                .level_header(0, short, header.max_chunk_len, header.schedule)
+                .level_header(
+                    0,
+                    short,
+                    header.max_chunk_len,
+                    header.schedule,
+                    header.position_mode
+                )
                 .err(),
             Some(Error::Truncated)
         );
         let beyond = table.len();
         assert_eq!(
             table
-                .level_header(beyond, bytes(0), header.max_chunk_len, header.schedule)
+                .level_header(
+                    beyond,
+                    bytes(0),
+                    header.max_chunk_len,
+                    header.schedule,
+                    header.position_mode
+                )
                 .err(),
             Some(Error::NoSuchLevel {
                 level: beyond,

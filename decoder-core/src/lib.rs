@@ -40,6 +40,7 @@ pub mod limits;
 #[cfg(feature = "alloc")]
 pub mod owned;
 pub mod pipe;
+pub mod positions_first;
 pub mod predict;
 mod rans;
 #[cfg(feature = "alloc")]
@@ -68,6 +69,7 @@ pub use inflate::Inflater;
 pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader};
 pub use level_table::{LevelInfo, LevelTable, head_len, level_within_error, write_level_table};
+pub use positions_first::RecordOrder;
 pub use predict::{
     ArcMeans, Plane, PlanePolicy, SplitFan, Target, add_residual, arc_means, constrained_positions,
     height_prediction, predict, residual, surface_height,

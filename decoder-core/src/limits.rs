@@ -8,7 +8,10 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 /// stream; 3.5 added a check and no feature, so no stream is written with
 /// minor version 5 (the writer uses the constants below).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 6;
+pub const VERSION_MINOR: u8 = 7;
+/// The first minor version with the record order `positions-first` (SPEC
+/// §5.1, §7.4).
+pub const VERSION_MINOR_RECORDS: u8 = 7;
 /// The minor version written when a stream uses the schedule
 /// `every-vertex` (SPEC §1, §3.2): 3.5 decoders reject its header flag bit.
 pub const VERSION_MINOR_SCHEDULE: u8 = 6;

@@ -26,12 +26,11 @@
 
 use crate::Error;
 use crate::limits::MAX_SPLIT_VALENCE;
-use crate::record::{RecordCoding, RecordFan, read_record};
+use crate::record::{RecordCoding, RecordFan, RecordScratch, read_record};
 use crate::ring::Ring;
 use crate::split::SplitRecord;
 use crate::substream::Substreams;
 use crate::symbols::WingCandidates;
-use crate::wing_order::NearKeys;
 
 /// Carries split requests from the structure half of a round to a
 /// [`RecordsHalf`] and the records back, both in split order.
@@ -53,7 +52,7 @@ pub trait RecordPipe {
 pub struct RecordsHalf<'l, 'b> {
     pub(crate) subs: Substreams<'l, 'b>,
     pub(crate) coding: RecordCoding,
-    pub(crate) keys: NearKeys,
+    pub(crate) scratch: RecordScratch,
     pub(crate) ring: Ring,
     pub(crate) positions: &'b mut [[u32; 3]],
     pub(crate) bits: u8,
@@ -98,7 +97,7 @@ impl RecordsHalf<'_, '_> {
             ring: &self.ring,
             eligible,
         };
-        let record = read_record(&mut self.subs, &self.coding, &mut self.keys, &fan)?;
+        let record = read_record(&mut self.subs, &self.coding, &mut self.scratch, &fan)?;
         // C's index is checked against the capacity when the split is
         // applied; this copy only needs the slot.
         if (c as usize) >= self.positions.len() || (r as usize) >= self.positions.len() {

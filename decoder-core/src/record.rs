@@ -5,8 +5,13 @@ use crate::context::{self, DeficitContexts, SINGLE};
 use crate::header::{PositionMode, Schedule};
 use crate::limits::MAX_SPLIT_VALENCE;
 use crate::limits::substream::{self, SLOTS};
+use crate::positions_first::{
+    self, KIND_CONTEXT, KIND_ESCAPE, NewEdge, OFFSET_CONTEXT, PositionsFirst, RecordOrder,
+    Z_CONTEXT, choice_context, rank_context,
+};
 use crate::predict::{
-    Plane, PlanePolicy, SplitFan, Target, arc_means, constrained_positions, predict,
+    Plane, PlanePolicy, SplitFan, Target, arc_means, constrained_positions, height_prediction,
+    predict, wrap,
 };
 use crate::ring::Ring;
 use crate::round::{RecordSource, all_ones};
@@ -42,8 +47,29 @@ pub struct StreamSource<'s, 'l, 'b> {
     pub deficits: DeficitContexts,
     /// The stream's schedule (SPEC §3.2, 3.6).
     pub schedule: Schedule,
-    /// The current ring's near keys, under a near wing policy.
+    /// The level's record order (SPEC §5.1, 3.7).
+    pub records: RecordOrder,
+    /// What reading a record needs besides the substreams.
+    scratch: RecordScratch,
+}
+
+/// The working arrays of a record (kept between records: nothing is
+/// cleared per split but what it uses): the current ring's near keys under
+/// a near wing policy, its fan's free lattice points and wing pairs under
+/// `positions-first`.
+#[derive(Clone)]
+pub struct RecordScratch {
     keys: NearKeys,
+    pf: PositionsFirst,
+}
+
+impl Default for RecordScratch {
+    fn default() -> Self {
+        RecordScratch {
+            keys: [0; MAX_SPLIT_VALENCE],
+            pf: PositionsFirst::default(),
+        }
+    }
 }
 
 impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
@@ -54,6 +80,7 @@ impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
         let wings = subs.level_header().wing_policy;
         let deficits = subs.level_header().deficit_contexts;
         let schedule = subs.level_header().schedule;
+        let records = subs.level_header().record_order;
         StreamSource {
             subs,
             mode,
@@ -61,7 +88,8 @@ impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
             wings,
             deficits,
             schedule,
-            keys: [0; MAX_SPLIT_VALENCE],
+            records,
+            scratch: RecordScratch::default(),
         }
     }
 }
@@ -86,6 +114,7 @@ impl StreamSource<'_, '_, '_> {
             wings: self.wings,
             deficits: self.deficits,
             schedule: self.schedule,
+            records: self.records,
         }
     }
 }
@@ -142,7 +171,7 @@ impl RecordSource for StreamSource<'_, '_, '_> {
             ring,
             eligible: &eligible,
         };
-        read_record(self.subs, &coding, &mut self.keys, &fan)
+        read_record(self.subs, &coding, &mut self.scratch, &fan)
     }
 }
 
@@ -155,6 +184,7 @@ pub(crate) struct RecordCoding {
     pub(crate) wings: WingPolicy,
     pub(crate) deficits: DeficitContexts,
     pub(crate) schedule: Schedule,
+    pub(crate) records: RecordOrder,
 }
 
 /// What a split record is read against (SPEC §7.4): the positions, R and
@@ -168,13 +198,179 @@ pub(crate) struct RecordFan<'a> {
     pub(crate) eligible: &'a WingCandidates,
 }
 
-/// Reads the record of the split of `fan.r` (SPEC §7.4), fields in order:
+/// Reads the record of the split of `fan.r` (SPEC §7.4): under the record
+/// order `positions-first` (3.7) positions first where the fan allows it,
+/// and otherwise wings first.
+#[inline]
+pub(crate) fn read_record(
+    s: &mut Substreams<'_, '_>,
+    coding: &RecordCoding,
+    scratch: &mut RecordScratch,
+    fan: &RecordFan<'_>,
+) -> Result<SplitRecord, Error> {
+    if coding.records == RecordOrder::PositionsFirst {
+        let parent = *fan
+            .positions
+            .get(fan.r as usize)
+            .ok_or(Error::CapacityExceeded)?;
+        if let Some(free) = scratch.pf.free_points(fan.positions, parent, fan.ring) {
+            let kind = byte_out_of_line(s, slot(substream::PLACEMENT), KIND_CONTEXT)?;
+            match kind {
+                0 | 1 => {
+                    return read_positions_first(s, coding, &mut scratch.pf, fan, free, kind == 1);
+                }
+                KIND_ESCAPE => {}
+                _ => return Err(Error::InvalidPlacement),
+            }
+        }
+    }
+    read_wings_first(s, coding, &mut scratch.keys, fan)
+}
+
+/// `read_record_pf` of SPEC §7.4 ("Positions first") after its kind: the
+/// new vertex's rank among the fan's `free` lattice points (a midpoint's
+/// offset after it), the wings among the pairs that keep the new
+/// triangles counter-clockwise in xy, the split valences, then z.
+fn read_positions_first(
+    s: &mut Substreams<'_, '_>,
+    coding: &RecordCoding,
+    pf: &mut PositionsFirst,
+    fan: &RecordFan<'_>,
+    free: usize,
+    midpoint: bool,
+) -> Result<SplitRecord, Error> {
+    let RecordFan {
+        positions,
+        bits,
+        r,
+        ring,
+        eligible,
+    } = *fan;
+    let j = varint_out_of_line(s, slot(substream::EDGE), rank_context(free))?;
+    let n = pf.point_at(j as usize).ok_or(Error::PositionOutOfRange)?;
+    let (edge, offset) = if midpoint {
+        let t = byte_out_of_line(s, slot(substream::PLACEMENT), OFFSET_CONTEXT)?;
+        if t > 3 {
+            return Err(Error::InvalidPlacement);
+        }
+        let offset = [(t & 1) as i64, (t >> 1) as i64];
+        let p = [offset[0] - n[0], offset[1] - n[1]];
+        (
+            NewEdge {
+                a: p,
+                b: n,
+                midpoint,
+            },
+            offset,
+        )
+    } else {
+        (
+            NewEdge {
+                a: n,
+                b: [0, 0],
+                midpoint,
+            },
+            [0, 0],
+        )
+    };
+    let xs = pf.order_xs(eligible, &edge);
+    let u = byte_out_of_line(s, slot(substream::WING_OFFSET), choice_context(xs))?;
+    let x = pf
+        .choice(xs, u as usize)
+        .ok_or(Error::RingOffsetOutOfRange)?;
+    let ys = pf.order_ys(&edge, x);
+    let v = byte_out_of_line(s, slot(substream::WING_DISTANCE), choice_context(ys))?;
+    let y = pf
+        .choice(ys, v as usize)
+        .ok_or(Error::RingOffsetOutOfRange)?;
+    let (o, d, code) = positions_first::wings_and_code(x, y, midpoint);
+    let (deficit_p, deficit_c) = read_deficits(s, coding, ring.len(), d)?;
+    let r_z = signed_out_of_line(s, slot(substream::EDGE), Z_CONTEXT)? as i64;
+    let parent = *positions.get(r as usize).ok_or(Error::CapacityExceeded)?;
+    let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
+    let xy = if midpoint {
+        [2 * n[0] - offset[0], 2 * n[1] - offset[1]]
+    } else {
+        n
+    };
+    let h = height_prediction(positions, parent, ring, target, [xy[0], xy[1], 0]).unwrap_or(0);
+    let (p, c) = constrained_positions(parent, code, [xy[0], xy[1], wrap(h + r_z)]);
+    Ok(SplitRecord {
+        wing_offset: o as u8,
+        wing_distance: d as u8,
+        deficit_p,
+        deficit_c,
+        position_p: to_grid(p, bits)?,
+        position_c: to_grid(c, bits)?,
+    })
+}
+
+/// The value readers of a positions-first record, out of line: the
+/// wings-first record inlines its readers for speed, and inlining these
+/// too would add kilobytes to a microcontroller's decoder for reads that
+/// are not its bottleneck (the fan's free points are).
+#[inline(never)]
+fn byte_out_of_line(s: &mut Substreams<'_, '_>, slot: usize, context: u8) -> Result<u8, Error> {
+    s.byte(slot, context)
+}
+
+#[inline(never)]
+fn varint_out_of_line(s: &mut Substreams<'_, '_>, slot: usize, context: u8) -> Result<u32, Error> {
+    s.varint(slot, context)
+}
+
+#[inline(never)]
+fn signed_out_of_line(s: &mut Substreams<'_, '_>, slot: usize, context: u8) -> Result<i32, Error> {
+    s.signed(slot, context)
+}
+
+/// The split valences of P and C (SPEC §7.4 step 2) of a split of a ring
+/// of `k` entries whose wings are `d` apart, in the level's deficit
+/// contexts; under `every-vertex` the valences themselves, read from
+/// nothing.
+#[inline]
+fn read_deficits(
+    s: &mut Substreams<'_, '_>,
+    coding: &RecordCoding,
+    k: usize,
+    d: usize,
+) -> Result<(u8, u8), Error> {
+    let (valence_p, valence_c) = (d + 2, k - d + 2);
+    match coding.schedule {
+        // 3.6: no split valences; the bytes are the valences (SPEC §7.4).
+        Schedule::EveryVertex => Ok((
+            valence_p.min(MAX_SPLIT_VALENCE) as u8,
+            valence_c.min(MAX_SPLIT_VALENCE) as u8,
+        )),
+        Schedule::SplitValences => {
+            let contexts = coding.deficits;
+            let deficit_p = deficit_of(
+                s.byte(
+                    slot(substream::DEFICIT_P),
+                    context::deficit_p(contexts, valence_p),
+                )?,
+                valence_p,
+            )?;
+            let deficit_c = deficit_of(
+                s.byte(
+                    slot(substream::DEFICIT_C),
+                    context::deficit_c(contexts, deficit_p, valence_c),
+                )?,
+                valence_c,
+            )?;
+            Ok((deficit_p, deficit_c))
+        }
+    }
+}
+
+/// Reads the record of the split of `fan.r` wings first (SPEC §7.4
+/// `read_record`), fields in order:
 /// wing ranks (in ring order, or in the near order of the level's wing
 /// policy), split valences of P and C (in the level's deficit contexts),
 /// then (constrained) the placement code and one residual vector, or
 /// (optimal) two residual vectors.
 #[inline]
-pub(crate) fn read_record(
+fn read_wings_first(
     s: &mut Substreams<'_, '_>,
     coding: &RecordCoding,
     keys: &mut NearKeys,
@@ -198,32 +394,7 @@ pub(crate) fn read_record(
             near_wings(&keys[..m], k, o_rank, d_rank)?
         }
     };
-    let (valence_p, valence_c) = (d + 2, k - d + 2);
-    let (deficit_p, deficit_c) = match coding.schedule {
-        // 3.6: no split valences; the bytes are the valences (SPEC §7.4).
-        Schedule::EveryVertex => (
-            valence_p.min(MAX_SPLIT_VALENCE) as u8,
-            valence_c.min(MAX_SPLIT_VALENCE) as u8,
-        ),
-        Schedule::SplitValences => {
-            let contexts = coding.deficits;
-            let deficit_p = deficit_of(
-                s.byte(
-                    slot(substream::DEFICIT_P),
-                    context::deficit_p(contexts, valence_p),
-                )?,
-                valence_p,
-            )?;
-            let deficit_c = deficit_of(
-                s.byte(
-                    slot(substream::DEFICIT_C),
-                    context::deficit_c(contexts, deficit_p, valence_c),
-                )?,
-                valence_c,
-            )?;
-            (deficit_p, deficit_c)
-        }
-    };
+    let (deficit_p, deficit_c) = read_deficits(s, coding, k, d)?;
     let parent = *positions.get(r as usize).ok_or(Error::CapacityExceeded)?;
     let means = arc_means(positions, parent, ring, o, d);
     let plane = Plane::new(coding.plane, &means);

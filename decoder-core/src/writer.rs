@@ -11,9 +11,10 @@ use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
     CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_BASELINE, VERSION_MINOR_DEFICITS,
-    VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_SCHEDULE, VERSION_MINOR_WINGS,
-    codec, substream,
+    VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_RECORDS, VERSION_MINOR_SCHEDULE,
+    VERSION_MINOR_WINGS, codec, substream,
 };
+use crate::positions_first::RecordOrder;
 use crate::predict::PlanePolicy;
 use crate::rans_segments::rans_segments;
 use crate::rans_writer::{Symbol, encode_chunk};
@@ -160,6 +161,9 @@ pub struct LevelPayload {
     /// §5.5.5; 3.3): they also set how many tables deficit-p and deficit-c
     /// have.
     pub deficits: DeficitContexts,
+    /// How the level's records are read (SPEC §5.1, §7.4; 3.7): it also
+    /// sets how many tables edge and placement have.
+    pub records: RecordOrder,
     /// Substreams in id order: ids 1..=7 for rounds (index 0 is id 1), or
     /// ids 8..=10 for a base level given to [`write_stream`].
     pub substreams: Vec<SubstreamWriter>,
@@ -256,6 +260,7 @@ impl SeedPayload {
             plane: PlanePolicy::Off,
             wings: WingPolicy::Ranks,
             deficits: DeficitContexts::Plain,
+            records: RecordOrder::WingsFirst,
             vertex_count: self.vertices,
             triangle_count: self.triangles,
             substreams: self.substreams,
@@ -351,12 +356,17 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
+    // SPEC §1: 3.7 where a level reads its records positions first, 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
     // `max_chunk_len`) is used, 3.3 where a 3.3 feature (the deficit
     // contexts `valence`) is, 3.2 where a 3.2 feature (a wing policy other
     // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
     // is; every other stream stays readable by 3.0 decoders.
-    let version_minor = if params.schedule == Schedule::EveryVertex {
+    let version_minor = if levels
+        .iter()
+        .any(|l| l.records == RecordOrder::PositionsFirst)
+    {
+        VERSION_MINOR_RECORDS
+    } else if params.schedule == Schedule::EveryVertex {
         VERSION_MINOR_SCHEDULE
     } else if rans_above {
         VERSION_MINOR_RANS_CHUNKS
@@ -435,7 +445,7 @@ pub fn frame_level_with(
         .flat_map(|s| s.substreams.iter().enumerate())
         .map(|(i, s)| (substream::BASE_POSITIONS + i as u8, s));
     for (id, sub) in rounds.chain(base) {
-        let contexts = context::count(id, level.deficits, params.schedule);
+        let contexts = context::count(id, level.deficits, level.records, params.schedule);
         let chunks = substream_chunks(sub, contexts, params, map);
         for chunk in chunks {
             let mut entry = [0u8; CHUNK_ENTRY_LEN];
@@ -461,7 +471,7 @@ pub fn frame_level_with(
         level.plane.to_byte(),
         level.wings.to_byte(),
         level.deficits.to_byte(),
-        0,
+        level.records.to_byte(),
     ]);
     if let Some(seed) = seed {
         out.extend_from_slice(&seed.vertices.to_le_bytes());
@@ -550,7 +560,19 @@ pub fn coded_len_in(
     deficits: DeficitContexts,
     params: &StreamParams,
 ) -> usize {
-    let contexts = context::count(id, deficits, params.schedule);
+    coded_len_under(sub, id, deficits, RecordOrder::WingsFirst, params)
+}
+
+/// [`coded_len_in`] in a level whose record order is `records` (it sets
+/// the table count of edge and placement, SPEC §5.5.5, 3.7).
+pub fn coded_len_under(
+    sub: &SubstreamWriter,
+    id: u8,
+    deficits: DeficitContexts,
+    records: RecordOrder,
+    params: &StreamParams,
+) -> usize {
+    let contexts = context::count(id, deficits, records, params.schedule);
     substream_chunks(sub, contexts, params, &one_by_one)
         .iter()
         .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)

@@ -44,6 +44,7 @@ fn level() -> LevelPayload {
         plane: PlanePolicy::Dominant,
         wings: WingPolicy::Ranks,
         deficits: DeficitContexts::Plain,
+        records: splitstream_decoder_core::RecordOrder::WingsFirst,
         substreams,
         vertex_count: 420,
         triangle_count: 836,

@@ -90,6 +90,7 @@ proptest! {
             plane: PlanePolicy::from_byte(plane).unwrap(),
             wings: WingPolicy::Ranks,
             deficits: DeficitContexts::Plain,
+            records: splitstream_decoder_core::RecordOrder::WingsFirst,
             substreams: subs
                 .iter()
                 .map(|s| {

@@ -52,6 +52,7 @@ fn splits(stream: &[u8]) -> u64 {
         true,
         head.max_chunk_len,
         head.schedule,
+        head.position_mode,
     )
     .expect("level 0");
     (head.vertex_capacity - lh.seed_vertices) as u64

@@ -478,3 +478,47 @@ fn both_schedules_decode_to_the_same_mesh() {
     assert_eq!(header(&forth).schedule, Schedule::EveryVertex);
     assert_eq!(mesh(&forth), mesh(&split));
 }
+
+/// `--records` (format 3.7): positions first forced on a raster decodes to
+/// the mesh the wings-first stream gives, `info` names each level's
+/// record order, and positions first where a level could not declare it
+/// is one clear line.
+#[test]
+fn records_read_positions_first_decode_to_the_same_mesh() {
+    let input = raster();
+    let i = input.to_str().unwrap();
+    let mut meshes = Vec::new();
+    for records in ["wings-first", "positions-first"] {
+        let stream = input.with_file_name(format!("records-{records}.sps"));
+        let s = stream.to_str().unwrap();
+        succeeded(&splitstream(&["encode", i, "-o", s, "--records", records]));
+        let doc: serde_json::Value =
+            serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();
+        for level in doc["levels"].as_array().unwrap() {
+            assert_eq!(level["record_order"], records, "{level}");
+        }
+        let text = succeeded(&splitstream(&["info", s]));
+        assert!(text.contains(records), "{text}");
+        let decoded = input.with_file_name(format!("records-{records}.obj"));
+        succeeded(&splitstream(&[
+            "decode",
+            s,
+            "-o",
+            decoded.to_str().unwrap(),
+        ]));
+        meshes.push(std::fs::read_to_string(&decoded).unwrap());
+    }
+    assert_eq!(meshes[0], meshes[1]);
+    let out = input.with_file_name("records-optimal.sps");
+    let err = one_line_error(&splitstream(&[
+        "encode",
+        i,
+        "-o",
+        out.to_str().unwrap(),
+        "--records",
+        "positions-first",
+        "--position",
+        "optimal",
+    ]));
+    assert!(err.contains("--records positions-first"), "{err}");
+}

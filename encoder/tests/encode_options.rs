@@ -6,6 +6,7 @@ mod common;
 
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_decoder_core::{PlanePolicy, PositionMode, RecordOrder, WingPolicy};
 use splitstream_encoder::emit::{
     EncodeError, EncodeOptions, encode, encode_quantized, quantize_for,
 };
@@ -45,6 +46,38 @@ fn lane_counts_outside_the_format_are_refused() {
             "--lanes",
         );
     }
+}
+
+/// Positions first needs what a positions-first level declares (SPEC
+/// §5.1, format 3.7): constrained mode, the plane policy `height`, the
+/// wing policy `ranks`.
+#[test]
+fn positions_first_is_refused_where_a_level_could_not_declare_it() {
+    let pf = || EncodeOptions {
+        records: Some(RecordOrder::PositionsFirst),
+        ..Default::default()
+    };
+    refused(
+        EncodeOptions {
+            position_mode: PositionMode::Optimal,
+            ..pf()
+        },
+        "--records",
+    );
+    refused(
+        EncodeOptions {
+            plane: Some(PlanePolicy::Dominant),
+            ..pf()
+        },
+        "--records",
+    );
+    refused(
+        EncodeOptions {
+            wings: Some(WingPolicy::NearXy),
+            ..pf()
+        },
+        "--records",
+    );
 }
 
 #[test]

@@ -7,7 +7,10 @@ mod roundtrip_check;
 use roundtrip_check::assert_roundtrip;
 
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, Schedule, WingPolicy};
+use splitstream_decoder_core::{
+    DeficitContexts, Header, LevelHeader, LevelTable, PlanePolicy, PositionMode, RecordOrder,
+    Schedule, WingPolicy,
+};
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::quantize::{Lattice, Quantization, Units};
 
@@ -108,6 +111,9 @@ fn height_policy_roundtrips_and_sets_the_minor_version() {
                     deficits: Some(DeficitContexts::Plain),
                     position_mode: mode,
                     schedule: Schedule::SplitValences,
+                    // Wings first: the minor version of the feature under test
+                    // (positions first, 3.7, would raise it to 7).
+                    records: Some(RecordOrder::WingsFirst),
                     ..EncodeOptions::default()
                 };
                 assert_roundtrip(&terrain, &options);
@@ -303,6 +309,9 @@ fn rans_chunks_beyond_max_chunk_len_set_minor_version_4() {
             chunk_limit,
             position_mode: PositionMode::Constrained,
             schedule: Schedule::SplitValences,
+            // Wings first: the minor version of the feature under test
+            // (positions first, 3.7, would raise it to 7).
+            records: Some(RecordOrder::WingsFirst),
             ..EncodeOptions::default()
         };
         assert_roundtrip(&large, &options);
@@ -356,6 +365,9 @@ fn every_vertex_roundtrips_and_sets_the_minor_version() {
                     codec,
                     position_mode: mode,
                     schedule: Schedule::EveryVertex,
+                    // Wings first: the minor version of the feature under test
+                    // (positions first, 3.7, would raise it to 7).
+                    records: Some(RecordOrder::WingsFirst),
                     ..EncodeOptions::default()
                 };
                 assert_roundtrip(mesh, &options);
@@ -456,4 +468,87 @@ fn the_stream_does_not_depend_on_the_input_order() {
             assert_eq!(renamed, b.permutation, "{name}, {mode:?}");
         }
     }
+}
+
+/// Format 3.7's record order `positions-first`, forced in every level, on
+/// terrain with and without a boundary and on a closed mesh (whose fans
+/// fold over in xy: escapes), under both schedules and both codecs: the
+/// round trip is exact, the minor version is 7 and the level headers say
+/// so (SPEC §1, §5.1, §7.4).
+#[test]
+fn positions_first_roundtrips_and_sets_the_minor_version() {
+    let meshes = [
+        common::bumpy_grid(21, 17, 3),
+        common::icosphere(2),
+        splitstream_encoder::input::fractal_terrain(24, 5),
+    ];
+    for mesh in &meshes {
+        for schedule in [Schedule::EveryVertex, Schedule::SplitValences] {
+            for codec in [ChunkCodec::Rans { lanes: 4 }, ChunkCodec::Deflate(6)] {
+                let options = EncodeOptions {
+                    records: Some(RecordOrder::PositionsFirst),
+                    schedule,
+                    codec,
+                    ..EncodeOptions::default()
+                };
+                assert_roundtrip(mesh, &options);
+                let encoded = encode(mesh, &options, |_| {}).expect("encode");
+                let stream = &encoded.stream;
+                assert_eq!(stream[9], 7, "{schedule:?} {codec:?}");
+                let header = Header::parse(stream).expect("header");
+                let table = LevelTable::parse(stream, &header).expect("table");
+                for k in 0..table.len() {
+                    let e = table.get(k);
+                    let bytes = &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
+                    let lh = LevelHeader::parse(
+                        bytes,
+                        k == 0,
+                        header.max_chunk_len,
+                        header.schedule,
+                        header.position_mode,
+                    )
+                    .expect("level header");
+                    assert_eq!(lh.record_order, RecordOrder::PositionsFirst);
+                    assert_eq!(lh.plane_policy, PlanePolicy::Height);
+                    assert_eq!(lh.wing_policy, WingPolicy::Ranks);
+                }
+            }
+        }
+    }
+}
+
+/// By default a raster's levels read their records positions first where
+/// that is smaller: never larger than wings first (a few bytes of slack:
+/// the choice ranks rANS sizes and framing may pick deflate), and on a
+/// fractal terrain clearly smaller.
+#[test]
+fn the_chosen_record_order_is_never_larger_than_wings_first() {
+    let terrain = splitstream_encoder::input::fractal_terrain(64, 9);
+    for mesh in [common::bumpy_grid(31, 23, 2), terrain] {
+        let size = |records| {
+            let options = EncodeOptions {
+                records,
+                ..EncodeOptions::default()
+            };
+            encode(&mesh, &options, |_| {})
+                .expect("encode")
+                .stream
+                .len()
+        };
+        let (auto, wings_first) = (size(None), size(Some(RecordOrder::WingsFirst)));
+        assert!(auto <= wings_first + 16, "{auto} > {wings_first}");
+    }
+    let terrain = splitstream_encoder::input::fractal_terrain(64, 9);
+    let size = |records| {
+        let options = EncodeOptions {
+            records,
+            ..EncodeOptions::default()
+        };
+        encode(&terrain, &options, |_| {})
+            .expect("encode")
+            .stream
+            .len()
+    };
+    let (auto, wings_first) = (size(None), size(Some(RecordOrder::WingsFirst)));
+    assert!(auto * 20 < wings_first * 19, "{auto} against {wings_first}");
 }

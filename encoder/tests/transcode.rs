@@ -129,8 +129,14 @@ fn smaller_chunks_lower_the_workspace_and_keep_every_round() {
         );
         assert!(long.stream.len() < short.stream.len(), "{name}");
         // Minor 6: the schedule every-vertex (the default, 3.6), a later
-        // feature than 3.4's long rANS chunks.
-        assert_eq!(long_header.version_minor, 6, "{name}");
+        // feature than 3.4's long rANS chunks; 7 where a level of the
+        // grid reads its records positions first (3.7, chosen by size).
+        let positions_first = long_header.version_minor == 7;
+        assert!(
+            long_header.version_minor == 6 || (positions_first && name == "bumpy grid"),
+            "{name}: minor {}",
+            long_header.version_minor
+        );
         assert_eq!(round_hashes(&long.stream), hashes, "{name}");
     }
 }

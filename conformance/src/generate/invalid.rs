@@ -314,8 +314,8 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "reserved-level-header",
         "malformed",
-        "Level 1's reserved level header byte 11 (after the deficit contexts) not zero (level header CRC recomputed).",
-        &["reserved", "plane-policy"],
+        "Level 1's level header byte 11 (after the deficit contexts; reserved until 3.6, the record order since 3.7) is 1, positions-first, in an optimal-mode stream, where it is not allowed (level header CRC recomputed).",
+        &["reserved", "plane-policy", "positions-first"],
         with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 3, 1),
     );
     // A stored chunk longer than the header's max_chunk_len: the buffer a
@@ -761,6 +761,7 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
         );
     }
     every_vertex_invalid(s);
+    super::positions_first::positions_first_invalid(s);
 }
 
 /// Faults of the schedule `every-vertex` (SPEC §3.2, §5.1, §6.3, §7.6,

@@ -5,6 +5,7 @@
 mod invalid;
 mod meshes;
 mod mutate;
+mod positions_first;
 mod rans;
 mod valid;
 
@@ -14,7 +15,9 @@ use std::path::Path;
 use splitstream_decoder_core::limits::codec;
 use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{Fnv1a, Header, LevelHeader, LevelTable, PositionMode, Schedule};
+use splitstream_decoder_core::{
+    Fnv1a, Header, LevelHeader, LevelTable, PositionMode, RecordOrder, Schedule,
+};
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
 
@@ -92,11 +95,13 @@ fn encoded(mesh: &Mesh, options: EncodeOptions) -> Vec<u8> {
 /// mode since 2026-12-03, the schedule `every-vertex` since format 3.6):
 /// the vectors named `position-constrained` ask for constrained mode, and
 /// those named `every-vertex-…` for the schedule `every-vertex`
-/// ([`every_vertex`]).
+/// ([`every_vertex`]); records are read wings first (format 3.7's
+/// `positions-first` has vectors of its own, `positions_first.rs`).
 fn opts() -> EncodeOptions {
     EncodeOptions {
         position_mode: PositionMode::Optimal,
         schedule: Schedule::SplitValences,
+        records: Some(RecordOrder::WingsFirst),
         ..EncodeOptions::default()
     }
 }
@@ -251,8 +256,14 @@ fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
     for k in 0..header.level_count {
         let info = table.get(k);
         let bytes = &stream[info.offset as usize..(info.offset + info.length as u64) as usize];
-        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len, header.schedule)
-            .expect("valid");
+        let lh = LevelHeader::parse(
+            bytes,
+            k == 0,
+            header.max_chunk_len,
+            header.schedule,
+            header.position_mode,
+        )
+        .expect("valid");
         if k == 0 && lh.round_count > 0 {
             tags.push("seed-rounds".to_string());
         }

@@ -27,6 +27,8 @@ pub struct Level {
     pub wings: WingPolicy,
     /// The level's deficit contexts (SPEC §5.1, 3.3).
     pub deficits: DeficitContexts,
+    /// The level's record order (SPEC §5.1, 3.7).
+    pub records: splitstream_decoder_core::RecordOrder,
     /// The rounds' substreams, ids 1..=7.
     pub substreams: Vec<Vec<u8>>,
     pub vertex_count: u32,
@@ -51,8 +53,14 @@ pub fn unframe(stream: &[u8]) -> Unframed {
     for k in 0..header.level_count {
         let info = table.get(k);
         let bytes = &stream[level_range(stream, k)];
-        let lh = LevelHeader::parse(bytes, k == 0, header.max_chunk_len, header.schedule)
-            .expect("a valid level");
+        let lh = LevelHeader::parse(
+            bytes,
+            k == 0,
+            header.max_chunk_len,
+            header.schedule,
+            header.position_mode,
+        )
+        .expect("a valid level");
         // Slots 0..7: ids 1..=7 (rounds); 7..10: ids 8..=10 (seed).
         let mut substreams = vec![Vec::new(); 10];
         let mut at = lh.payload_start;
@@ -84,6 +92,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
             plane: lh.plane_policy,
             wings: lh.wing_policy,
             deficits: lh.deficit_contexts,
+            records: lh.record_order,
             substreams,
             vertex_count: info.vertex_count,
             triangle_count: info.triangle_count,
@@ -132,6 +141,7 @@ pub fn reframe(u: &Unframed) -> Vec<u8> {
             plane: l.plane,
             wings: l.wings,
             deficits: l.deficits,
+            records: l.records,
             substreams: writers(&l.substreams),
             vertex_count: l.vertex_count,
             triangle_count: l.triangle_count,

@@ -457,6 +457,7 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
         cone,
     };
     every_vertex_vectors(s, &bunny, &shapes);
+    super::positions_first::positions_first_valid(s);
     Ok(())
 }
 

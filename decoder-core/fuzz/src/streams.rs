@@ -604,6 +604,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                         plane,
                         wings,
                         deficits,
+                        records: splitstream_decoder_core::RecordOrder::WingsFirst,
                         substreams: subs,
                         vertex_count: n + declared,
                         triangle_count: state.triangle_count() + remaining,
@@ -623,6 +624,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
             plane,
             wings,
             deficits,
+            records: splitstream_decoder_core::RecordOrder::WingsFirst,
             substreams: subs,
             vertex_count: state.vertex_count(),
             triangle_count: state.triangle_count(),
@@ -1019,6 +1021,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                     plane,
                     wings,
                     deficits,
+                    records: splitstream_decoder_core::RecordOrder::WingsFirst,
                     substreams: s
                         .into_iter()
                         .map(|b| {

@@ -205,6 +205,7 @@ fn size_row(
         true,
         header.max_chunk_len,
         header.schedule,
+        header.position_mode,
     )
     .map_err(|e| e.to_string())?
     .seed_vertices;

@@ -2,9 +2,9 @@
 //! `transcode` share.
 
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{DeficitContexts, PlanePolicy, Schedule, WingPolicy};
+use splitstream_decoder_core::{DeficitContexts, PlanePolicy, RecordOrder, Schedule, WingPolicy};
 
-use super::{CliResult, Codec, DeficitsArg, PlaneArg, ScheduleArg, WingsArg};
+use super::{CliResult, Codec, DeficitsArg, PlaneArg, RecordsArg, ScheduleArg, WingsArg};
 use splitstream_encoder::emit::check_coding;
 
 #[derive(clap::Args)]
@@ -41,6 +41,14 @@ pub struct CodingArgs {
     /// 3.3) (SPEC §5.5.5); `auto` picks the cheaper per level.
     #[arg(long, value_enum, default_value_t = DeficitsArg::Auto)]
     pub deficits: DeficitsArg,
+    /// How each level reads its split records: `wings-first` (every 3.x
+    /// decoder, the fastest to decode), or `positions-first`, the new
+    /// vertex as a rank among its fan's free lattice points, then the
+    /// wings among the pairs that keep the triangles up (rasters on their
+    /// lattice, constrained mode, format 3.7) (SPEC §7.4); `auto` picks the
+    /// smaller per level.
+    #[arg(long, value_enum, default_value_t = RecordsArg::Auto)]
+    pub records: RecordsArg,
     /// How the stream says which vertices split in which round:
     /// `every-vertex`, a flag for every vertex (format 3.6, smaller), or
     /// `split-valences`, the paper's split valences (read by every 3.x
@@ -75,6 +83,10 @@ impl CodingArgs {
 
     pub fn deficits(&self) -> Option<DeficitContexts> {
         self.deficits.contexts()
+    }
+
+    pub fn records(&self) -> Option<RecordOrder> {
+        self.records.order()
     }
 
     pub fn schedule(&self) -> Schedule {

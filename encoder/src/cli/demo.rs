@@ -12,6 +12,7 @@ pub fn run(
     side: usize,
     output: Option<&std::path::Path>,
     schedule: splitstream_decoder_core::Schedule,
+    records: Option<splitstream_decoder_core::RecordOrder>,
 ) -> CliResult {
     if !(2..=4096).contains(&side) {
         return Err(format!("--side {side} is outside 2..=4096"));
@@ -30,6 +31,7 @@ pub fn run(
     // optimal mode, which this command used until 2026-12-02, took 32.3).
     let options = EncodeOptions {
         schedule,
+        records,
         ..EncodeOptions::default()
     };
     let started = Instant::now();

@@ -102,6 +102,7 @@ pub fn run(a: Args) -> CliResult {
         backend: a.backend.into(),
         plane: a.coding.plane(),
         wings: a.coding.wings(),
+        records: a.coding.records(),
         deficits: a.coding.deficits(),
         schedule: a.coding.schedule(),
     };

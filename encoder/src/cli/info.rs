@@ -93,7 +93,13 @@ fn field_sizes_of(
             )
         })?;
         let lh = table
-            .level_header(k, bytes, header.max_chunk_len, header.schedule)
+            .level_header(
+                k,
+                bytes,
+                header.max_chunk_len,
+                header.schedule,
+                header.position_mode,
+            )
             .map_err(|e| format!("level {k}: {e}"))?;
         sizes.framing += lh.payload_start as u64;
         let mut level = [0u64; FIELDS];
@@ -212,24 +218,36 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
     } else {
         Vec::new()
     };
-    // Each level's plane and wing policies and deficit contexts (SPEC §5.1,
-    // §5.5.5, §7.4).
-    let policies: Vec<(&str, &str, &str)> = (0..table.len())
+    // Each level's plane and wing policies, deficit contexts and record
+    // order (SPEC §5.1, §5.5.5, §7.4).
+    let policies: Vec<(&str, &str, &str, &str)> = (0..table.len())
         .map(|k| {
             let e = table.get(k);
             stream
                 .get(e.offset as usize..(e.offset + e.length as u64) as usize)
                 .and_then(|b| {
-                    LevelHeader::parse(b, k == 0, header.max_chunk_len, header.schedule).ok()
+                    LevelHeader::parse(
+                        b,
+                        k == 0,
+                        header.max_chunk_len,
+                        header.schedule,
+                        header.position_mode,
+                    )
+                    .ok()
                 })
-                .map_or(("?", "?", "?"), |lh| {
+                .map_or(("?", "?", "?", "?"), |lh| {
                     // Under `every-vertex` no split valences are coded
                     // (SPEC §3.2): no deficit contexts to name.
                     let deficits = match header.schedule {
                         Schedule::SplitValences => lh.deficit_contexts.name(),
                         Schedule::EveryVertex => "-",
                     };
-                    (lh.plane_policy.name(), lh.wing_policy.name(), deficits)
+                    (
+                        lh.plane_policy.name(),
+                        lh.wing_policy.name(),
+                        deficits,
+                        lh.record_order.name(),
+                    )
                 })
         })
         .collect();
@@ -281,6 +299,7 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
                     "wing_policy": policies[k as usize].1,
                     // null where the schedule codes no split valences.
                     "deficit_contexts": (policies[k as usize].2 != "-").then_some(policies[k as usize].2),
+                    "record_order": policies[k as usize].3,
                     "workspace_bytes": memory[k as usize],
                     // null for a level that is not in the file.
                     "field_bytes": sizes.per_level.get(k as usize).map(|level| {
@@ -391,12 +410,12 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
         header.max_chunk_len
     );
     println!(
-        "  level    offset     bytes   vertices  triangles rounds  plane     wings    deficits  decoder memory  geometric error"
+        "  level    offset     bytes   vertices  triangles rounds  plane     wings    deficits  records          decoder memory  geometric error"
     );
     for k in 0..table.len() {
         let e = table.get(k);
         println!(
-            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:<8} {:>14}  {:.6}",
+            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:<8} {:<15} {:>15}  {:.6}",
             k,
             e.offset,
             e.length,
@@ -406,6 +425,7 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
             policies[k as usize].0,
             policies[k as usize].1,
             policies[k as usize].2,
+            policies[k as usize].3,
             memory[k as usize],
             e.geometric_error
         );

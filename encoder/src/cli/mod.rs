@@ -170,6 +170,30 @@ impl DeficitsArg {
     }
 }
 
+/// How each level reads its split records (SPEC §5.1, §7.4, format 3.7).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum RecordsArg {
+    /// Per level, positions first where it is allowed and smaller.
+    #[default]
+    Auto,
+    /// The wings first (every 3.x decoder; the fastest to decode).
+    WingsFirst,
+    /// The new vertex first, as a rank among its fan's free lattice points
+    /// (rasters on their lattice, constrained mode; 3.7).
+    PositionsFirst,
+}
+
+impl RecordsArg {
+    pub fn order(self) -> Option<splitstream_decoder_core::RecordOrder> {
+        use splitstream_decoder_core::RecordOrder;
+        match self {
+            RecordsArg::Auto => None,
+            RecordsArg::WingsFirst => Some(RecordOrder::WingsFirst),
+            RecordsArg::PositionsFirst => Some(RecordOrder::PositionsFirst),
+        }
+    }
+}
+
 /// How a stream says which vertices split in which round (SPEC §3.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum ScheduleArg {
@@ -296,6 +320,9 @@ pub enum Command {
         /// §3.2; as `encode --schedule`).
         #[arg(long, value_enum, default_value_t = ScheduleArg::EveryVertex)]
         schedule: ScheduleArg,
+        /// How each level reads its split records (as `encode --records`).
+        #[arg(long, value_enum, default_value_t = RecordsArg::Auto)]
+        records: RecordsArg,
     },
 }
 
@@ -339,7 +366,8 @@ pub fn run(cli: Cli) -> CliResult {
             side,
             output,
             schedule,
-        } => demo::run(side, output.as_deref(), schedule.into()),
+            records,
+        } => demo::run(side, output.as_deref(), schedule.into(), records.order()),
     }
 }
 

@@ -29,6 +29,7 @@ pub fn run(a: Args) -> CliResult {
         rans_chunk_limit: a.coding.rans_chunk,
         plane: a.coding.plane(),
         wings: a.coding.wings(),
+        records: a.coding.records(),
         deficits: a.coding.deficits(),
         schedule: a.coding.schedule(),
     };

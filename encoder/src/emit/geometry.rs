@@ -20,6 +20,9 @@ use splitstream_decoder_core::{
 };
 
 use super::policies::{SplitResiduals, early_choice_at};
+use super::positions_first::{
+    PositionsFirstCoding, SplitSeen, WingsFirstRecord, escape_wing_context,
+};
 use super::wings::WingCoding;
 
 /// What a split's record takes from the state at the start of its round.
@@ -119,10 +122,12 @@ impl GeometrySender {
 }
 
 /// A level's coded geometry: the wing ranks under every wing policy, and in
-/// constrained mode the placement substream.
+/// constrained mode the placement substream, and the records read
+/// positions first when they are a choice (format 3.7).
 pub struct LevelGeometry {
     pub wings: WingCoding,
     pub placement: SubstreamWriter,
+    pub positions_first: Option<PositionsFirstCoding>,
 }
 
 /// Codes the batches arriving on `batches` for one level of `splits` splits
@@ -136,6 +141,7 @@ pub fn code_geometry(
     batches: GeometryReceiver,
     residuals: Sender<Vec<SplitResiduals>>,
     mut wings: WingCoding,
+    mut positions_first: Option<PositionsFirstCoding>,
     params: &StreamParams,
     splits: usize,
     heights: bool,
@@ -170,14 +176,33 @@ pub fn code_geometry(
                     g.id
                 ));
             }
-            out.push(split_residuals(
-                g,
-                positions,
-                &ring,
-                mode,
-                heights,
-                &mut placement,
-            )?);
+            let (residuals, placed) =
+                split_residuals(g, positions, &ring, mode, heights, &mut placement)?;
+            if let (Some(pf), Some((code, placement_context))) = (&mut positions_first, placed) {
+                let ranks = g
+                    .eligible
+                    .ranks(o, d)
+                    .ok_or_else(|| format!("the wings of {} are not eligible", g.id))?;
+                let seen = SplitSeen {
+                    positions,
+                    ring: &ring,
+                    eligible: &g.eligible,
+                    parent: g.parent,
+                    p: g.p,
+                    c: g.c,
+                    o,
+                    d,
+                    code,
+                };
+                let escape = WingsFirstRecord {
+                    ranks,
+                    wing_context: escape_wing_context(&g.eligible),
+                    placement_context,
+                    vector: residuals.vectors(PlanePolicy::Height).0,
+                };
+                pf.write(&seen, &escape);
+            }
+            out.push(residuals);
         }
         // A closed channel means the coder failed: its error is reported
         // when it is joined.
@@ -191,11 +216,16 @@ pub fn code_geometry(
         batch.ring_positions.clear();
         let _ = batches.spent.send(batch);
     }
-    Ok(LevelGeometry { wings, placement })
+    Ok(LevelGeometry {
+        wings,
+        placement,
+        positions_first,
+    })
 }
 
 /// The residual vectors of split `g` (and in constrained mode its placement
-/// code, written to `placement`), from its ring's `positions`.
+/// code, written to `placement`, and returned with its context), from its
+/// ring's `positions`.
 fn split_residuals(
     g: &SplitGeometry,
     positions: &[[u32; 3]],
@@ -203,8 +233,9 @@ fn split_residuals(
     mode: PositionMode,
     heights: bool,
     placement: &mut SubstreamWriter,
-) -> Result<SplitResiduals, String> {
+) -> Result<(SplitResiduals, Option<(u8, u8)>), String> {
     let (parent, p, c) = (g.parent, g.p, g.c);
+    let mut placed = None;
     let means = arc_means(positions, parent, ring, g.o as usize, g.d as usize);
     let wide = |x: [u32; 3]| x.map(|v| v as i64);
     let sub = |a: [i64; 3], b: [i64; 3]| -> [i64; 3] { std::array::from_fn(|i| a[i] - b[i]) };
@@ -255,7 +286,9 @@ fn split_residuals(
                     g.id
                 ));
             };
-            placement.byte_in(context::placement(&means), code);
+            let placement_context = context::placement(&means);
+            placement.byte_in(placement_context, code);
+            placed = Some((code, placement_context));
             let target = Target::of_code(code).expect("codes 0..=2");
             let prediction = predict(&means, mode, target);
             let r = residual(x, prediction);
@@ -270,11 +303,14 @@ fn split_residuals(
             g.id
         ));
     }
-    Ok(SplitResiduals {
-        normal: Plane::new(PlanePolicy::Dominant, &means).normal,
-        first,
-        second,
-        height: height_residuals,
-        id: g.id,
-    })
+    Ok((
+        SplitResiduals {
+            normal: Plane::new(PlanePolicy::Dominant, &means).normal,
+            first,
+            second,
+            height: height_residuals,
+            id: g.id,
+        },
+        placed,
+    ))
 }

@@ -6,13 +6,16 @@ mod deficits;
 mod geometry;
 mod levels;
 mod policies;
+mod positions_first;
 mod replay;
 mod transcode;
 mod wings;
 
 use splitstream_decoder_core::limits::rans::MAX_LANES;
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
-use splitstream_decoder_core::{DeficitContexts, PlanePolicy, PositionMode, Schedule, WingPolicy};
+use splitstream_decoder_core::{
+    DeficitContexts, PlanePolicy, PositionMode, RecordOrder, Schedule, WingPolicy,
+};
 
 use crate::input::{MeshError, MeshStats, check_mesh};
 use crate::mesh::Mesh;
@@ -20,7 +23,7 @@ use crate::quantize::{GridError, Lattice, Quantization, QuantizedMesh, Units, qu
 use crate::simplify::{Backend, Checked, GpuError, SimplifyOptions, simplify_on};
 use crate::spatial_order::spatially_ordered;
 pub use levels::plan_levels;
-pub use replay::{ReplayError, ReplayOptions, replay};
+pub use replay::{ReplayError, ReplayOptions, positions_first_allowed, replay};
 use std::borrow::Cow;
 pub use transcode::{TranscodeError, TranscodeOptions, Transcoded, transcode};
 
@@ -81,6 +84,11 @@ pub struct EncodeOptions {
     /// The deficit contexts of every level (SPEC §5.5.5, format 3.3);
     /// `None`: per level, the ones whose split valences take fewest bytes.
     pub deficits: Option<DeficitContexts>,
+    /// How every level reads its records (SPEC §5.1, §7.4, format 3.7);
+    /// `None`: per level, positions first where it is allowed (constrained
+    /// mode, the plane policy and the wing policy not forced to others
+    /// than `height` and `ranks`) and smaller.
+    pub records: Option<RecordOrder>,
     /// How the stream says which vertices split in which round (SPEC
     /// §3.2): by default `every-vertex` (format 3.6), the smaller.
     pub schedule: Schedule,
@@ -106,6 +114,7 @@ impl Default for EncodeOptions {
             plane: None,
             wings: None,
             deficits: None,
+            records: None,
             schedule: Schedule::EveryVertex,
         }
     }
@@ -213,9 +222,31 @@ impl EncodeOptions {
                 "--max-error {e} is not a finite error of 0 or more"
             ));
         }
+        check_records(self.records, self.position_mode, self.plane, self.wings)
+            .map_err(EncodeError::BadOption)?;
         check_coding(self.codec, self.chunk_limit, self.rans_chunk_limit)
             .map_err(EncodeError::BadOption)
     }
+}
+
+/// `--records positions-first` needs what a positions-first level
+/// declares (SPEC §5.1, 3.7): constrained mode, the plane policy `height`
+/// and the wing policy `ranks` (or neither forced).
+pub fn check_records(
+    records: Option<RecordOrder>,
+    mode: PositionMode,
+    plane: Option<PlanePolicy>,
+    wings: Option<WingPolicy>,
+) -> Result<(), String> {
+    if records == Some(RecordOrder::PositionsFirst) && !positions_first_allowed(mode, plane, wings)
+    {
+        return Err(
+            "--records positions-first needs --position constrained, --plane height or auto \
+                    and --wings ranks or auto"
+                .into(),
+        );
+    }
+    Ok(())
 }
 
 /// The coding options' own rules, shared by [`EncodeOptions::check`] and
@@ -336,6 +367,7 @@ fn encode_checked(
             plane: options.plane,
             wings: options.wings,
             deficits: options.deficits,
+            records: options.records,
             final_hash: false,
         },
     )

@@ -5,11 +5,12 @@ use splitstream_decoder_core::corner_refs;
 use splitstream_decoder_core::limits::{LEAF, NONE, substream};
 use splitstream_decoder_core::symbols::split_valence_symbol;
 use splitstream_decoder_core::writer::{
-    Chunk, FramedLevel, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, frame_level_with,
+    Chunk, FramedLevel, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, coded_len_under,
+    frame_level_with,
 };
 use splitstream_decoder_core::{
-    CornerRefs, DeficitContexts, Error, MeshState, PlanePolicy, PositionMode, RecordSource, Ring,
-    Schedule, SplitOutcome, SplitRecord, StateMemory, WingPolicy, context,
+    CornerRefs, DeficitContexts, Error, MeshState, PlanePolicy, PositionMode, RecordOrder,
+    RecordSource, Ring, Schedule, SplitOutcome, SplitRecord, StateMemory, WingPolicy, context,
 };
 
 use std::sync::mpsc;
@@ -21,7 +22,8 @@ use super::geometry::{
     GeometryBatch, GeometrySender, LevelGeometry, SplitGeometry, code_geometry, geometry_channels,
 };
 use super::levels::LevelPlan;
-use super::policies::{choose_policy, code_policies, early_choice_at};
+use super::policies::{choose_policy, code_policies, early_choice_at, ranking_params};
+use super::positions_first::PositionsFirstCoding;
 use super::wings::WingCoding;
 use crate::corner_table::Fan;
 use crate::mesh::sorted_canonical;
@@ -66,6 +68,10 @@ pub struct ReplayOptions {
     pub wings: Option<WingPolicy>,
     /// The deficit contexts of every level; by default each level's cheapest.
     pub deficits: Option<DeficitContexts>,
+    /// The record order of every level (format 3.7); by default each
+    /// level's cheaper where `positions-first` is allowed
+    /// ([`positions_first_allowed`]).
+    pub records: Option<RecordOrder>,
     /// Whether to hash the final state (SPEC §8; a serial pass over the
     /// whole state, about 45 ms on the 1M terrain, which `encode` does not
     /// need and `transcode` compares).
@@ -328,8 +334,14 @@ pub fn replay(
         plane,
         wings: wing_policy,
         deficits: deficit_contexts,
+        records,
         final_hash,
     } = options;
+    // Positions first is tried where the level could declare it: in
+    // constrained mode, with the plane policy `height` and the wing policy
+    // `ranks` of its escapes allowed.
+    let try_positions_first = records != Some(RecordOrder::WingsFirst)
+        && positions_first_allowed(params.position_mode, plane, wing_policy);
     let mode = params.position_mode;
     let n = mesh.positions.len();
     let t_total = mesh.triangles.len();
@@ -395,147 +407,163 @@ pub fn replay(
     // level run on another while the next level replays (same bytes: the
     // replay itself is sequential).
     let seed_ref = &seed;
-    let done = std::thread::scope(|scope| -> LevelsAndHash {
-        let mut choosing = Vec::with_capacity(plan.rounds.len());
-        let mut input_sorted = None;
-        for (l, steps) in plan.rounds.iter().enumerate() {
-            if l + 1 == plan.rounds.len() {
-                // The input's side of the exactness check needs nothing
-                // from the replay: it is sorted beside the last level,
-                // whose replay leaves the other core mostly idle once the
-                // level's policies are chosen.
-                input_sorted = Some(scope.spawn(|| sorted_canonical(&mesh.triangles, None)));
-            }
-            let mut subs = vec![SubstreamWriter::default(); 7];
-            // Under `every-vertex` no split valences are coded, and the
-            // level header says `plain` (SPEC §5.1, 3.6).
-            let mut deficit_coding = DeficitCoding::new(match params.schedule {
-                Schedule::SplitValences => deficit_contexts,
-                Schedule::EveryVertex => Some(DeficitContexts::Plain),
-            });
-            // The level's split geometry goes round by round to a thread
-            // that codes the wings and computes the residual vectors, and
-            // they on to a thread that codes them under every plane policy.
-            let (batches, coded_batches) = mpsc::channel();
-            let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
-            let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
-            let (geometry_batches, geometry_in) = geometry_channels();
-            let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
-            let wing_coding = WingCoding::new(wing_policy);
-            let geometry_coder = scope.spawn(move || {
-                code_geometry(geometry_in, batches, wing_coding, params, splits, heights)
-            });
-            let mut geometry = GeometryBatch::new();
-            let mut round_splits = Vec::with_capacity(steps.len());
-            // A large level chooses its deficit contexts after the round
-            // that completes its first eighth, as it chooses its plane and
-            // wing policies (`policies::EARLY_CHOICE_SPLITS`); the symbols
-            // after it are written in the chosen contexts only.
-            let (mut early, mut seen) = (early_choice_at(splits), 0);
-            for &k in steps {
-                let collapses = &s.steps[k];
-                flagged.clear();
-                wings.clear();
-                let dec = |enc: u32| {
-                    if enc == NONE {
-                        NONE
-                    } else {
-                        enc2dec[enc as usize]
+    let done =
+        std::thread::scope(|scope| -> LevelsAndHash {
+            let mut choosing = Vec::with_capacity(plan.rounds.len());
+            let mut input_sorted = None;
+            for (l, steps) in plan.rounds.iter().enumerate() {
+                if l + 1 == plan.rounds.len() {
+                    // The input's side of the exactness check needs nothing
+                    // from the replay: it is sorted beside the last level,
+                    // whose replay leaves the other core mostly idle once the
+                    // level's policies are chosen.
+                    input_sorted = Some(scope.spawn(|| sorted_canonical(&mesh.triangles, None)));
+                }
+                let mut subs = vec![SubstreamWriter::default(); 7];
+                // Under `every-vertex` no split valences are coded, and the
+                // level header says `plain` (SPEC §5.1, 3.6).
+                let mut deficit_coding = DeficitCoding::new(match params.schedule {
+                    Schedule::SplitValences => deficit_contexts,
+                    Schedule::EveryVertex => Some(DeficitContexts::Plain),
+                });
+                // The level's split geometry goes round by round to a thread
+                // that codes the wings and computes the residual vectors, and
+                // they on to a thread that codes them under every plane policy.
+                let (batches, coded_batches) = mpsc::channel();
+                let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
+                let coder =
+                    scope.spawn(move || code_policies(coded_batches, params, plane, splits));
+                let (geometry_batches, geometry_in) = geometry_channels();
+                let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
+                let wing_coding = WingCoding::new(wing_policy);
+                let positions_first = try_positions_first.then(PositionsFirstCoding::default);
+                let geometry_coder = scope.spawn(move || {
+                    code_geometry(
+                        geometry_in,
+                        batches,
+                        wing_coding,
+                        positions_first,
+                        params,
+                        splits,
+                        heights,
+                    )
+                });
+                let mut geometry = GeometryBatch::new();
+                let mut round_splits = Vec::with_capacity(steps.len());
+                // A large level chooses its deficit contexts after the round
+                // that completes its first eighth, as it chooses its plane and
+                // wing policies (`policies::EARLY_CHOICE_SPLITS`); the symbols
+                // after it are written in the chosen contexts only.
+                let (mut early, mut seen) = (early_choice_at(splits), 0);
+                for &k in steps {
+                    let collapses = &s.steps[k];
+                    flagged.clear();
+                    wings.clear();
+                    let dec = |enc: u32| {
+                        if enc == NONE {
+                            NONE
+                        } else {
+                            enc2dec[enc as usize]
+                        }
+                    };
+                    for (i, col) in collapses.iter().enumerate() {
+                        let r = enc2dec[col.p as usize];
+                        current[r as usize] = i as u32;
+                        flagged.push(r);
+                        wings.push([dec(col.wing_a), dec(col.wing_b)]);
                     }
-                };
-                for (i, col) in collapses.iter().enumerate() {
-                    let r = enc2dec[col.p as usize];
-                    current[r as usize] = i as u32;
-                    flagged.push(r);
-                    wings.push([dec(col.wing_a), dec(col.wing_b)]);
+                    let mut source = StepSource {
+                        collapses,
+                        wings: &wings,
+                        current: &mut current,
+                        enc2dec: &mut enc2dec,
+                        dec2enc: &mut dec2enc,
+                        subs: &mut subs,
+                        deficit_coding: &mut deficit_coding,
+                        geometry: &mut geometry,
+                        geometry_out: &geometry_batches,
+                        pending: None,
+                        swapped: false,
+                        problem: None,
+                    };
+                    let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
+                    if let Err(e) = result {
+                        let why = source.problem.take().unwrap_or_else(|| e.to_string());
+                        return Err(ReplayError(format!("step {k}: {why}")));
+                    }
+                    for &r in &flagged {
+                        current[r as usize] = NONE;
+                    }
+                    round_splits.push(collapses.len() as u32);
+                    seen += collapses.len();
+                    if early.is_some_and(|at| seen >= at) {
+                        early = None;
+                        deficit_coding.choose_early(params);
+                    }
                 }
-                let mut source = StepSource {
-                    collapses,
-                    wings: &wings,
-                    current: &mut current,
-                    enc2dec: &mut enc2dec,
-                    dec2enc: &mut dec2enc,
-                    subs: &mut subs,
-                    deficit_coding: &mut deficit_coding,
-                    geometry: &mut geometry,
-                    geometry_out: &geometry_batches,
-                    pending: None,
-                    swapped: false,
-                    problem: None,
-                };
-                let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
-                if let Err(e) = result {
-                    let why = source.problem.take().unwrap_or_else(|| e.to_string());
-                    return Err(ReplayError(format!("step {k}: {why}")));
-                }
-                for &r in &flagged {
-                    current[r as usize] = NONE;
-                }
-                round_splits.push(collapses.len() as u32);
-                seen += collapses.len();
-                if early.is_some_and(|at| seen >= at) {
-                    early = None;
-                    deficit_coding.choose_early(params);
-                }
+                let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
+                let geometric_error = plan.errors[l];
+                geometry_batches.send(&mut geometry);
+                drop(geometry_batches);
+                choosing.push(scope.spawn(move || {
+                    let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
+                    let LevelGeometry {
+                        wings: wing_coding,
+                        placement,
+                        positions_first,
+                    } = geometry_coder
+                        .join()
+                        .expect("coding the split geometry does not panic")
+                        .map_err(level_error)?;
+                    if mode == PositionMode::Constrained {
+                        subs[slot(substream::PLACEMENT)] = placement;
+                    }
+                    let residuals = coder
+                        .join()
+                        .expect("coding residuals does not panic")
+                        .map_err(level_error)?;
+                    let plane = choose_policy(&mut subs, residuals, params, plane)
+                        .map_err(|why| level_error(why.to_string()))?;
+                    let wings = wing_coding.choose(&mut subs, params);
+                    let deficits = deficit_coding.choose(&mut subs, params);
+                    let (plane, wings, records) =
+                        choose_record_order(&mut subs, positions_first, params, records)
+                            .unwrap_or((plane, wings, RecordOrder::WingsFirst));
+                    let level = LevelPayload {
+                        round_splits,
+                        plane,
+                        wings,
+                        deficits,
+                        records,
+                        substreams: subs,
+                        vertex_count,
+                        triangle_count,
+                        geometric_error,
+                    };
+                    // The level's chunks are coded in parallel (same bytes).
+                    let parallel = |n: usize, job: &(dyn Fn(usize) -> Chunk + Sync)| {
+                        (0..n).into_par_iter().map(job).collect()
+                    };
+                    let framed =
+                        frame_level_with(&level, (l == 0).then_some(seed_ref), params, &parallel);
+                    Ok((level, framed))
+                }));
             }
-            let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
-            let geometric_error = plan.errors[l];
-            geometry_batches.send(&mut geometry);
-            drop(geometry_batches);
-            choosing.push(scope.spawn(move || {
-                let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
-                let LevelGeometry {
-                    wings: wing_coding,
-                    placement,
-                } = geometry_coder
-                    .join()
-                    .expect("coding the split geometry does not panic")
-                    .map_err(level_error)?;
-                if mode == PositionMode::Constrained {
-                    subs[slot(substream::PLACEMENT)] = placement;
-                }
-                let residuals = coder
-                    .join()
-                    .expect("coding residuals does not panic")
-                    .map_err(level_error)?;
-                let plane = choose_policy(&mut subs, residuals, params, plane)
-                    .map_err(|why| level_error(why.to_string()))?;
-                let wings = wing_coding.choose(&mut subs, params);
-                let deficits = deficit_coding.choose(&mut subs, params);
-                let level = LevelPayload {
-                    round_splits,
-                    plane,
-                    wings,
-                    deficits,
-                    substreams: subs,
-                    vertex_count,
-                    triangle_count,
-                    geometric_error,
-                };
-                // The level's chunks are coded in parallel (same bytes).
-                let parallel = |n: usize, job: &(dyn Fn(usize) -> Chunk + Sync)| {
-                    (0..n).into_par_iter().map(job).collect()
-                };
-                let framed =
-                    frame_level_with(&level, (l == 0).then_some(seed_ref), params, &parallel);
-                Ok((level, framed))
-            }));
-        }
-        // The replay is over: check it (and hash it, if asked) while the last levels
-        // are still being chosen and framed.
-        let input_sorted =
-            input_sorted.map(|h| h.join().expect("sorting triangles does not panic"));
-        let (checked, hash) = rayon::join(
-            || check_exact(mesh, &state, &dec2enc, input_sorted),
-            || final_hash.then(|| state.state_hash()),
-        );
-        let checked = checked.map(|()| hash);
-        let levels = choosing
-            .into_iter()
-            .map(|h| h.join().expect("choosing a plane policy does not panic"))
-            .collect::<Result<Vec<_>, _>>()?;
-        Ok((levels, checked?))
-    })?;
+            // The replay is over: check it (and hash it, if asked) while the last levels
+            // are still being chosen and framed.
+            let input_sorted =
+                input_sorted.map(|h| h.join().expect("sorting triangles does not panic"));
+            let (checked, hash) = rayon::join(
+                || check_exact(mesh, &state, &dec2enc, input_sorted),
+                || final_hash.then(|| state.state_hash()),
+            );
+            let checked = checked.map(|()| hash);
+            let levels = choosing
+                .into_iter()
+                .map(|h| h.join().expect("choosing a plane policy does not panic"))
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok((levels, checked?))
+        })?;
     let (done, final_hash) = done;
     let (levels, framed) = done.into_iter().unzip();
     Ok(Replayed {
@@ -545,6 +573,62 @@ pub fn replay(
         permutation: dec2enc,
         final_hash,
     })
+}
+
+/// Whether a level may read its records positions first (SPEC §5.1, 3.7):
+/// constrained mode, and neither a plane policy other than `height` nor a
+/// wing policy other than `ranks` (its escapes') forced.
+pub fn positions_first_allowed(
+    mode: PositionMode,
+    plane: Option<PlanePolicy>,
+    wings: Option<WingPolicy>,
+) -> bool {
+    mode == PositionMode::Constrained
+        && plane.is_none_or(|p| p == PlanePolicy::Height)
+        && wings.is_none_or(|w| w == WingPolicy::Ranks)
+}
+
+/// The positions-first records of a level when they are forced, or when
+/// their four substreams code smaller than the wings-first ones already in
+/// `subs`: they replace those, and the level's plane and wing policies and
+/// record order are returned. `None` keeps the wings-first records.
+fn choose_record_order(
+    subs: &mut [SubstreamWriter],
+    positions_first: Option<PositionsFirstCoding>,
+    params: &StreamParams,
+    forced: Option<RecordOrder>,
+) -> Option<(PlanePolicy, WingPolicy, RecordOrder)> {
+    let pf = positions_first?;
+    if forced != Some(RecordOrder::PositionsFirst) {
+        let ranking = ranking_params(params);
+        let wings_first: usize = [
+            substream::WING_OFFSET,
+            substream::WING_DISTANCE,
+            substream::EDGE,
+            substream::PLACEMENT,
+        ]
+        .into_iter()
+        .map(|id| {
+            let sub = &subs[slot(id)];
+            coded_len_under(
+                sub,
+                id,
+                DeficitContexts::Plain,
+                RecordOrder::WingsFirst,
+                &ranking,
+            )
+        })
+        .sum();
+        if pf.cost(params) >= wings_first {
+            return None;
+        }
+    }
+    pf.install(subs);
+    Some((
+        PlanePolicy::Height,
+        WingPolicy::Ranks,
+        RecordOrder::PositionsFirst,
+    ))
 }
 
 /// decode(encode(M)) == M: the refined state, mapped back to input ids, has

@@ -16,12 +16,13 @@ use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, assemble_stream};
 use splitstream_decoder_core::{
-    DeficitContexts, MeshState, PlanePolicy, Ring, Schedule, SplitObserver, SplitRecord, WingPolicy,
+    DeficitContexts, MeshState, PlanePolicy, RecordOrder, Ring, Schedule, SplitObserver,
+    SplitRecord, WingPolicy,
 };
 
-use super::check_coding;
 use super::levels::LevelPlan;
 use super::replay::{ReplayError, ReplayOptions, replay};
+use super::{check_coding, check_records};
 use crate::corner_table::{CornerTable, Fan};
 use crate::quantize::QuantizedMesh;
 use crate::simplify::{Collapse, NO_SPLIT, Simplification};
@@ -42,6 +43,9 @@ pub struct TranscodeOptions {
     pub wings: Option<WingPolicy>,
     /// The deficit contexts of every level; `None`: chosen per level by size.
     pub deficits: Option<DeficitContexts>,
+    /// The record order of every level (format 3.7); `None`: chosen per
+    /// level by size where positions first is allowed.
+    pub records: Option<RecordOrder>,
     /// The schedule of the stream written (SPEC §3.2), whatever the
     /// input's.
     pub schedule: Schedule,
@@ -59,6 +63,7 @@ impl Default for TranscodeOptions {
             plane: None,
             wings: None,
             deficits: None,
+            records: None,
             schedule: Schedule::EveryVertex,
         }
     }
@@ -108,6 +113,13 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
     check_coding(options.codec, options.chunk_limit, options.rans_chunk_limit)
         .map_err(TranscodeError::BadOption)?;
     let mut refinement = Refinement::decode(stream)?;
+    check_records(
+        options.records,
+        refinement.position_mode,
+        options.plane,
+        options.wings,
+    )
+    .map_err(TranscodeError::BadOption)?;
     let params = StreamParams {
         position_mode: refinement.position_mode,
         bits: refinement.mesh.bits,
@@ -128,6 +140,7 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
             plane: options.plane,
             wings: options.wings,
             deficits: options.deficits,
+            records: options.records,
             final_hash: true,
         },
     )

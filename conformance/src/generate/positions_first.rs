@@ -1,0 +1,187 @@
+//! Vectors of the record order `positions-first` (SPEC §5.1, §7.4,
+//! format 3.7): terrains whose records read the new vertex first, with
+//! and without boundaries, under both schedules and codecs, a stream whose
+//! fans all escape, and the faults a decoder must find in them.
+
+use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_decoder_core::{DeficitContexts, PositionMode, RecordOrder, Schedule};
+use splitstream_encoder::Mesh;
+use splitstream_encoder::emit::EncodeOptions;
+
+use super::meshes;
+use super::mutate::*;
+use super::{Specs, encoded, opts};
+use crate::builtin;
+use crate::protocol::Verdict;
+
+/// [`opts`] in constrained mode with every level read positions first.
+fn positions_first(options: EncodeOptions) -> EncodeOptions {
+    EncodeOptions {
+        position_mode: PositionMode::Constrained,
+        records: Some(RecordOrder::PositionsFirst),
+        ..options
+    }
+}
+
+fn terrain() -> Mesh {
+    meshes::checked(
+        splitstream_encoder::input::fractal_terrain(33, 7),
+        "terrain",
+    )
+}
+
+/// The deflate stream the record faults are made in.
+fn deflated_terrain() -> Vec<u8> {
+    encoded(
+        &terrain(),
+        positions_first(EncodeOptions {
+            codec: ChunkCodec::Deflate(9),
+            schedule: Schedule::EveryVertex,
+            ..opts()
+        }),
+    )
+}
+
+pub(super) fn positions_first_valid(s: &mut Specs) {
+    s.valid(
+        "positions-first-terrain-rans",
+        "33x33 fractal terrain, constrained positions on the raster's lattice, the schedule every-vertex, every level read positions first (3.7): the new vertex as a rank among its fan's free lattice points, the wings among the pairs that keep the new triangles counter-clockwise, z from the fan's surface; every substream rANS-coded.",
+        &["encoded", "terrain", "rans", "positions-first"],
+        encoded(
+            &terrain(),
+            positions_first(EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 4 },
+                schedule: Schedule::EveryVertex,
+                ..opts()
+            }),
+        ),
+    );
+    s.valid(
+        "positions-first-terrain-split-valences-deflate",
+        "33x33 fractal terrain read positions first (3.7) under the schedule split-valences (the split valences of P and C read after the wings, in the contexts `valence`), deflate: the lattice ranks as varints.",
+        &["encoded", "terrain", "deflate", "positions-first", "split-valences"],
+        encoded(
+            &terrain(),
+            positions_first(EncodeOptions {
+                codec: ChunkCodec::Deflate(9),
+                deficits: Some(DeficitContexts::Valence),
+                ..opts()
+            }),
+        ),
+    );
+    s.valid(
+        "positions-first-grid-hole",
+        "Height field with an outer boundary and a rectangular hole read positions first (3.7): boundary fans (the ghost among the wings, open sides with no lattice point), rANS.",
+        &["encoded", "boundary", "ghost-wing", "rans", "positions-first"],
+        encoded(
+            &meshes::checked(
+                meshes::grid(24, 20, 1, Some([8, 15, 6, 12])),
+                "grid with hole",
+            ),
+            positions_first(EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 4 },
+                schedule: Schedule::EveryVertex,
+                ..opts()
+            }),
+        ),
+    );
+    s.valid(
+        "positions-first-stepped-terrain",
+        "40x40 height field of whole-unit heights 0..3 read positions first (3.7): many free points at equal distances from the ring's centroid (ties by y, then x) and cocircular wings (ties by ring position).",
+        &["encoded", "terrain", "rans", "positions-first", "ties"],
+        encoded(
+            &meshes::checked(meshes::stepped_grid(40, 40, 1), "stepped grid"),
+            positions_first(EncodeOptions {
+                codec: ChunkCodec::RansAlways { lanes: 4 },
+                schedule: Schedule::EveryVertex,
+                ..opts()
+            }),
+        ),
+    );
+    s.valid(
+        "positions-first-all-escapes",
+        "33x33 fractal terrain at 20 bits per axis, its x and y not kept on the raster's lattice: every fan's bounding box holds more than 1,024 lattice points, so every record of the positions-first levels is read wings first (an escape without a kind, SPEC §7.4).",
+        &["encoded", "terrain", "rans", "positions-first", "escape"],
+        encoded(
+            &terrain(),
+            positions_first(EncodeOptions {
+                bits: 20,
+                codec: ChunkCodec::RansAlways { lanes: 4 },
+                schedule: Schedule::EveryVertex,
+                ..opts()
+            }),
+        ),
+    );
+}
+
+/// The first stream made from `subject` by `mutate` on one of its levels
+/// from level 1 on that fails with `class` (a record fault needs a level
+/// whose first record is read positions first).
+fn first_failing(
+    subject: &[u8],
+    class: &str,
+    mutate: impl Fn(&mut Vec<Vec<u8>>) -> Option<()>,
+) -> Vec<u8> {
+    let parts = unframe(subject);
+    (1..parts.levels.len())
+        .find_map(|k| {
+            let mut p = parts.clone();
+            mutate(&mut p.levels[k].substreams)?;
+            let bytes = reframe(&p);
+            (builtin::decoder_core(&bytes).verdict == Verdict::Error(class.into())).then_some(bytes)
+        })
+        .unwrap_or_else(|| panic!("no level gives {class}"))
+}
+
+pub(super) fn positions_first_invalid(s: &mut Specs) {
+    let subject = deflated_terrain();
+    let record_at = |k: u16| plane_policy_at(&subject, k) + 3;
+    assert_eq!(subject[record_at(1)], 1, "level 1 is read positions first");
+    s.invalid(
+        "record-order-2",
+        "malformed",
+        "Level 1's record order (level header byte 11) is 2, a reserved value (level header CRC recomputed).",
+        &["positions-first", "level-header"],
+        with_level_header_byte(&subject, 1, record_at(1), 2),
+    );
+    s.invalid(
+        "positions-first-plane-off",
+        "malformed",
+        "Level 1 is read positions first under the plane policy off: positions-first needs the plane policy height (level header CRC recomputed).",
+        &["positions-first", "level-header", "plane-policy"],
+        with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1), 0),
+    );
+    s.invalid(
+        "positions-first-kind-3",
+        "malformed",
+        "A positions-first level whose first placement value is 3: a kind above 2 (SPEC §7.4).",
+        &["positions-first", "records"],
+        first_failing(&subject, "malformed", |subs| {
+            *subs[6].first_mut()? = 3;
+            Some(())
+        }),
+    );
+    s.invalid(
+        "positions-first-rank-past-free-points",
+        "position-out-of-range",
+        "A positions-first level whose first lattice rank is 255: a fan has at most 255 free points (SPEC §7.4).",
+        &["positions-first", "records"],
+        first_failing(&subject, "position-out-of-range", |subs| {
+            let edge = &mut subs[5];
+            // The first value is a one-byte varint; 255 takes two.
+            (*edge.first()? < 0x80).then_some(())?;
+            edge.splice(0..1, [0xFF, 0x01]);
+            Some(())
+        }),
+    );
+    s.invalid(
+        "positions-first-wing-past-choices",
+        "ring-offset-out-of-range",
+        "A positions-first level whose first wing rank u is 200: more than the pairs that keep the new triangles counter-clockwise (SPEC §7.4).",
+        &["positions-first", "records", "ring-offset"],
+        first_failing(&subject, "ring-offset-out-of-range", |subs| {
+            *subs[1].first_mut()? = 200;
+            Some(())
+        }),
+    );
+}

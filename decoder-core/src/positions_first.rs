@@ -1,0 +1,761 @@
+//! Records read positions first (SPEC §7.4 "Positions first", format 3.7).
+//!
+//! On a terrain whose x and y lie on a lattice, a split vertex's fan is, in
+//! the xy projection, a star of triangles with no other vertex inside, and
+//! the split's new vertex lies on a free lattice point in it. A record of a
+//! level whose record order is `positions-first` names that point by its
+//! rank among the fan's free points (nearest first to the ring's centroid),
+//! then the wings by their ranks among the pairs of ring entries that keep
+//! every new triangle counter-clockwise in xy, widest angle first. The
+//! decoder and the encoder share this module, so both sides count the same
+//! points and pairs.
+//!
+//! Every quantity is relative to R in x and y, and the cap on the fan's
+//! bounding box (1,024 lattice points) keeps coordinates below 2^10, so
+//! 64-bit arithmetic is exact throughout (SPEC §7.4 "Bounds").
+
+use crate::limits::{MAX_SPLIT_VALENCE, NONE};
+use crate::ring::Ring;
+use crate::symbols::WingCandidates;
+
+/// How a level's split records are read (SPEC §5.1, level header byte 11,
+/// format 3.7).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum RecordOrder {
+    /// Formats 3.0 to 3.6: the wings, the split valences, then the
+    /// placement code and the residual vector.
+    #[default]
+    WingsFirst,
+    /// 3.7, constrained mode under the plane policy `height` only: the new
+    /// vertex as a lattice rank, then the wings among the pairs that keep
+    /// the new triangles counter-clockwise in xy; an escape reads the
+    /// record as `WingsFirst` does.
+    PositionsFirst,
+}
+
+impl RecordOrder {
+    /// Every choice, in byte order.
+    pub const ALL: [RecordOrder; 2] = [RecordOrder::WingsFirst, RecordOrder::PositionsFirst];
+
+    pub fn from_byte(b: u8) -> Option<RecordOrder> {
+        RecordOrder::ALL.get(b as usize).copied()
+    }
+
+    pub fn to_byte(self) -> u8 {
+        self as u8
+    }
+
+    /// The name `splitstream info` and the SPEC use.
+    pub fn name(self) -> &'static str {
+        match self {
+            RecordOrder::WingsFirst => "wings-first",
+            RecordOrder::PositionsFirst => "positions-first",
+        }
+    }
+}
+
+/// Most lattice points a fan's bounding box may hold (SPEC §7.4
+/// `free_points`): past it the record is an escape.
+pub const POINT_CAP: i64 = 1024;
+/// Most free points a fan may have: past it the record is an escape.
+pub const LIST_CAP: usize = 255;
+
+/// The placement substream's context of the kind (SPEC §5.5.5).
+pub const KIND_CONTEXT: u8 = 5;
+/// The placement substream's context of a midpoint's offset.
+pub const OFFSET_CONTEXT: u8 = 6;
+/// The edge substream's context of the z residual.
+pub const Z_CONTEXT: u8 = 2;
+/// The kind that escapes to the wings-first record.
+pub const KIND_ESCAPE: u8 = 2;
+
+/// The edge substream's context of the lattice rank, by the number of free
+/// points `f` (SPEC §5.5.5): 1, 2, 3–4, 5–8, 9 or more.
+#[inline]
+pub fn rank_context(f: usize) -> u8 {
+    3 + match f {
+        0 | 1 => 0,
+        2 => 1,
+        3..=4 => 2,
+        5..=8 => 3,
+        _ => 4,
+    }
+}
+
+/// The wing substreams' context of a rank among `choices` choices.
+#[inline]
+pub fn choice_context(choices: usize) -> u8 {
+    (choices.clamp(1, 8) - 1) as u8
+}
+
+/// `orient(a, b, c)` of SPEC §7.4: twice the signed area of `a b c` in xy.
+#[inline]
+fn orient(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> i64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// `incircle(a, b, c, p)` of SPEC §7.4: positive when `p` lies inside the
+/// circle through `a`, `b`, `c` (counter-clockwise).
+#[inline]
+fn incircle(a: [i64; 2], b: [i64; 2], c: [i64; 2], p: [i64; 2]) -> i64 {
+    let row = |v: [i64; 2]| {
+        let (dx, dy) = (v[0] - p[0], v[1] - p[1]);
+        (dx, dy, dx * dx + dy * dy)
+    };
+    let (ax, ay, al) = row(a);
+    let (bx, by, bl) = row(b);
+    let (cx, cy, cl) = row(c);
+    ax * (by * cl - bl * cy) - ay * (bx * cl - bl * cx) + al * (bx * cy - by * cx)
+}
+
+/// A split's fan in xy, its free lattice points and its wing pairs: the
+/// scratch a record read positions first needs, kept between records so
+/// that nothing is cleared per split but what it uses.
+#[derive(Clone)]
+pub struct PositionsFirst {
+    /// Ring length.
+    k: usize,
+    /// Entries relative to R in xy; `real[i]` is false for the ghost.
+    q: [[i32; 2]; MAX_SPLIT_VALENCE],
+    real: [bool; MAX_SPLIT_VALENCE],
+    /// The bounding box's low corner and width.
+    x0: i64,
+    y0: i64,
+    width: i64,
+    /// Free points as packed keys (`key`), unordered, `keys[..free]`.
+    keys: [u64; LIST_CAP],
+    free: usize,
+    /// The points of the bounding box inside a wedge, by `(y − y0) width +
+    /// (x − x0)`.
+    inside: [u64; POINT_CAP as usize / 64],
+    /// The wing choices being named (`xs` or `ys` of SPEC §7.4), the edge
+    /// `(a, b)` their order goes by, and whether they are in that order.
+    choices: [u8; MAX_SPLIT_VALENCE],
+    list_edge: [[i64; 2]; 2],
+    sorted: bool,
+    /// Per ring entry, for the current new edge ([`Self::prepare`]):
+    /// whether it may be wing x, wing y; whether its wedge keeps its
+    /// orientation under a, under b; how many wedges from it on do under b.
+    x_ok: [bool; MAX_SPLIT_VALENCE],
+    y_ok: [bool; MAX_SPLIT_VALENCE],
+    a_ok: [bool; MAX_SPLIT_VALENCE],
+    b_ok: [bool; MAX_SPLIT_VALENCE],
+    run_b: [u8; MAX_SPLIT_VALENCE],
+}
+
+impl Default for PositionsFirst {
+    fn default() -> Self {
+        PositionsFirst {
+            k: 0,
+            q: [[0; 2]; MAX_SPLIT_VALENCE],
+            real: [false; MAX_SPLIT_VALENCE],
+            x0: 0,
+            y0: 0,
+            width: 1,
+            keys: [0; LIST_CAP],
+            free: 0,
+            inside: [0; POINT_CAP as usize / 64],
+            choices: [0; MAX_SPLIT_VALENCE],
+            list_edge: [[0; 2]; 2],
+            sorted: false,
+            x_ok: [false; MAX_SPLIT_VALENCE],
+            y_ok: [false; MAX_SPLIT_VALENCE],
+            a_ok: [false; MAX_SPLIT_VALENCE],
+            b_ok: [false; MAX_SPLIT_VALENCE],
+            run_b: [0; MAX_SPLIT_VALENCE],
+        }
+    }
+}
+
+/// The new edge of a record read positions first, relative to R in xy:
+/// `a` owns the ring's arc from wing x to wing y, `b` the rest.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NewEdge {
+    pub a: [i64; 2],
+    pub b: [i64; 2],
+    /// Kind 1 (R sat on the floor midpoint): then x < y.
+    pub midpoint: bool,
+}
+
+impl PositionsFirst {
+    /// `free_points` of SPEC §7.4 for the split of the vertex at `parent`
+    /// whose ring is `ring` (entries index `positions`): the number of free
+    /// lattice points, or `None` for an escape (the bounding box holds more
+    /// than [`POINT_CAP`] points, no wedge has an area, or no point or more
+    /// than [`LIST_CAP`] points are free).
+    pub fn free_points(
+        &mut self,
+        positions: &[[u32; 3]],
+        parent: [u32; 3],
+        ring: &Ring,
+    ) -> Option<usize> {
+        let vertices = ring.vertices();
+        let k = vertices.len();
+        self.k = k;
+        let (rx, ry) = (parent[0] as i64, parent[1] as i64);
+        let (mut x0, mut x1, mut y0, mut y1) = (0i64, 0i64, 0i64, 0i64);
+        let (mut n, mut sx, mut sy) = (0i64, 0i64, 0i64);
+        for (i, &v) in vertices.iter().enumerate() {
+            let p = if v == NONE {
+                None
+            } else {
+                positions.get(v as usize)
+            };
+            match p {
+                Some(p) => {
+                    let q = [p[0] as i64 - rx, p[1] as i64 - ry];
+                    x0 = x0.min(q[0]);
+                    x1 = x1.max(q[0]);
+                    y0 = y0.min(q[1]);
+                    y1 = y1.max(q[1]);
+                    n += 1;
+                    sx += q[0];
+                    sy += q[1];
+                    // |q| < 2^31: positions are below 2^31.
+                    self.q[i] = [q[0] as i32, q[1] as i32];
+                    self.real[i] = true;
+                }
+                None => {
+                    self.q[i] = [0, 0];
+                    self.real[i] = false;
+                }
+            }
+        }
+        let (width, height) = (x1 - x0 + 1, y1 - y0 + 1);
+        if width * height > POINT_CAP {
+            return None;
+        }
+        (self.x0, self.y0, self.width) = (x0, y0, width);
+        let words = ((width * height) as usize).div_ceil(64);
+        self.inside[..words].fill(0);
+        let mut any_wedge = false;
+        for i in 0..k {
+            let j = if i + 1 == k { 0 } else { i + 1 };
+            if !(self.real[i] && self.real[j]) {
+                continue;
+            }
+            let (a, b) = (self.q(i), self.q(j));
+            if orient([0, 0], a, b) == 0 {
+                continue;
+            }
+            any_wedge = true;
+            self.mark_triangle(a, b);
+        }
+        if !any_wedge {
+            return None;
+        }
+        // R and the ring entries are not free.
+        self.unmark([0, 0]);
+        for i in 0..k {
+            if self.real[i] {
+                self.unmark(self.q(i));
+            }
+        }
+        let mut free = 0;
+        // The row of the current bit, followed as the bits come in
+        // ascending order (no division per point).
+        let (mut dy, mut row_start) = (0i64, 0i64);
+        for w in 0..words {
+            let mut word = self.inside[w];
+            while word != 0 {
+                let index = 64 * w as i64 + word.trailing_zeros() as i64;
+                word &= word - 1;
+                if free == LIST_CAP {
+                    return None;
+                }
+                while index >= row_start + width {
+                    row_start += width;
+                    dy += 1;
+                }
+                let dx = index - row_start;
+                let (x, y) = (x0 + dx, y0 + dy);
+                let (ex, ey) = (n * x - sx, n * y - sy);
+                let distance = (ex * ex + ey * ey) as u64;
+                self.keys[free] = distance << 20 | (dy as u64) << 10 | dx as u64;
+                free += 1;
+            }
+        }
+        self.free = free;
+        (free > 0).then_some(free)
+    }
+
+    /// Ring entry `i` relative to R in xy.
+    #[inline]
+    fn q(&self, i: usize) -> [i64; 2] {
+        [self.q[i][0] as i64, self.q[i][1] as i64]
+    }
+
+    /// Marks the bounding box's points in the closed triangle `(0, a, b)`
+    /// (`inside` of SPEC §7.4, either orientation; the triangle has an
+    /// area). Each of the three orientations is linear in the point, so a
+    /// row steps them by a constant; with their signs turned so that the
+    /// triangle is counter-clockwise, a point is inside when none is
+    /// negative (the three sum to twice the area, so they cannot all be
+    /// negative or zero as for a clockwise triangle).
+    fn mark_triangle(&mut self, a: [i64; 2], b: [i64; 2]) {
+        let sign = if orient([0, 0], a, b) > 0 { 1 } else { -1 };
+        // orient(u, v, p) = step_x · p_x + step_y · p_y + at_origin.
+        let edge = |u: [i64; 2], v: [i64; 2]| {
+            let (dx, dy) = (v[0] - u[0], v[1] - u[1]);
+            (-dy * sign, dx * sign, (dy * u[0] - dx * u[1]) * sign)
+        };
+        let edges = [edge([0, 0], a), edge(a, b), edge(b, [0, 0])];
+        let (lx, hx) = (a[0].min(b[0]).min(0), a[0].max(b[0]).max(0));
+        let (ly, hy) = (a[1].min(b[1]).min(0), a[1].max(b[1]).max(0));
+        for y in ly..=hy {
+            let mut f = edges.map(|(sx, sy, c)| sx * lx + sy * y + c);
+            let row = (y - self.y0) * self.width - self.x0;
+            for x in lx..=hx {
+                // Inside when no orientation is negative: no sign bit in
+                // their OR (branch-free: the test is not predictable).
+                let inside = ((f[0] | f[1] | f[2]) >= 0) as u64;
+                let index = (row + x) as usize;
+                self.inside[index / 64] |= inside << (index % 64);
+                for (f, e) in f.iter_mut().zip(&edges) {
+                    *f += e.0;
+                }
+            }
+        }
+    }
+
+    fn unmark(&mut self, p: [i64; 2]) {
+        let index = ((p[1] - self.y0) * self.width + (p[0] - self.x0)) as usize;
+        self.inside[index / 64] &= !(1 << (index % 64));
+    }
+
+    /// The point of a packed key, relative to R.
+    fn point_of(&self, key: u64) -> [i64; 2] {
+        [
+            self.x0 + (key & 1023) as i64,
+            self.y0 + (key >> 10 & 1023) as i64,
+        ]
+    }
+
+    /// `F[j]` of the last [`Self::free_points`], relative to R; `None` when
+    /// `j` is not below the number of free points.
+    pub fn point_at(&mut self, j: usize) -> Option<[i64; 2]> {
+        if j >= self.free {
+            return None;
+        }
+        let keys = &mut self.keys[..self.free];
+        // The nearest point is the most common rank by far.
+        let key = if j == 0 {
+            keys.iter().copied().min()?
+        } else {
+            select_nth(keys, j)
+        };
+        Some(self.point_of(key))
+    }
+
+    /// The rank of point `p` (relative to R) among the last free points
+    /// (encoder): `None` when `p` is not free.
+    pub fn rank_of(&self, p: [i64; 2]) -> Option<usize> {
+        let keys = &self.keys[..self.free];
+        let key = keys.iter().copied().find(|&key| self.point_of(key) == p)?;
+        Some(keys.iter().filter(|&&other| other < key).count())
+    }
+
+    /// Prepares the tests of SPEC §7.4 `pair` for the new edge `e`: which
+    /// entries may be wing x and wing y, which wedges keep their
+    /// orientation under `a`, and how many wedges from each one on keep it
+    /// under `b`. `O(k)` orientation tests, so that a pair then costs a few
+    /// comparisons.
+    fn prepare(&mut self, eligible: &WingCandidates, e: &NewEdge) {
+        let k = self.k;
+        for i in 0..k {
+            let (real, q) = (self.real[i], self.q(i));
+            let j = if i + 1 == k { 0 } else { i + 1 };
+            // A wedge touching the ghost is virtual: it always keeps it.
+            let virtual_wedge = !(real && self.real[j]);
+            let eligible = eligible.contains(i);
+            self.x_ok[i] = eligible && (!real || orient(e.a, e.b, q) > 0);
+            self.y_ok[i] = eligible && (!real || orient(e.b, e.a, q) > 0);
+            let next = self.q(j);
+            self.a_ok[i] = virtual_wedge || orient(e.a, q, next) > 0;
+            self.b_ok[i] = virtual_wedge || orient(e.b, q, next) > 0;
+        }
+        // run_b[t]: how many wedges from t on keep their orientation under
+        // b, capped at k: backwards twice around the ring.
+        let mut run = 0usize;
+        for i in (0..2 * k).rev() {
+            let t = i % k;
+            run = if self.b_ok[t] { (run + 1).min(k) } else { 0 };
+            self.run_b[t] = run as u8;
+        }
+    }
+
+    /// The wings y that pair with `x` (SPEC §7.4 `pair`) after
+    /// [`Self::prepare`], in ring order from x, into `self.choices`
+    /// (none when `any` asks only whether there is one); returns their
+    /// number, or 1 for `any` when there is one.
+    fn ys_of(&mut self, midpoint: bool, x: usize, any: bool) -> usize {
+        let k = self.k;
+        if !self.x_ok[x] {
+            return 0;
+        }
+        let mut count = 0;
+        // A's arc, wedges x .. y − 1, grows wedge by wedge; once a wedge
+        // fails under a, every longer arc fails too.
+        let mut y = x;
+        for _ in 1..k {
+            if !self.a_ok[y] {
+                break;
+            }
+            y = if y + 1 == k { 0 } else { y + 1 };
+            if midpoint && y < x {
+                break;
+            }
+            // B's arc: wedges y .. x − 1, (x − y) mod k of them.
+            let b_arc = if x > y { x - y } else { x + k - y };
+            if self.y_ok[y] && self.run_b[y] as usize >= b_arc {
+                if any {
+                    return 1;
+                }
+                self.choices[count] = y as u8;
+                count += 1;
+            }
+        }
+        count
+    }
+
+    /// Whether choice `u` comes before choice `w` (`before(a, b)` of SPEC
+    /// §7.4, with the current list's edge): the ghost last, real entries
+    /// widest angle on the segment `a b` first, then by ring position.
+    #[inline]
+    fn before(&self, u: usize, w: usize) -> bool {
+        match (self.real[u], self.real[w]) {
+            (true, false) => true,
+            (false, true) => false,
+            (false, false) => u < w,
+            (true, true) => {
+                let [a, b] = self.list_edge;
+                // > 0: u sees a b under a wider angle than w.
+                let wider = incircle(a, b, self.q(w), self.q(u));
+                wider > 0 || (wider == 0 && u < w)
+            }
+        }
+    }
+
+    /// Collects the choices of wing x for the new edge `e` (SPEC §7.4
+    /// `xs`, in ring order) and returns their number; [`Self::choice`]
+    /// then names them in their order.
+    pub fn order_xs(&mut self, eligible: &WingCandidates, e: &NewEdge) -> usize {
+        self.prepare(eligible, e);
+        let mut n = 0;
+        for x in 0..self.k {
+            if self.ys_of(e.midpoint, x, true) > 0 {
+                self.choices[n] = x as u8;
+                n += 1;
+            }
+        }
+        self.list_edge = [e.a, e.b];
+        self.sorted = false;
+        n
+    }
+
+    /// Collects the choices of wing y that pair with `x` (SPEC §7.4 `ys`),
+    /// after [`Self::order_xs`] for the same edge, and returns their
+    /// number.
+    pub fn order_ys(&mut self, e: &NewEdge, x: usize) -> usize {
+        let n = if x < self.k {
+            self.ys_of(e.midpoint, x, false)
+        } else {
+            0
+        };
+        self.list_edge = [e.b, e.a];
+        self.sorted = false;
+        n
+    }
+
+    /// The ring position of choice `i` (in the order of SPEC §7.4) of the
+    /// last `n` collected.
+    pub fn choice(&mut self, n: usize, i: usize) -> Option<usize> {
+        if i >= n {
+            return None;
+        }
+        if i == 0 {
+            // The first choice, by far the most common: one pass.
+            let mut best = self.choices[0] as usize;
+            for &c in &self.choices[1..n] {
+                if self.before(c as usize, best) {
+                    best = c as usize;
+                }
+            }
+            return Some(best);
+        }
+        if !self.sorted {
+            // Insertion sort: a handful of choices, and little code (core's
+            // sorts would double the decoder's size on a microcontroller).
+            for end in 1..n {
+                let mut at = end;
+                while at > 0
+                    && self.before(self.choices[at] as usize, self.choices[at - 1] as usize)
+                {
+                    self.choices.swap(at, at - 1);
+                    at -= 1;
+                }
+            }
+            self.sorted = true;
+        }
+        Some(self.choices[i] as usize)
+    }
+
+    /// The rank of ring position `entry` among the last `n` choices
+    /// collected (encoder): how many come before it.
+    pub fn rank_of_choice(&self, n: usize, entry: usize) -> Option<usize> {
+        let list = &self.choices[..n];
+        list.iter().any(|&c| c as usize == entry).then(|| {
+            list.iter()
+                .filter(|&&c| c as usize != entry && self.before(c as usize, entry))
+                .count()
+        })
+    }
+}
+
+/// The `j`-th smallest of `keys` (distinct, `j < keys.len()`), by
+/// quickselect on the middle element: `O(n)` on average, and at most
+/// [`LIST_CAP`]² steps, with little code (core's selection would add
+/// kilobytes to a microcontroller's decoder).
+fn select_nth(keys: &mut [u64], j: usize) -> u64 {
+    let (mut lo, mut hi) = (0, keys.len());
+    while hi - lo > 1 {
+        let mid = lo + (hi - lo) / 2;
+        keys.swap(mid, hi - 1);
+        let pivot = keys[hi - 1];
+        let mut store = lo;
+        for i in lo..hi - 1 {
+            if keys[i] < pivot {
+                keys.swap(i, store);
+                store += 1;
+            }
+        }
+        keys.swap(store, hi - 1);
+        match j.cmp(&store) {
+            core::cmp::Ordering::Equal => return keys[store],
+            core::cmp::Ordering::Less => hi = store,
+            core::cmp::Ordering::Greater => lo = store + 1,
+        }
+    }
+    keys[lo]
+}
+
+/// The wings' ring positions `(o, d)` and the placement code of a record
+/// read positions first whose new vertex owns the arc from `x` to `y`
+/// (SPEC §7.4): `a` owns arc 1 when `x < y`.
+#[inline]
+pub fn wings_and_code(x: usize, y: usize, midpoint: bool) -> (usize, usize, u8) {
+    let code = if midpoint {
+        2
+    } else if x < y {
+        1
+    } else {
+        0
+    };
+    if x < y {
+        (x, y - x, code)
+    } else {
+        (y, x - y, code)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A hexagon-like ring of lattice points around R at (5, 5).
+    fn hexagon() -> ([[u32; 3]; 7], Ring) {
+        let positions = [
+            [5, 5, 0],
+            [8, 5, 0],
+            [7, 8, 0],
+            [3, 8, 0],
+            [2, 5, 0],
+            [3, 2, 0],
+            [7, 2, 0],
+        ];
+        let ring = Ring::of_vertices(&[1, 2, 3, 4, 5, 6]);
+        (positions, ring)
+    }
+
+    #[test]
+    fn free_points_are_the_fans_lattice_points_nearest_the_centroid_first() {
+        let (positions, ring) = hexagon();
+        let mut pf = PositionsFirst::default();
+        let f = pf.free_points(&positions, positions[0], &ring).unwrap();
+        let mut points = [[0i64; 2]; LIST_CAP];
+        for (j, p) in points[..f].iter_mut().enumerate() {
+            *p = pf.point_at(j).unwrap();
+        }
+        // Every point inside the hexagon, but R and the entries.
+        let inside = |p: [i64; 2]| {
+            let q: [[i64; 2]; 6] = core::array::from_fn(|i| {
+                [
+                    positions[i + 1][0] as i64 - 5,
+                    positions[i + 1][1] as i64 - 5,
+                ]
+            });
+            (0..6).any(|i| {
+                let (a, b) = (q[i], q[(i + 1) % 6]);
+                let s = [orient([0, 0], a, p), orient(a, b, p), orient(b, [0, 0], p)];
+                s.iter().all(|&s| s >= 0)
+            })
+        };
+        let mut expected = 0;
+        for y in -3..=3 {
+            for x in -3..=3 {
+                let is_entry = (1..7)
+                    .any(|i| [positions[i][0] as i64 - 5, positions[i][1] as i64 - 5] == [x, y]);
+                if [x, y] != [0, 0] && !is_entry && inside([x, y]) {
+                    expected += 1;
+                    assert!(points[..f].contains(&[x, y]), "{x} {y}");
+                }
+            }
+        }
+        assert_eq!(f, expected);
+        // The centroid is (0, 0) relative to R: distances never fall.
+        let d = |p: [i64; 2]| p[0] * p[0] + p[1] * p[1];
+        for pair in points[..f].windows(2) {
+            assert!(d(pair[0]) <= d(pair[1]));
+        }
+        for (j, p) in points[..f].iter().enumerate() {
+            assert_eq!(pf.rank_of(*p), Some(j));
+        }
+    }
+
+    #[test]
+    fn a_fan_past_the_cap_escapes() {
+        let positions = [[0, 0, 0], [100, 0, 0], [0, 100, 0], [0, 0, 0]];
+        let ring = Ring::of_vertices(&[1, 2, NONE]);
+        let mut pf = PositionsFirst::default();
+        assert_eq!(pf.free_points(&positions, [50, 50, 0], &ring), None);
+    }
+
+    #[test]
+    fn wings_are_the_pairs_that_keep_the_triangles_up() {
+        let (positions, ring) = hexagon();
+        let mut pf = PositionsFirst::default();
+        pf.free_points(&positions, positions[0], &ring).unwrap();
+        let all = WingCandidates::all(6);
+        // The new vertex one step right of R: it owns the arc around entry
+        // 0 (8, 5), from entry 5 (7, 2) to entry 1 (7, 8).
+        let e = NewEdge {
+            a: [1, 0],
+            b: [0, 0],
+            midpoint: false,
+        };
+        let n = pf.order_xs(&all, &e);
+        let rank = pf.rank_of_choice(n, 5).expect("x = 5 is a choice");
+        assert_eq!(pf.choice(n, rank), Some(5));
+        let n = pf.order_ys(&e, 5);
+        let rank = pf.rank_of_choice(n, 1).expect("(5, 1) is a pair");
+        assert_eq!(pf.choice(n, rank), Some(1));
+        assert_eq!(wings_and_code(5, 1, false), (1, 4, 0));
+        // A pair that would fold a triangle is not one.
+        assert_eq!(pf.rank_of_choice(n, 3), None);
+    }
+
+    #[test]
+    fn select_nth_agrees_with_a_sort() {
+        let mut state = 12345u64;
+        for n in 1..40 {
+            let mut keys = [0u64; 40];
+            for k in keys[..n].iter_mut() {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                *k = state >> 40;
+            }
+            let mut sorted = keys;
+            sorted[..n].sort_unstable();
+            for (j, &want) in sorted[..n].iter().enumerate() {
+                let mut work = keys;
+                assert_eq!(select_nth(&mut work[..n], j), want, "{n} {j}");
+            }
+        }
+    }
+
+    #[test]
+    fn incircle_orders_by_the_angle_seen() {
+        let (a, b) = ([0, 0], [4, 0]);
+        // (2, 1) sees a b under a wider angle than (2, 3).
+        assert!(incircle(a, b, [2, 3], [2, 1]) > 0);
+        assert!(incircle(a, b, [2, 1], [2, 3]) < 0);
+        // Cocircular: (0, 4) and (4, 4) both see the segment at 45°.
+        assert_eq!(incircle(a, b, [0, 4], [4, 4]), 0);
+    }
+
+    /// A ring worked by hand and by the clean-room Python decoder
+    /// (conformance/python): the free points in order, and the wing
+    /// choices of three new edges.
+    #[test]
+    fn a_small_hexagon_gives_the_python_decoders_lists() {
+        let positions = [
+            [5, 5, 0],
+            [7, 5, 0],
+            [6, 7, 0],
+            [4, 7, 0],
+            [3, 5, 0],
+            [4, 3, 0],
+            [6, 3, 0],
+        ];
+        let ring = Ring::of_vertices(&[1, 2, 3, 4, 5, 6]);
+        let mut pf = PositionsFirst::default();
+        let f = pf.free_points(&positions, positions[0], &ring).unwrap();
+        let expected = [
+            [0, -1],
+            [-1, 0],
+            [1, 0],
+            [0, 1],
+            [-1, -1],
+            [1, -1],
+            [-1, 1],
+            [1, 1],
+            [0, -2],
+            [0, 2],
+        ];
+        assert_eq!(f, expected.len());
+        for (j, p) in expected.iter().enumerate() {
+            assert_eq!(pf.point_at(j), Some(*p), "F[{j}]");
+        }
+        assert_eq!(rank_context(f), 7);
+        let all = WingCandidates::all(6);
+        let lists = |pf: &mut PositionsFirst, e: NewEdge, x: usize| {
+            let n = pf.order_xs(&all, &e);
+            let xs: [Option<usize>; 4] = core::array::from_fn(|i| pf.choice(n, i));
+            let n = pf.order_ys(&e, x);
+            let ys: [Option<usize>; 4] = core::array::from_fn(|i| pf.choice(n, i));
+            (xs, ys)
+        };
+        let kind0 = |n: [i64; 2]| NewEdge {
+            a: n,
+            b: [0, 0],
+            midpoint: false,
+        };
+        let (xs, ys) = lists(&mut pf, kind0([0, -1]), 3);
+        assert_eq!(xs, [Some(3), Some(4), Some(2), None]);
+        assert_eq!(ys, [Some(0), Some(5), Some(1), None]);
+        let (xs, ys) = lists(&mut pf, kind0([-1, 0]), 2);
+        assert_eq!(xs, [Some(2), Some(1), None, None]);
+        assert_eq!(ys, [Some(4), Some(5), None, None]);
+        let mid = NewEdge {
+            a: [0, 1],
+            b: [0, -1],
+            midpoint: true,
+        };
+        let (xs, ys) = lists(&mut pf, mid, 0);
+        assert_eq!(xs, [Some(0), Some(1), None, None]);
+        assert_eq!(ys, [Some(3), Some(2), Some(4), None]);
+        // With the ghost: ring [⊥, (7, 5), (6, 7), (4, 7), (3, 5)].
+        let ring = Ring::of_vertices(&[NONE, 1, 2, 3, 4]);
+        let f = pf.free_points(&positions, positions[0], &ring).unwrap();
+        let expected = [[0, 1], [-1, 1], [1, 1], [0, 2], [-1, 0], [1, 0]];
+        assert_eq!(f, expected.len());
+        for (j, p) in expected.iter().enumerate() {
+            assert_eq!(pf.point_at(j), Some(*p), "F[{j}] with the ghost");
+        }
+        let all = WingCandidates::all(5);
+        let n = pf.order_xs(&all, &kind0([0, 1]));
+        let xs: [Option<usize>; 4] = core::array::from_fn(|i| pf.choice(n, i));
+        assert_eq!(xs, [Some(1), Some(2), Some(0), None]);
+    }
+}

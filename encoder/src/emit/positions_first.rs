@@ -1,0 +1,231 @@
+//! A level's records read positions first (SPEC §7.4 "Positions first",
+//! format 3.7): the geometry thread writes every split's record both ways,
+//! and the level keeps the record order whose four substreams (wing-offset,
+//! wing-distance, edge, placement) code smallest.
+//!
+//! A split is written positions first when its fan has free lattice
+//! points, its new vertex is one of them and its wings are one of the
+//! pairs that keep the new triangles counter-clockwise in xy; otherwise it
+//! is an escape, written as under `wings-first` with the wing policy
+//! `ranks` and the plane policy `height`, which a positions-first level
+//! declares.
+
+use splitstream_decoder_core::limits::substream;
+use splitstream_decoder_core::positions_first::{
+    KIND_CONTEXT, KIND_ESCAPE, NewEdge, OFFSET_CONTEXT, PositionsFirst, Z_CONTEXT, choice_context,
+    rank_context,
+};
+use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter, coded_len_under};
+use splitstream_decoder_core::{
+    DeficitContexts, RecordOrder, Ring, Target, WingCandidates, context, height_prediction,
+};
+
+use splitstream_decoder_core::predict::wrap;
+
+use super::policies::ranking_params;
+
+/// One level's records under the record order `positions-first`.
+#[derive(Clone, Default)]
+pub struct PositionsFirstCoding {
+    pf: PositionsFirst,
+    /// Substreams 2, 3, 6 and 7 (wing-offset, wing-distance, edge,
+    /// placement) of the level under this order.
+    subs: [SubstreamWriter; 4],
+    /// Splits read positions first, and escapes.
+    pub named: usize,
+    pub escaped: usize,
+}
+
+/// A split as the geometry thread sees it: its ring (local ids, positions
+/// of the entries), R, P and C, the wings and the placement code.
+pub struct SplitSeen<'a> {
+    pub positions: &'a [[u32; 3]],
+    pub ring: &'a Ring,
+    pub eligible: &'a WingCandidates,
+    pub parent: [u32; 3],
+    pub p: [u32; 3],
+    pub c: [u32; 3],
+    pub o: usize,
+    pub d: usize,
+    pub code: u8,
+}
+
+/// The escape's part of a split: what `wings-first` writes under the wing
+/// policy `ranks` and the plane policy `height`.
+pub struct WingsFirstRecord {
+    /// Wing ranks `o'`, `d'` and their context.
+    pub ranks: (u8, u8),
+    pub wing_context: u8,
+    /// Placement code's context.
+    pub placement_context: u8,
+    /// The residual vector under `height` (x, y linear, z of the surface).
+    pub vector: [i64; 3],
+}
+
+const WING_OFFSET: usize = 0;
+const WING_DISTANCE: usize = 1;
+const EDGE: usize = 2;
+const PLACEMENT: usize = 3;
+
+impl PositionsFirstCoding {
+    /// Writes the record of split `s`, positions first where it can be,
+    /// else `escape`.
+    pub fn write(&mut self, s: &SplitSeen<'_>, escape: &WingsFirstRecord) {
+        match self.name(s) {
+            Some(named) => {
+                let [offset, distance, edge, placement] = &mut self.subs;
+                placement.byte_in(KIND_CONTEXT, named.kind);
+                edge.varint_in(rank_context(named.free), named.rank as u32);
+                if let Some(t) = named.offset {
+                    placement.byte_in(OFFSET_CONTEXT, t);
+                }
+                offset.byte_in(choice_context(named.xs), named.u as u8);
+                distance.byte_in(choice_context(named.ys), named.v as u8);
+                edge.signed_in(Z_CONTEXT, named.r_z as i32);
+                self.named += 1;
+            }
+            None => {
+                if self.pf.free_points(s.positions, s.parent, s.ring).is_some() {
+                    self.subs[PLACEMENT].byte_in(KIND_CONTEXT, KIND_ESCAPE);
+                }
+                let [offset, distance, edge, placement] = &mut self.subs;
+                offset.byte_in(escape.wing_context, escape.ranks.0);
+                distance.byte_in(escape.wing_context, escape.ranks.1);
+                placement.byte_in(escape.placement_context, s.code);
+                for (axis, &r) in escape.vector.iter().enumerate() {
+                    edge.signed_in(axis as u8, r as i32);
+                }
+                self.escaped += 1;
+            }
+        }
+    }
+
+    /// The record of split `s` read positions first, or `None` for an
+    /// escape (SPEC §7.4 `read_record_pf`, backwards).
+    fn name(&mut self, s: &SplitSeen<'_>) -> Option<Named> {
+        let free = self.pf.free_points(s.positions, s.parent, s.ring)?;
+        let wide = |v: [u32; 3]| v.map(|x| x as i64);
+        let (r, p, c) = (wide(s.parent), wide(s.p), wide(s.c));
+        let rel = |v: [i64; 3]| [v[0] - r[0], v[1] - r[1]];
+        let (o, b) = (s.o, s.o + s.d);
+        // The new vertex N, the edge's ends, the offset and the pair.
+        let (n, edge, offset, pair, vector_z) = match s.code {
+            0 => {
+                let n = rel(c);
+                let e = NewEdge {
+                    a: n,
+                    b: [0, 0],
+                    midpoint: false,
+                };
+                (n, e, None, (b, o), c[2] - r[2])
+            }
+            1 => {
+                let n = rel(p);
+                let e = NewEdge {
+                    a: n,
+                    b: [0, 0],
+                    midpoint: false,
+                };
+                (n, e, None, (o, b), p[2] - r[2])
+            }
+            _ => {
+                let n = rel(c);
+                let t = [p[0] - (2 * r[0] - c[0]), p[1] - (2 * r[1] - c[1])];
+                if !(0..=1).contains(&t[0]) || !(0..=1).contains(&t[1]) {
+                    return None;
+                }
+                let e = NewEdge {
+                    a: rel(p),
+                    b: n,
+                    midpoint: true,
+                };
+                (n, e, Some((t[0] + 2 * t[1]) as u8), (o, b), c[2] - p[2])
+            }
+        };
+        let rank = self.pf.rank_of(n)?;
+        let xs = self.pf.order_xs(s.eligible, &edge);
+        let u = self.pf.rank_of_choice(xs, pair.0)?;
+        let ys = self.pf.order_ys(&edge, pair.0);
+        let v = self.pf.rank_of_choice(ys, pair.1)?;
+        // z: the fan's surface at the new x and y, or 0 where no wedge
+        // holds it.
+        let target = Target::of_code(s.code)?;
+        let xy = match offset {
+            Some(t) => [2 * n[0] - (t & 1) as i64, 2 * n[1] - (t >> 1) as i64],
+            None => n,
+        };
+        let h = height_prediction(s.positions, s.parent, s.ring, target, [xy[0], xy[1], 0])
+            .unwrap_or(0);
+        Some(Named {
+            kind: u8::from(s.code == 2),
+            free,
+            rank,
+            offset,
+            xs,
+            u,
+            ys,
+            v,
+            r_z: wrap(vector_z - h),
+        })
+    }
+
+    /// The four substreams' cost under `params`' ranking parameters, in a
+    /// positions-first level.
+    pub fn cost(&self, params: &StreamParams) -> usize {
+        let ranking = ranking_params(params);
+        IDS.iter()
+            .zip(&self.subs)
+            .map(|(&id, sub)| {
+                coded_len_under(
+                    sub,
+                    id,
+                    DeficitContexts::Plain,
+                    RecordOrder::PositionsFirst,
+                    &ranking,
+                )
+            })
+            .sum()
+    }
+
+    /// Puts the four substreams into `subs` (ids 1..=7 at 0..=6).
+    pub fn install(self, subs: &mut [SubstreamWriter]) {
+        for (id, sub) in IDS.into_iter().zip(self.subs) {
+            subs[(id - substream::FLAGS) as usize] = sub;
+        }
+    }
+}
+
+/// Substream ids of [`PositionsFirstCoding::subs`].
+const IDS: [u8; 4] = [
+    substream::WING_OFFSET,
+    substream::WING_DISTANCE,
+    substream::EDGE,
+    substream::PLACEMENT,
+];
+
+const _: () = assert!(
+    IDS[WING_OFFSET] == substream::WING_OFFSET
+        && IDS[WING_DISTANCE] == substream::WING_DISTANCE
+        && IDS[EDGE] == substream::EDGE
+        && IDS[PLACEMENT] == substream::PLACEMENT
+);
+
+/// A record read positions first: its values and the counts their
+/// contexts come from.
+struct Named {
+    kind: u8,
+    free: usize,
+    rank: usize,
+    offset: Option<u8>,
+    xs: usize,
+    u: usize,
+    ys: usize,
+    v: usize,
+    r_z: i64,
+}
+
+/// The wing-offset and wing-distance context of an escaped record
+/// (SPEC §5.5.5: by the eligible entries).
+pub fn escape_wing_context(eligible: &WingCandidates) -> u8 {
+    context::wing(eligible.count())
+}
