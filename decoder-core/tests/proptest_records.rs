@@ -216,3 +216,32 @@ proptest! {
         level.join_records(half);
     }
 }
+
+/// The generator reads records positions first (format 3.7) on some of its
+/// constrained `height` levels, and those levels split vertices: the
+/// property tests above then cover that record order too.
+#[test]
+fn generated_streams_read_positions_first_records() {
+    use splitstream_decoder_core::RecordOrder;
+    let mut levels = 0;
+    let mut splits = 0u32;
+    for seed in 1..=400u64 {
+        let bytes = streams::pseudo_random_bytes(seed, 4096);
+        let g = streams::generate(&mut Choices::new(&bytes), false);
+        assert_eq!(g.error, None, "seed {seed}");
+        let d = streams::decode_full(&g.stream);
+        streams::check_against(&g, &d).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        for l in g
+            .levels
+            .iter()
+            .filter(|l| l.records == RecordOrder::PositionsFirst)
+        {
+            levels += 1;
+            splits += l.round_splits.iter().sum::<u32>();
+        }
+    }
+    assert!(
+        levels >= 5 && splits >= 50,
+        "{levels} levels, {splits} splits"
+    );
+}

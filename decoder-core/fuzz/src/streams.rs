@@ -24,6 +24,11 @@
 use splitstream_decoder_core::handmade;
 use splitstream_decoder_core::limits::{LEAF, NONE};
 use splitstream_decoder_core::pipe::{InPlacePipe, PendingSplit, PendingSplits};
+use splitstream_decoder_core::positions_first::{
+    self, KIND_CONTEXT, KIND_ESCAPE, NewEdge, OFFSET_CONTEXT, PositionsFirst, Z_CONTEXT,
+    choice_context, rank_context,
+};
+use splitstream_decoder_core::predict::wrap;
 use splitstream_decoder_core::symbols::{deficit_of, split_valence_symbol};
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream,
@@ -31,8 +36,9 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     Decoder, DeficitContexts, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane,
-    PlanePolicy, PositionMode, RecordSource, Ring, Schedule, SplitFan, SplitRecord, Target,
-    WingPolicy, arc_means, constrained_positions, context, predict, wing_order, workspace_len,
+    PlanePolicy, PositionMode, RecordOrder, RecordSource, Ring, Schedule, SplitFan, SplitRecord,
+    Target, WingPolicy, arc_means, constrained_positions, context, height_prediction, predict,
+    wing_order, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -192,6 +198,9 @@ struct GenSource<'g, 'c> {
     plane: PlanePolicy,
     wings: WingPolicy,
     deficits: DeficitContexts,
+    /// The level's record order (3.7) and the positions-first scratch.
+    records: RecordOrder,
+    pf: PositionsFirst,
     bits: u8,
     allow_invalid: bool,
 }
@@ -257,6 +266,163 @@ fn small(b: u8) -> i64 {
     ((b as i8) >> 2) as i64
 }
 
+impl GenSource<'_, '_> {
+    /// The split valences of P and C for a ring of `k` entries whose wings
+    /// are `d` apart (SPEC §7.4 step 2), chosen and written.
+    fn split_valences(
+        &mut self,
+        state: &MeshState<'_>,
+        k: usize,
+        d: usize,
+    ) -> Result<(u8, u8), Error> {
+        let c = &mut *self.choices;
+        let (valence_p, valence_c) = (d + 2, k - d + 2);
+        Ok(if state.schedule() == Schedule::EveryVertex {
+            // 3.6: no split valences coded; the bytes are the valences.
+            (valence_p.min(255) as u8, valence_c.min(255) as u8)
+        } else {
+            let (deficit_p, deficit_c) = (
+                pick_deficit(c.byte(), valence_p),
+                pick_deficit(c.byte(), valence_c),
+            );
+            let (mut sp, mut sc) = (
+                split_valence_symbol(deficit_p, valence_p),
+                split_valence_symbol(deficit_c, valence_c),
+            );
+            if self.allow_invalid && c.byte() == 0xFE {
+                sp = c.byte();
+                sc = c.byte();
+            }
+            self.subs[3].byte_in(context::deficit_p(self.deficits, valence_p), sp);
+            let deficit_p = deficit_of(sp, valence_p)?;
+            self.subs[4].byte_in(context::deficit_c(self.deficits, deficit_p, valence_c), sc);
+            let deficit_c = deficit_of(sc, valence_c)?;
+            (deficit_p, deficit_c)
+        })
+    }
+
+    /// A record read positions first (SPEC §7.4, format 3.7), chosen the
+    /// way a decoder reads it: a kind, a lattice rank, an offset, wing
+    /// ranks among the pairs, a z residual, each picked among the values
+    /// the decoder accepts (the wings also among those with a deficit left
+    /// now). `None` after writing an escape (or nothing, for a fan without
+    /// free points): the caller writes the wings-first record.
+    fn positions_first_record(
+        &mut self,
+        state: &MeshState<'_>,
+        r: u32,
+        ring: &Ring,
+    ) -> Result<Option<SplitRecord>, Error> {
+        let positions = state.positions();
+        let parent = positions[r as usize];
+        let Some(free) = self.pf.free_points(positions, parent, ring) else {
+            return Ok(None);
+        };
+        let c = &mut *self.choices;
+        let escape = |subs: &mut [SubstreamWriter]| {
+            subs[6].byte_in(KIND_CONTEXT, KIND_ESCAPE);
+            Ok(None)
+        };
+        if self.allow_invalid && c.byte() == 0xFB {
+            // A kind above 2, or a lattice rank past the free points.
+            if c.byte() & 1 == 0 {
+                self.subs[6].byte_in(KIND_CONTEXT, 3 + c.byte() % 253);
+                return Err(Error::InvalidPlacement);
+            }
+            self.subs[6].byte_in(KIND_CONTEXT, 0);
+            self.subs[5].varint_in(rank_context(free), (free + c.below(4)) as u32);
+            return Err(Error::PositionOutOfRange);
+        }
+        let kind = c.byte() % 3;
+        if kind == KIND_ESCAPE {
+            return escape(self.subs);
+        }
+        let midpoint = kind == 1;
+        let j = c.below(free);
+        let n = self.pf.point_at(j).expect("a rank below the free points");
+        let t = if midpoint { c.byte() % 4 } else { 0 };
+        let offset = [(t & 1) as i64, (t >> 1) as i64];
+        let edge = if midpoint {
+            NewEdge {
+                a: [offset[0] - n[0], offset[1] - n[1]],
+                b: n,
+                midpoint,
+            }
+        } else {
+            NewEdge {
+                a: n,
+                b: [0, 0],
+                midpoint,
+            }
+        };
+        // Every pair, as ranks, whose wings still have a deficit left.
+        let eligible = state.wing_candidates(ring);
+        let v = ring.vertices();
+        let nx = self.pf.order_xs(&eligible, &edge);
+        let xs: Vec<usize> = (0..nx).filter_map(|u| self.pf.choice(nx, u)).collect();
+        let mut pairs = Vec::new();
+        for (u, &x) in xs.iter().enumerate() {
+            let ny = self.pf.order_ys(&edge, x);
+            for w in 0..ny {
+                let y = self.pf.choice(ny, w).expect("a rank below the count");
+                if wing_ok(state, v[x]) && wing_ok(state, v[y]) {
+                    pairs.push((u, w, x, y, ny));
+                }
+            }
+        }
+        // The positions must stay on the grid.
+        let limit = 1i64 << self.bits;
+        let base = parent.map(|x| x as i64);
+        let on_grid = |p: [i64; 2]| (0..2).all(|i| (0..limit).contains(&(base[i] + p[i])));
+        if pairs.is_empty() || !on_grid(n) || !on_grid(edge.a) {
+            return escape(self.subs);
+        }
+        let (u, w, x, y, ny) = pairs[c.below(pairs.len())];
+        let dz = small(c.byte());
+        self.subs[6].byte_in(KIND_CONTEXT, kind);
+        self.subs[5].varint_in(rank_context(free), j as u32);
+        if midpoint {
+            self.subs[6].byte_in(OFFSET_CONTEXT, t);
+        }
+        self.subs[1].byte_in(choice_context(nx), u as u8);
+        self.subs[2].byte_in(choice_context(ny), w as u8);
+        let (o, d, code) = positions_first::wings_and_code(x, y, midpoint);
+        let (deficit_p, deficit_c) = self.split_valences(state, ring.len(), d)?;
+        let target = Target::of_code(code).expect("codes 0..=2");
+        let xy = if midpoint {
+            [2 * n[0] - offset[0], 2 * n[1] - offset[1]]
+        } else {
+            n
+        };
+        let h = height_prediction(positions, parent, ring, target, [xy[0], xy[1], 0]).unwrap_or(0);
+        // z: a small step from R (or between P and C), or none when that
+        // leaves the grid.
+        let pick = |vz: i64| constrained_positions(parent, code, [xy[0], xy[1], vz]);
+        let in_grid = |v: &[i64; 3]| v.iter().all(|&x| (0..limit).contains(&x));
+        let vz = if let (p, q) = pick(dz)
+            && in_grid(&p)
+            && in_grid(&q)
+        {
+            dz
+        } else {
+            0
+        };
+        self.subs[5].signed_in(Z_CONTEXT, wrap(vz - h) as i32);
+        let (p, q) = pick(wrap(h + wrap(vz - h)));
+        if !in_grid(&p) || !in_grid(&q) {
+            return Err(Error::PositionOutOfRange);
+        }
+        Ok(Some(SplitRecord {
+            wing_offset: o as u8,
+            wing_distance: d as u8,
+            deficit_p,
+            deficit_c,
+            position_p: [p[0] as u32, p[1] as u32, p[2] as u32],
+            position_c: [q[0] as u32, q[1] as u32, q[2] as u32],
+        }))
+    }
+}
+
 impl RecordSource for GenSource<'_, '_> {
     fn flag(&mut self, _state: &MeshState<'_>, _v: u32) -> Result<bool, Error> {
         let f = self.flags.get(self.next_flag).copied().unwrap_or(false);
@@ -265,6 +431,11 @@ impl RecordSource for GenSource<'_, '_> {
     }
 
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
+        if self.records == RecordOrder::PositionsFirst
+            && let Some(record) = self.positions_first_record(state, r, ring)?
+        {
+            return Ok(record);
+        }
         let c = &mut *self.choices;
         let k = ring.len();
         let pairs = wing_pairs(state, ring);
@@ -294,29 +465,8 @@ impl RecordSource for GenSource<'_, '_> {
             WingPolicy::Ranks => eligible.wings(o_rank, d_rank)?,
             _ => wing_order::near_wings(keys, k, o_rank, d_rank)?,
         };
-        let (valence_p, valence_c) = (d + 2, k - d + 2);
-        let (deficit_p, deficit_c) = if state.schedule() == Schedule::EveryVertex {
-            // 3.6: no split valences coded; the bytes are the valences.
-            (valence_p.min(255) as u8, valence_c.min(255) as u8)
-        } else {
-            let (deficit_p, deficit_c) = (
-                pick_deficit(c.byte(), valence_p),
-                pick_deficit(c.byte(), valence_c),
-            );
-            let (mut sp, mut sc) = (
-                split_valence_symbol(deficit_p, valence_p),
-                split_valence_symbol(deficit_c, valence_c),
-            );
-            if self.allow_invalid && c.byte() == 0xFE {
-                sp = c.byte();
-                sc = c.byte();
-            }
-            self.subs[3].byte_in(context::deficit_p(self.deficits, valence_p), sp);
-            let deficit_p = deficit_of(sp, valence_p)?;
-            self.subs[4].byte_in(context::deficit_c(self.deficits, deficit_p, valence_c), sc);
-            let deficit_c = deficit_of(sc, valence_c)?;
-            (deficit_p, deficit_c)
-        };
+        let (deficit_p, deficit_c) = self.split_valences(state, k, d)?;
+        let c = &mut *self.choices;
         let limit = 1i64 << self.bits;
         let in_grid = |v: &[i64; 3]| v.iter().all(|&x| (0..limit).contains(&x));
         let clamp = |v: i64| v.clamp(0, limit - 1);
@@ -524,6 +674,17 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
             // No split valences: the level header says `plain` (SPEC §5.1).
             deficits = DeficitContexts::Plain;
         }
+        // Positions first (3.7) on every other constrained level under
+        // `height` (no choice of its own, so that existing corpora keep
+        // their meaning); its escapes use the level's wing policy.
+        let records = if position_mode == PositionMode::Constrained
+            && plane == PlanePolicy::Height
+            && (levels.len() + base_index) % 2 == 1
+        {
+            RecordOrder::PositionsFirst
+        } else {
+            RecordOrder::WingsFirst
+        };
         let rounds = 3 - choices.below(3);
         for _ in 0..rounds {
             let n = state.vertex_count();
@@ -591,6 +752,8 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                 plane,
                 wings,
                 deficits,
+                records,
+                pf: PositionsFirst::default(),
                 bits,
                 allow_invalid,
             };
@@ -604,7 +767,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                         plane,
                         wings,
                         deficits,
-                        records: splitstream_decoder_core::RecordOrder::WingsFirst,
+                        records,
                         substreams: subs,
                         vertex_count: n + declared,
                         triangle_count: state.triangle_count() + remaining,
@@ -624,7 +787,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
             plane,
             wings,
             deficits,
-            records: splitstream_decoder_core::RecordOrder::WingsFirst,
+            records,
             substreams: subs,
             vertex_count: state.vertex_count(),
             triangle_count: state.triangle_count(),
@@ -895,6 +1058,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
             )
         })
         .collect();
+    let mut records: Vec<RecordOrder> = g.levels.iter().map(|l| l.records).collect();
     let mut n_ops = 0;
     while !ops.exhausted() && n_ops < 32 {
         n_ops += 1;
@@ -994,12 +1158,19 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 bytes.extend(core::iter::repeat_n(v, n as usize));
             }
             11 => {
-                // Another plane or wing policy, or other deficit contexts,
-                // for the level (SPEC §5.1, §5.5.5, §7.4).
-                match ops.byte() % 3 {
+                // Another plane or wing policy, other deficit contexts or
+                // the other record order, for the level (SPEC §5.1,
+                // §5.5.5, §7.4).
+                match ops.byte() % 4 {
                     0 => meta[l].3 = PlanePolicy::ALL[ops.below(PlanePolicy::ALL.len())],
                     1 => meta[l].4 = WingPolicy::ALL[ops.below(WingPolicy::ALL.len())],
-                    _ => meta[l].5 = DeficitContexts::ALL[ops.below(DeficitContexts::ALL.len())],
+                    2 => meta[l].5 = DeficitContexts::ALL[ops.below(DeficitContexts::ALL.len())],
+                    _ => {
+                        records[l] = match records[l] {
+                            RecordOrder::WingsFirst => RecordOrder::PositionsFirst,
+                            RecordOrder::PositionsFirst => RecordOrder::WingsFirst,
+                        }
+                    }
                 }
             }
             _ => {
@@ -1007,6 +1178,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                 if subs.len() > 1 && ops.byte() & 1 == 0 {
                     subs.pop();
                     meta.pop();
+                    records.pop();
                 }
             }
         }
@@ -1014,14 +1186,18 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
     let levels = subs
         .into_iter()
         .zip(meta)
+        .zip(records)
         .map(
-            |(s, (round_splits, vertex_count, triangle_count, plane, wings, deficits))| {
+            |(
+                (s, (round_splits, vertex_count, triangle_count, plane, wings, deficits)),
+                records,
+            )| {
                 LevelPayload {
                     round_splits,
                     plane,
                     wings,
                     deficits,
-                    records: splitstream_decoder_core::RecordOrder::WingsFirst,
+                    records,
                     substreams: s
                         .into_iter()
                         .map(|b| {
