@@ -22,6 +22,8 @@ use splitstream_decoder_core::{
 
 use splitstream_decoder_core::predict::wrap;
 
+use rayon::prelude::*;
+
 use super::policies::ranking_params;
 
 /// One level's records under the record order `positions-first`.
@@ -72,7 +74,7 @@ impl PositionsFirstCoding {
     /// else `escape`.
     pub fn write(&mut self, s: &SplitSeen<'_>, escape: &WingsFirstRecord) {
         match self.name(s) {
-            Some(named) => {
+            Ok(named) => {
                 let [offset, distance, edge, placement] = &mut self.subs;
                 placement.byte_in(KIND_CONTEXT, named.kind);
                 edge.varint_in(rank_context(named.free), named.rank as u32);
@@ -84,8 +86,8 @@ impl PositionsFirstCoding {
                 edge.signed_in(Z_CONTEXT, named.r_z as i32);
                 self.named += 1;
             }
-            None => {
-                if self.pf.free_points(s.positions, s.parent, s.ring).is_some() {
+            Err(has_free_points) => {
+                if has_free_points {
                     self.subs[PLACEMENT].byte_in(KIND_CONTEXT, KIND_ESCAPE);
                 }
                 let [offset, distance, edge, placement] = &mut self.subs;
@@ -100,10 +102,19 @@ impl PositionsFirstCoding {
         }
     }
 
-    /// The record of split `s` read positions first, or `None` for an
-    /// escape (SPEC §7.4 `read_record_pf`, backwards).
-    fn name(&mut self, s: &SplitSeen<'_>) -> Option<Named> {
-        let free = self.pf.free_points(s.positions, s.parent, s.ring)?;
+    /// The record of split `s` read positions first, or for an escape
+    /// whether the fan has free points (then a kind is read: SPEC §7.4
+    /// `read_record_pf`, backwards).
+    fn name(&mut self, s: &SplitSeen<'_>) -> Result<Named, bool> {
+        let free = self
+            .pf
+            .free_points(s.positions, s.parent, s.ring)
+            .ok_or(false)?;
+        self.name_among(s, free).ok_or(true)
+    }
+
+    /// [`Self::name`] once the fan's `free` points are known.
+    fn name_among(&mut self, s: &SplitSeen<'_>, free: usize) -> Option<Named> {
         let wide = |v: [u32; 3]| v.map(|x| x as i64);
         let (r, p, c) = (wide(s.parent), wide(s.p), wide(s.c));
         let rel = |v: [i64; 3]| [v[0] - r[0], v[1] - r[1]];
@@ -173,7 +184,7 @@ impl PositionsFirstCoding {
     /// positions-first level.
     pub fn cost(&self, params: &StreamParams) -> usize {
         let ranking = ranking_params(params);
-        IDS.iter()
+        IDS.par_iter()
             .zip(&self.subs)
             .map(|(&id, sub)| {
                 coded_len_under(

@@ -600,26 +600,34 @@ fn choose_record_order(
 ) -> Option<(PlanePolicy, WingPolicy, RecordOrder)> {
     let pf = positions_first?;
     if forced != Some(RecordOrder::PositionsFirst) {
+        // The eight substreams are costed in parallel: after the last
+        // level's replay this is on the emission's critical path.
         let ranking = ranking_params(params);
-        let wings_first: usize = [
+        let ids = [
             substream::WING_OFFSET,
             substream::WING_DISTANCE,
             substream::EDGE,
             substream::PLACEMENT,
-        ]
-        .into_iter()
-        .map(|id| {
-            let sub = &subs[slot(id)];
-            coded_len_under(
-                sub,
-                id,
-                DeficitContexts::Plain,
-                RecordOrder::WingsFirst,
-                &ranking,
-            )
-        })
-        .sum();
-        if pf.cost(params) >= wings_first {
+        ];
+        let held: &[SubstreamWriter] = subs;
+        let (wings_first, positions_first) = rayon::join(
+            || {
+                ids.par_iter()
+                    .map(|&id| {
+                        let sub = &held[slot(id)];
+                        coded_len_under(
+                            sub,
+                            id,
+                            DeficitContexts::Plain,
+                            RecordOrder::WingsFirst,
+                            &ranking,
+                        )
+                    })
+                    .sum::<usize>()
+            },
+            || pf.cost(params),
+        );
+        if positions_first >= wings_first {
             return None;
         }
     }
