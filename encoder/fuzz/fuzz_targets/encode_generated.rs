@@ -15,7 +15,7 @@
 use libfuzzer_sys::fuzz_target;
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{PositionMode, Schedule};
+use splitstream_decoder_core::{PositionMode, RecordOrder, Schedule};
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode, quantize_for};
 use splitstream_encoder::input::{Grid, check_mesh, grid_to_mesh, icosphere};
@@ -134,7 +134,7 @@ fn options(b: &mut Bytes<'_>, vertices: usize) -> EncodeOptions {
             lanes: b.range(1, 32) as u8,
         },
     };
-    EncodeOptions {
+    let mut options = EncodeOptions {
         bits: b.range(1, 24) as u8,
         levels: b.range(1, 7),
         base_vertices: b.flag().then(|| b.range(0, vertices)),
@@ -161,7 +161,17 @@ fn options(b: &mut Bytes<'_>, vertices: usize) -> EncodeOptions {
             Schedule::EveryVertex
         },
         ..EncodeOptions::default()
-    }
+    };
+    // The record order (3.7): chosen per level (the default), or forced;
+    // positions first only where a level can declare it (constrained).
+    options.records = match b.range(0, 2) {
+        1 => Some(RecordOrder::WingsFirst),
+        2 if options.position_mode == PositionMode::Constrained => {
+            Some(RecordOrder::PositionsFirst)
+        }
+        _ => None,
+    };
+    options
 }
 
 fuzz_target!(|data: &[u8]| {

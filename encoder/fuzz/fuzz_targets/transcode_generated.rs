@@ -1,6 +1,7 @@
 //! `transcode` on generated valid streams: decoder-core's fuzz generator
 //! builds a stream from the first bytes (any base mesh, both position
-//! modes, 8 to 31 bits per axis, every plane, wing and deficit policy,
+//! modes, 8 to 31 bits per axis, every plane, wing and deficit policy and
+//! record order,
 //! leaves, boundaries, seeded level 0), the next bytes pick the coding to
 //! write it in, and the transcoded stream must decode to the very same
 //! state hash after every round. A replay that refuses a valid stream, or
@@ -9,12 +10,14 @@
 
 use libfuzzer_sys::fuzz_target;
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{DeficitContexts, PlanePolicy, Schedule, WingPolicy};
+use splitstream_decoder_core::{
+    DeficitContexts, PlanePolicy, PositionMode, RecordOrder, Schedule, WingPolicy,
+};
 use splitstream_decoder_core_fuzz::streams::{self, Choices};
-use splitstream_encoder::emit::{TranscodeOptions, transcode};
+use splitstream_encoder::emit::{TranscodeOptions, positions_first_allowed, transcode};
 
 /// The coding to write the stream in, from the bytes left.
-fn options(choices: &mut Choices<'_>, input: Schedule) -> TranscodeOptions {
+fn options(choices: &mut Choices<'_>, input: Schedule, mode: PositionMode) -> TranscodeOptions {
     let codec = match choices.byte() % 6 {
         0 => ChunkCodec::Stored,
         1 => ChunkCodec::Deflate(1),
@@ -26,19 +29,31 @@ fn options(choices: &mut Choices<'_>, input: Schedule) -> TranscodeOptions {
         },
     };
     let pick = |b: u8, n: usize| (b as usize % (n + 1)).checked_sub(1);
+    let plane = pick(choices.byte(), PlanePolicy::ALL.len()).map(|i| PlanePolicy::ALL[i]);
+    let wings = pick(choices.byte(), WingPolicy::ALL.len()).map(|i| WingPolicy::ALL[i]);
+    let deficits = pick(choices.byte(), DeficitContexts::ALL.len()).map(|i| DeficitContexts::ALL[i]);
+    let schedule = match (choices.byte() & 1, input) {
+        (0, s) => s,
+        (_, Schedule::SplitValences) => Schedule::EveryVertex,
+        (_, Schedule::EveryVertex) => Schedule::SplitValences,
+    };
+    // The record order (3.7): chosen per level, or forced where a level
+    // could declare it.
+    let records = pick(choices.byte(), RecordOrder::ALL.len())
+        .map(|i| RecordOrder::ALL[i])
+        .filter(|&r| {
+            r == RecordOrder::WingsFirst || positions_first_allowed(mode, plane, wings)
+        });
     TranscodeOptions {
         codec,
         chunk_limit: [16 * 1024, 1, 7, 64, 255][choices.below(5)],
         rans_chunk_limit: [16 * 1024, 1, 3, 64][choices.below(4)],
-        plane: pick(choices.byte(), PlanePolicy::ALL.len()).map(|i| PlanePolicy::ALL[i]),
-        wings: pick(choices.byte(), WingPolicy::ALL.len()).map(|i| WingPolicy::ALL[i]),
-        deficits: pick(choices.byte(), DeficitContexts::ALL.len()).map(|i| DeficitContexts::ALL[i]),
+        plane,
+        wings,
+        deficits,
         // The input's schedule, or the other one (SPEC §3.2).
-        schedule: match (choices.byte() & 1, input) {
-            (0, s) => s,
-            (_, Schedule::SplitValences) => Schedule::EveryVertex,
-            (_, Schedule::EveryVertex) => Schedule::SplitValences,
-        },
+        schedule,
+        records,
     }
 }
 
@@ -46,7 +61,7 @@ fuzz_target!(|data: &[u8]| {
     let mut choices = Choices::new(data);
     let g = streams::generate(&mut choices, false);
     assert_eq!(g.error, None, "the generator builds valid streams");
-    let options = options(&mut choices, g.params.schedule);
+    let options = options(&mut choices, g.params.schedule, g.params.position_mode);
     let same_schedule = options.schedule == g.params.schedule;
     let transcoded = transcode(&g.stream, &options).unwrap_or_else(|e| {
         panic!(
