@@ -187,13 +187,7 @@ fn pieces(stream: &[u8], broken: bool, hashes: &mut Vec<u64>) -> Result<(), Erro
             .ok_or(Error::Truncated)?;
         // SPEC §5.1: the level header against the table entry.
         let is_base = k == 0;
-        let level_header = table.level_header(
-            k,
-            bytes,
-            header.max_chunk_len,
-            header.schedule,
-            header.position_mode,
-        )?;
+        let level_header = table.level_header(k, bytes, header.level_rules())?;
         // SPEC §7.6: no split may take the level past its triangle count.
         state.set_triangle_limit(info.triangle_count);
         let rounds = level_header.round_count;

@@ -78,13 +78,6 @@ fn seed_vertices(stream: &[u8]) -> u64 {
     let table = LevelTable::parse(stream, &head).expect("level table");
     let level0 = table.get(0);
     let bytes = &stream[level0.offset as usize..(level0.offset + level0.length as u64) as usize];
-    let level = LevelHeader::parse(
-        bytes,
-        true,
-        head.max_chunk_len,
-        head.schedule,
-        head.position_mode,
-    )
-    .expect("level 0");
+    let level = LevelHeader::parse(bytes, true, head.level_rules()).expect("level 0");
     level.seed_vertices as u64
 }

@@ -171,16 +171,9 @@ fn write_fields(stream: &[u8], out: &mut dyn Write) -> Result<std::io::Result<()
     };
     while let Some(k) = decoder.next_level() {
         let bytes = decoder.level_bytes(k, stream)?;
-        let max_chunk_len = decoder.header().max_chunk_len;
         fields.wings = decoder
             .level_table()
-            .level_header(
-                k,
-                bytes,
-                max_chunk_len,
-                decoder.header().schedule,
-                decoder.header().position_mode,
-            )?
+            .level_header(k, bytes, decoder.header().level_rules())?
             .wing_policy;
         let mut level = decoder.begin_level(k, bytes)?;
         // Level 0's seed is decoded by now: its vertices are old too.

@@ -222,13 +222,10 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
             });
         }
         let info = self.table.get(level);
-        let header = match self.table.level_header(
-            level,
-            bytes,
-            self.header.max_chunk_len,
-            self.header.schedule,
-            self.header.position_mode,
-        ) {
+        let header = match self
+            .table
+            .level_header(level, bytes, self.header.level_rules())
+        {
             Ok(h) => h,
             Err(e) => {
                 self.poisoned = true;

@@ -72,6 +72,15 @@ pub struct Header {
 }
 
 impl Header {
+    /// What this stream's level headers are checked against (SPEC §5.1).
+    pub fn level_rules(&self) -> crate::LevelRules {
+        crate::LevelRules {
+            max_chunk_len: self.max_chunk_len,
+            schedule: self.schedule,
+            position_mode: self.position_mode,
+        }
+    }
+
     /// Parses and validates the header at the start of `bytes` (SPEC §3).
     pub fn parse(bytes: &[u8]) -> Result<Header, Error> {
         if bytes.len() < MAGIC.len() {

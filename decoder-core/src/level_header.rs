@@ -21,6 +21,29 @@ const fn split_counts_at(is_base: bool) -> usize {
     if is_base { 20 } else { 12 }
 }
 
+/// What a level header is checked against that the stream header says
+/// (SPEC §5.1): the largest stored or deflate chunk, the schedule (the
+/// flags' table count, the deficit contexts allowed) and the position mode
+/// (where `positions-first` is allowed). [`crate::Header::level_rules`]
+/// gives a stream's.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LevelRules {
+    pub max_chunk_len: u32,
+    pub schedule: Schedule,
+    pub position_mode: PositionMode,
+}
+
+impl LevelRules {
+    /// Rules for unit tests that frame levels by hand: 64 KiB chunks,
+    /// split valences, constrained mode.
+    #[cfg(test)]
+    pub(crate) const TEST: LevelRules = LevelRules {
+        max_chunk_len: 1 << 16,
+        schedule: Schedule::SplitValences,
+        position_mode: PositionMode::Constrained,
+    };
+}
+
 /// One chunk-directory entry (SPEC §5.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ChunkEntry {
@@ -71,16 +94,14 @@ pub struct LevelHeader<'l> {
 
 impl<'l> LevelHeader<'l> {
     /// Parses and validates the level header of `level` (SPEC §5.1) of a
-    /// stream with the given `max_chunk_len`, schedule and position mode
-    /// (SPEC §3.2).
+    /// stream whose header sets `rules` (SPEC §3.2).
     /// `is_base` selects which substream ids are allowed.
-    pub fn parse(
-        level: &'l [u8],
-        is_base: bool,
-        max_chunk_len: u32,
-        schedule: Schedule,
-        mode: PositionMode,
-    ) -> Result<Self, Error> {
+    pub fn parse(level: &'l [u8], is_base: bool, rules: LevelRules) -> Result<Self, Error> {
+        let LevelRules {
+            max_chunk_len,
+            schedule,
+            position_mode: mode,
+        } = rules;
         let round_count = u32_at(level, 0)?;
         let chunk_count = u32_at(level, 4)?;
         let counts_at = split_counts_at(is_base);

@@ -1,8 +1,9 @@
 //! The level table: where each level's bytes lie and what it yields (SPEC §4).
 
 use crate::bytes::{crc32, f32_at, u32_at, u64_at};
+use crate::level_header::LevelRules;
 use crate::limits::{HEADER_LEN, LEVEL_ENTRY_LEN};
-use crate::{ChecksumScope, Error, Header, LevelHeader, PositionMode, Schedule};
+use crate::{ChecksumScope, Error, Header, LevelHeader};
 
 /// One level-table entry (SPEC §4.1). Level 0 is the base mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -151,9 +152,7 @@ impl<'h> LevelTable<'h> {
         &self,
         k: u16,
         bytes: &'l [u8],
-        max_chunk_len: u32,
-        schedule: Schedule,
-        mode: PositionMode,
+        rules: LevelRules,
     ) -> Result<LevelHeader<'l>, Error> {
         if k >= self.count {
             return Err(Error::NoSuchLevel {
@@ -166,7 +165,7 @@ impl<'h> LevelTable<'h> {
             return Err(Error::Truncated);
         }
         let is_base = k == 0;
-        let header = LevelHeader::parse(bytes, is_base, max_chunk_len, schedule, mode)?;
+        let header = LevelHeader::parse(bytes, is_base, rules)?;
         if header.round_count != info.round_count {
             return Err(Error::LevelCountMismatch);
         }
@@ -286,40 +285,20 @@ mod tests {
         };
         for k in 0..table.len() {
             let level = table
-                .level_header(
-                    k,
-                    bytes(k),
-                    header.max_chunk_len,
-                    header.schedule,
-                    header.position_mode,
-                )
+                .level_header(k, bytes(k), header.level_rules())
                 .unwrap();
             assert_eq!(level.round_count, table.get(k).round_count);
         }
         // Not exactly the level's bytes, or a level that is not there.
         let short = &bytes(0)[..bytes(0).len() - 1];
         assert_eq!(
-            table
-                .level_header(
-                    0,
-                    short,
-                    header.max_chunk_len,
-                    header.schedule,
-                    header.position_mode
-                )
-                .err(),
+            table.level_header(0, short, header.level_rules()).err(),
             Some(Error::Truncated)
         );
         let beyond = table.len();
         assert_eq!(
             table
-                .level_header(
-                    beyond,
-                    bytes(0),
-                    header.max_chunk_len,
-                    header.schedule,
-                    header.position_mode
-                )
+                .level_header(beyond, bytes(0), header.level_rules())
                 .err(),
             Some(Error::NoSuchLevel {
                 level: beyond,

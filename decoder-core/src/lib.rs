@@ -67,7 +67,7 @@ pub use hash::Fnv1a;
 pub use header::{Header, PositionMode, Schedule};
 pub use inflate::Inflater;
 pub use layout::Layout;
-pub use level_header::{ChunkEntry, LevelHeader};
+pub use level_header::{ChunkEntry, LevelHeader, LevelRules};
 pub use level_table::{LevelInfo, LevelTable, head_len, level_within_error, write_level_table};
 pub use positions_first::RecordOrder;
 pub use predict::{

@@ -217,7 +217,15 @@ pub(crate) fn read_record(
             let kind = byte_out_of_line(s, slot(substream::PLACEMENT), KIND_CONTEXT)?;
             match kind {
                 0 | 1 => {
-                    return read_positions_first(s, coding, &mut scratch.pf, fan, free, kind == 1);
+                    return read_positions_first(
+                        s,
+                        coding,
+                        &mut scratch.pf,
+                        fan,
+                        parent,
+                        free,
+                        kind == 1,
+                    );
                 }
                 KIND_ESCAPE => {}
                 _ => return Err(Error::InvalidPlacement),
@@ -227,7 +235,8 @@ pub(crate) fn read_record(
     read_wings_first(s, coding, &mut scratch.keys, fan)
 }
 
-/// `read_record_pf` of SPEC §7.4 ("Positions first") after its kind: the
+/// `read_record_pf` of SPEC §7.4 ("Positions first") after its kind, for
+/// the split of the vertex at `parent`: the
 /// new vertex's rank among the fan's `free` lattice points (a midpoint's
 /// offset after it), the wings among the pairs that keep the new
 /// triangles counter-clockwise in xy, the split valences, then z.
@@ -236,15 +245,16 @@ fn read_positions_first(
     coding: &RecordCoding,
     pf: &mut PositionsFirst,
     fan: &RecordFan<'_>,
+    parent: [u32; 3],
     free: usize,
     midpoint: bool,
 ) -> Result<SplitRecord, Error> {
     let RecordFan {
         positions,
         bits,
-        r,
         ring,
         eligible,
+        ..
     } = *fan;
     let j = varint_out_of_line(s, slot(substream::EDGE), rank_context(free))?;
     let n = pf.point_at(j as usize).ok_or(Error::PositionOutOfRange)?;
@@ -286,7 +296,6 @@ fn read_positions_first(
     let (o, d, code) = positions_first::wings_and_code(x, y, midpoint);
     let (deficit_p, deficit_c) = read_deficits(s, coding, ring.len(), d)?;
     let r_z = signed_out_of_line(s, slot(substream::EDGE), Z_CONTEXT)? as i64;
-    let parent = *positions.get(r as usize).ok_or(Error::CapacityExceeded)?;
     let target = Target::of_code(code).ok_or(Error::InvalidPlacement)?;
     let xy = if midpoint {
         [2 * n[0] - offset[0], 2 * n[1] - offset[1]]

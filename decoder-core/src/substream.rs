@@ -522,14 +522,8 @@ mod tests {
     /// says so; returns what was read, up to and including the first error,
     /// and whether the peeks always showed the bits that followed.
     fn read_all(bytes: &[u8], lanes: u8, peeks: &[bool]) -> (Vec<Result<bool, Error>>, bool) {
-        let header = LevelHeader::parse(
-            bytes,
-            false,
-            1 << 16,
-            crate::Schedule::SplitValences,
-            crate::PositionMode::Constrained,
-        )
-        .expect("level header");
+        let header =
+            LevelHeader::parse(bytes, false, crate::LevelRules::TEST).expect("level header");
         let mut memory = slot_memory(lanes);
         let mut inflater = Inflater::new();
         let buffers = slot_buffers(&mut memory);
@@ -591,7 +585,7 @@ mod tests {
                 // Corrupt a payload byte and refresh its chunk's CRC, so that
                 // the damage reaches the decoders rather than the CRC check.
                 let copy = bytes.clone();
-                let header = LevelHeader::parse(&copy, false, 1 << 16, crate::Schedule::SplitValences, crate::PositionMode::Constrained).expect("header");
+                let header = LevelHeader::parse(&copy, false, crate::LevelRules::TEST).expect("header");
                 let start = header.payload_start;
                 if bytes.len() > start {
                     let at = start + at % (bytes.len() - start);
@@ -642,14 +636,8 @@ mod tests {
             ..StreamParams::default()
         };
         let bytes = frame_level(&payload, None, &params).bytes;
-        let header = LevelHeader::parse(
-            &bytes,
-            false,
-            1 << 16,
-            crate::Schedule::SplitValences,
-            crate::PositionMode::Constrained,
-        )
-        .expect("level header");
+        let header =
+            LevelHeader::parse(&bytes, false, crate::LevelRules::TEST).expect("level header");
         let lengths = (0..header.chunk_count)
             .map(|c| header.chunk(c).expect("chunk").raw_len)
             .collect();
@@ -713,7 +701,7 @@ mod tests {
             let (bytes, lengths) = edge_level(&values, lanes, limit);
             prop_assert_eq!(lengths.iter().map(|&l| l as usize).sum::<usize>(), n);
             prop_assert!(lengths.iter().all(|&l| l >= 1 && l <= limit));
-            let header = LevelHeader::parse(&bytes, false, 1 << 16, crate::Schedule::SplitValences, crate::PositionMode::Constrained).expect("level header");
+            let header = LevelHeader::parse(&bytes, false, crate::LevelRules::TEST).expect("level header");
             let mut memory = slot_memory(lanes);
             let mut inflater = Inflater::new();
             let buffers = slot_buffers(&mut memory);

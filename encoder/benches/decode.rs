@@ -47,14 +47,8 @@ fn splits(stream: &[u8]) -> u64 {
     let table = splitstream_decoder_core::LevelTable::parse(stream, &head).expect("table");
     let level0 = table.get(0);
     let bytes = &stream[level0.offset as usize..(level0.offset + level0.length as u64) as usize];
-    let lh = splitstream_decoder_core::LevelHeader::parse(
-        bytes,
-        true,
-        head.max_chunk_len,
-        head.schedule,
-        head.position_mode,
-    )
-    .expect("level 0");
+    let lh = splitstream_decoder_core::LevelHeader::parse(bytes, true, head.level_rules())
+        .expect("level 0");
     (head.vertex_capacity - lh.seed_vertices) as u64
 }
 

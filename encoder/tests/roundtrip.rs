@@ -500,14 +500,8 @@ fn positions_first_roundtrips_and_sets_the_minor_version() {
                 for k in 0..table.len() {
                     let e = table.get(k);
                     let bytes = &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
-                    let lh = LevelHeader::parse(
-                        bytes,
-                        k == 0,
-                        header.max_chunk_len,
-                        header.schedule,
-                        header.position_mode,
-                    )
-                    .expect("level header");
+                    let lh = LevelHeader::parse(bytes, k == 0, header.level_rules())
+                        .expect("level header");
                     assert_eq!(lh.record_order, RecordOrder::PositionsFirst);
                     assert_eq!(lh.plane_policy, PlanePolicy::Height);
                     assert_eq!(lh.wing_policy, WingPolicy::Ranks);

@@ -256,14 +256,7 @@ fn final_mesh(stream: &[u8]) -> (FinalMesh, Vec<String>) {
     for k in 0..header.level_count {
         let info = table.get(k);
         let bytes = &stream[info.offset as usize..(info.offset + info.length as u64) as usize];
-        let lh = LevelHeader::parse(
-            bytes,
-            k == 0,
-            header.max_chunk_len,
-            header.schedule,
-            header.position_mode,
-        )
-        .expect("valid");
+        let lh = LevelHeader::parse(bytes, k == 0, header.level_rules()).expect("valid");
         if k == 0 && lh.round_count > 0 {
             tags.push("seed-rounds".to_string());
         }

@@ -53,14 +53,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
     for k in 0..header.level_count {
         let info = table.get(k);
         let bytes = &stream[level_range(stream, k)];
-        let lh = LevelHeader::parse(
-            bytes,
-            k == 0,
-            header.max_chunk_len,
-            header.schedule,
-            header.position_mode,
-        )
-        .expect("a valid level");
+        let lh = LevelHeader::parse(bytes, k == 0, header.level_rules()).expect("a valid level");
         // Slots 0..7: ids 1..=7 (rounds); 7..10: ids 8..=10 (seed).
         let mut substreams = vec![Vec::new(); 10];
         let mut at = lh.payload_start;

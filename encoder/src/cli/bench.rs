@@ -200,15 +200,9 @@ fn size_row(
     // Every vertex but the seed's comes from a split.
     let level0 = table.get(0);
     let level0 = &stream[level0.offset as usize..(level0.offset + level0.length as u64) as usize];
-    let seed = splitstream_decoder_core::LevelHeader::parse(
-        level0,
-        true,
-        header.max_chunk_len,
-        header.schedule,
-        header.position_mode,
-    )
-    .map_err(|e| e.to_string())?
-    .seed_vertices;
+    let seed = splitstream_decoder_core::LevelHeader::parse(level0, true, header.level_rules())
+        .map_err(|e| e.to_string())?
+        .seed_vertices;
     let splits = (header.vertex_capacity - seed) as f64;
     println!(
         "| {name} | {} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {} | {:.2} | {:.1} | {:.2} |",

@@ -93,13 +93,7 @@ fn field_sizes_of(
             )
         })?;
         let lh = table
-            .level_header(
-                k,
-                bytes,
-                header.max_chunk_len,
-                header.schedule,
-                header.position_mode,
-            )
+            .level_header(k, bytes, header.level_rules())
             .map_err(|e| format!("level {k}: {e}"))?;
         sizes.framing += lh.payload_start as u64;
         let mut level = [0u64; FIELDS];
@@ -225,16 +219,7 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
             let e = table.get(k);
             stream
                 .get(e.offset as usize..(e.offset + e.length as u64) as usize)
-                .and_then(|b| {
-                    LevelHeader::parse(
-                        b,
-                        k == 0,
-                        header.max_chunk_len,
-                        header.schedule,
-                        header.position_mode,
-                    )
-                    .ok()
-                })
+                .and_then(|b| LevelHeader::parse(b, k == 0, header.level_rules()).ok())
                 .map_or(("?", "?", "?", "?"), |lh| {
                     // Under `every-vertex` no split valences are coded
                     // (SPEC §3.2): no deficit contexts to name.

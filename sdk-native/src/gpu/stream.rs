@@ -155,13 +155,7 @@ fn capture_into(
             .ok_or(Error::Truncated)?;
         // SPEC §5.1: the level header against the table entry.
         let is_base = k == 0;
-        let level_header = table.level_header(
-            k,
-            bytes,
-            header.max_chunk_len,
-            header.schedule,
-            header.position_mode,
-        )?;
+        let level_header = table.level_header(k, bytes, header.level_rules())?;
         state.set_triangle_limit(info.triangle_count);
         if is_base {
             let slots = buffers.each_mut().map(|b| &mut **b);
