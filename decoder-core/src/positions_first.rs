@@ -108,6 +108,113 @@ fn incircle(a: [i64; 2], b: [i64; 2], c: [i64; 2], p: [i64; 2]) -> i64 {
     ax * (by * cl - bl * cy) - ay * (bx * cl - bl * cx) + al * (bx * cy - by * cx)
 }
 
+/// Words of the free-point map: [`POINT_CAP`] bits and a spare word.
+const INSIDE_WORDS: usize = POINT_CAP as usize / 64 + 1;
+
+/// Rows of at most this many points take one fixed-length pass.
+const SHORT_ROW: usize = 4;
+
+/// Whether each of the first `N` points of a row is inside a triangle, as
+/// bits: `f` holds the three orientations at the row's first point,
+/// `steps` what they gain per point. Inside when none is negative: no
+/// sign bit in their OR (branch-free: the test is not predictable).
+#[inline(always)]
+fn row_bits<const N: usize>(f: [i64; 3], steps: [i64; 3]) -> u64 {
+    let mut bits = 0u64;
+    let mut f = f;
+    for i in 0..N {
+        bits |= u64::from((f[0] | f[1] | f[2]) >= 0) << i;
+        for (f, step) in f.iter_mut().zip(steps) {
+            *f += step;
+        }
+    }
+    bits
+}
+
+/// [`row_bits`] for `len` (1..=64) points.
+fn long_row_bits(f: [i64; 3], steps: [i64; 3], len: usize) -> u64 {
+    let mut bits = 0u64;
+    let mut f = f;
+    for i in 0..len {
+        bits |= u64::from((f[0] | f[1] | f[2]) >= 0) << i;
+        for (f, step) in f.iter_mut().zip(steps) {
+            *f += step;
+        }
+    }
+    bits
+}
+
+/// The bounding box's points in the closed triangle `(0, a, b)`
+/// (`inside` of SPEC §7.4; `ccw`: its orientation, it has an area), row
+/// by row: `emit(index, bits)` for each row, `bits` the row's points from
+/// map index `index` on (the box's low corner `corner`, its `width`), at
+/// most 64 at a time. Each of the three orientations is linear in the
+/// point, so a row steps them by a constant; with their signs turned so
+/// that the triangle is counter-clockwise, a point is inside when none is
+/// negative (the three sum to twice the area, so they cannot all be
+/// negative or zero as for a clockwise triangle).
+#[inline(always)]
+fn triangle_rows(
+    a: [i64; 2],
+    b: [i64; 2],
+    ccw: bool,
+    corner: [i64; 2],
+    width: i64,
+    mut emit: impl FnMut(usize, u64),
+) {
+    let sign = if ccw { 1 } else { -1 };
+    // orient(u, v, p) = step_x · p_x + step_y · p_y + at_origin.
+    let edge = |u: [i64; 2], v: [i64; 2]| {
+        let (dx, dy) = (v[0] - u[0], v[1] - u[1]);
+        (-dy * sign, dx * sign, (dy * u[0] - dx * u[1]) * sign)
+    };
+    let edges = [edge([0, 0], a), edge(a, b), edge(b, [0, 0])];
+    let (lx, hx) = (a[0].min(b[0]).min(0), a[0].max(b[0]).max(0));
+    let (ly, hy) = (a[1].min(b[1]).min(0), a[1].max(b[1]).max(0));
+    let len = (hx - lx + 1) as usize;
+    let steps = edges.map(|e| e.0);
+    let mut f = edges.map(|(sx, sy, c)| sx * lx + sy * ly + c);
+    let mut start = ((ly - corner[1]) * width + (lx - corner[0])) as usize;
+    for _ in ly..hy + 1 {
+        // A loop as long as the row mispredicted its exit on most rows;
+        // the short rows, most of them, take a fixed number of tests
+        // (points past the row are outside the triangle).
+        let bits = if len <= SHORT_ROW {
+            row_bits::<SHORT_ROW>(f, steps)
+        } else if len <= 8 {
+            row_bits::<8>(f, steps)
+        } else {
+            long_row_bits(f, steps, len.min(64))
+        };
+        emit(start, bits);
+        let mut done = 64;
+        while done < len {
+            // Rows this long are rare: the box holds at most
+            // [`POINT_CAP`] points.
+            let at: [i64; 3] = core::array::from_fn(|e| f[e] + done as i64 * steps[e]);
+            emit(start + done, long_row_bits(at, steps, (len - done).min(64)));
+            done += 64;
+        }
+        for (f, e) in f.iter_mut().zip(&edges) {
+            *f += e.1;
+        }
+        start += width as usize;
+    }
+}
+
+/// ORs `bits` into the map `inside` from bit `index` on (the bits set lie
+/// inside the bounding box's points).
+#[inline(always)]
+fn mark_bits(inside: &mut [u64; INSIDE_WORDS], index: usize, bits: u64) {
+    let (word, shift) = (index / 64, index % 64);
+    // The bits past the word go to the next one, branch-free (the branch
+    // was mispredicted): `(bits >> 1) >> (63 − shift)` is `bits >> (64 −
+    // shift)`, and 0 for shift 0, where no bit passes. The map has a spare
+    // word for a row that ends in the last one.
+    inside[word] |= bits << shift;
+    inside[word + 1] |= (bits >> 1) >> (63 - shift);
+}
+
 /// A split's fan in xy, its free lattice points and its wing pairs: the
 /// scratch a record read positions first needs, kept between records so
 /// that nothing is cleared per split but what it uses.
@@ -127,7 +234,7 @@ pub struct PositionsFirst {
     free: usize,
     /// The points of the bounding box inside a wedge, by `(y − y0) width +
     /// (x − x0)`.
-    inside: [u64; POINT_CAP as usize / 64],
+    inside: [u64; INSIDE_WORDS],
     /// The wing choices being named (`xs` or `ys` of SPEC §7.4), the edge
     /// `(a, b)` their order goes by, and whether they are in that order.
     choices: [u8; MAX_SPLIT_VALENCE],
@@ -154,7 +261,7 @@ impl Default for PositionsFirst {
             width: 1,
             keys: [0; LIST_CAP],
             free: 0,
-            inside: [0; POINT_CAP as usize / 64],
+            inside: [0; INSIDE_WORDS],
             choices: [0; MAX_SPLIT_VALENCE],
             list_edge: [[0; 2]; 2],
             sorted: false,
@@ -229,20 +336,37 @@ impl PositionsFirst {
         let words = ((width * height) as usize).div_ceil(64);
         self.inside[..words].fill(0);
         let mut any_wedge = false;
+        // Most boxes fit one word: it stays in a register while the wedges
+        // mark it (rows ORed into memory waited for each other's stores).
+        let mut word = 0u64;
         for i in 0..k {
             let j = if i + 1 == k { 0 } else { i + 1 };
             if !(self.real[i] && self.real[j]) {
                 continue;
             }
             let (a, b) = (self.q(i), self.q(j));
-            if orient([0, 0], a, b) == 0 {
+            let area = orient([0, 0], a, b);
+            if area == 0 {
                 continue;
             }
             any_wedge = true;
-            self.mark_triangle(a, b);
+            let corner = [x0, y0];
+            if words == 1 {
+                triangle_rows(a, b, area > 0, corner, width, |start, bits| {
+                    word |= bits << start
+                });
+            } else {
+                let inside = &mut self.inside;
+                triangle_rows(a, b, area > 0, corner, width, |start, bits| {
+                    mark_bits(inside, start, bits)
+                });
+            }
         }
         if !any_wedge {
             return None;
+        }
+        if words == 1 {
+            self.inside[0] = word;
         }
         // R and the ring entries are not free.
         self.unmark([0, 0]);
@@ -252,22 +376,23 @@ impl PositionsFirst {
             }
         }
         let mut free = 0;
-        // The row of the current bit, followed as the bits come in
-        // ascending order (no division per point).
-        let (mut dy, mut row_start) = (0i64, 0i64);
+        // A point's row is its index divided by the width, by a
+        // multiplication: with `m = ceil(2^32 / width)`, `index · m / 2^32`
+        // exceeds `index / width` by less than `index / 2^32 < 2^-22`, less
+        // than the distance from a fraction `j / width` to the next
+        // integer, so the floor is exact (following the rows with a loop
+        // mispredicted its exit at every new row).
+        let per_row = (1u64 << 32).div_ceil(width as u64);
         for w in 0..words {
             let mut word = self.inside[w];
             while word != 0 {
-                let index = 64 * w as i64 + word.trailing_zeros() as i64;
+                let index = 64 * w as u64 + word.trailing_zeros() as u64;
                 word &= word - 1;
                 if free == LIST_CAP {
                     return None;
                 }
-                while index >= row_start + width {
-                    row_start += width;
-                    dy += 1;
-                }
-                let dx = index - row_start;
+                let dy = ((index * per_row) >> 32) as i64;
+                let dx = index as i64 - dy * width;
                 let (x, y) = (x0 + dx, y0 + dy);
                 let (ex, ey) = (n * x - sx, n * y - sy);
                 let distance = (ex * ex + ey * ey) as u64;
@@ -283,39 +408,6 @@ impl PositionsFirst {
     #[inline]
     fn q(&self, i: usize) -> [i64; 2] {
         [self.q[i][0] as i64, self.q[i][1] as i64]
-    }
-
-    /// Marks the bounding box's points in the closed triangle `(0, a, b)`
-    /// (`inside` of SPEC §7.4, either orientation; the triangle has an
-    /// area). Each of the three orientations is linear in the point, so a
-    /// row steps them by a constant; with their signs turned so that the
-    /// triangle is counter-clockwise, a point is inside when none is
-    /// negative (the three sum to twice the area, so they cannot all be
-    /// negative or zero as for a clockwise triangle).
-    fn mark_triangle(&mut self, a: [i64; 2], b: [i64; 2]) {
-        let sign = if orient([0, 0], a, b) > 0 { 1 } else { -1 };
-        // orient(u, v, p) = step_x · p_x + step_y · p_y + at_origin.
-        let edge = |u: [i64; 2], v: [i64; 2]| {
-            let (dx, dy) = (v[0] - u[0], v[1] - u[1]);
-            (-dy * sign, dx * sign, (dy * u[0] - dx * u[1]) * sign)
-        };
-        let edges = [edge([0, 0], a), edge(a, b), edge(b, [0, 0])];
-        let (lx, hx) = (a[0].min(b[0]).min(0), a[0].max(b[0]).max(0));
-        let (ly, hy) = (a[1].min(b[1]).min(0), a[1].max(b[1]).max(0));
-        for y in ly..=hy {
-            let mut f = edges.map(|(sx, sy, c)| sx * lx + sy * y + c);
-            let row = (y - self.y0) * self.width - self.x0;
-            for x in lx..=hx {
-                // Inside when no orientation is negative: no sign bit in
-                // their OR (branch-free: the test is not predictable).
-                let inside = ((f[0] | f[1] | f[2]) >= 0) as u64;
-                let index = (row + x) as usize;
-                self.inside[index / 64] |= inside << (index % 64);
-                for (f, e) in f.iter_mut().zip(&edges) {
-                    *f += e.0;
-                }
-            }
-        }
     }
 
     fn unmark(&mut self, p: [i64; 2]) {

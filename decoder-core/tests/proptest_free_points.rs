@@ -1,0 +1,122 @@
+//! `PositionsFirst::free_points` and `point_at` against SPEC §7.4
+//! "Positions first" written out point by point: every lattice point of
+//! the fan's bounding box tested against every real wedge, the free ones
+//! sorted by their key. decoder-core marks rows of points at a time, keeps
+//! boxes of one word in a register and finds rows by a multiplication;
+//! these fans (folded, flat, with a ghost, up to the 1,024-point cap and
+//! past it) check that none of that changes a list.
+
+use proptest::prelude::*;
+use splitstream_decoder_core::Ring;
+use splitstream_decoder_core::limits::NONE;
+use splitstream_decoder_core::positions_first::{LIST_CAP, POINT_CAP, PositionsFirst};
+
+/// R's position: far enough from 0 that no entry leaves the grid.
+const R: [u32; 3] = [4096, 4096, 7];
+
+fn orient(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> i64 {
+    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+}
+
+/// `free_points` of SPEC §7.4 for entries `q` relative to R (`None`: the
+/// ghost): the free points in list order, or `None` for an escape.
+fn spec_free_points(q: &[Option<[i64; 2]>]) -> Option<Vec<[i64; 2]>> {
+    let real: Vec<[i64; 2]> = q.iter().flatten().copied().collect();
+    let xs = real.iter().map(|p| p[0]).chain([0]);
+    let ys = real.iter().map(|p| p[1]).chain([0]);
+    let (x0, x1) = (xs.clone().min()?, xs.max()?);
+    let (y0, y1) = (ys.clone().min()?, ys.max()?);
+    if (x1 - x0 + 1) * (y1 - y0 + 1) > POINT_CAP {
+        return None;
+    }
+    let k = q.len();
+    let wedges: Vec<([i64; 2], [i64; 2])> = (0..k)
+        .filter_map(|i| Some((q[i]?, q[(i + 1) % k]?)))
+        .filter(|&(a, b)| orient([0, 0], a, b) != 0)
+        .collect();
+    if wedges.is_empty() {
+        return None;
+    }
+    let inside = |p: [i64; 2]| {
+        wedges.iter().any(|&(a, b)| {
+            let s = [orient([0, 0], a, p), orient(a, b, p), orient(b, [0, 0], p)];
+            s.iter().all(|&s| s >= 0) || s.iter().all(|&s| s <= 0)
+        })
+    };
+    let n = real.len() as i64;
+    let (sx, sy) = (
+        real.iter().map(|p| p[0]).sum::<i64>(),
+        real.iter().map(|p| p[1]).sum::<i64>(),
+    );
+    let mut free = Vec::new();
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let p = [x, y];
+            if p != [0, 0] && !real.contains(&p) && inside(p) {
+                let (ex, ey) = (n * x - sx, n * y - sy);
+                free.push(((ex * ex + ey * ey), y, x));
+            }
+        }
+    }
+    if free.is_empty() || free.len() > LIST_CAP {
+        return None;
+    }
+    free.sort();
+    Some(free.into_iter().map(|(_, y, x)| [x, y]).collect())
+}
+
+/// A fan: 3 to 12 entries within `reach` of R, at most one the ghost.
+fn fans() -> impl Strategy<Value = Vec<Option<[i64; 2]>>> {
+    (
+        prop_oneof![Just(3i64), Just(8), Just(20), Just(40)],
+        3usize..=12,
+    )
+        .prop_flat_map(|(reach, k)| {
+            (
+                prop::collection::vec([-reach..=reach, -reach..=reach], k),
+                prop::option::of(0..k),
+            )
+        })
+        .prop_map(|(points, ghost)| {
+            points
+                .into_iter()
+                .enumerate()
+                .map(|(i, p)| (Some(i) != ghost).then_some(p))
+                .collect()
+        })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(4000))]
+
+    #[test]
+    fn free_points_are_the_spec_list(q in fans()) {
+        let mut positions = vec![R];
+        let mut entries = Vec::new();
+        for p in &q {
+            match p {
+                Some(p) => {
+                    entries.push(positions.len() as u32);
+                    positions.push([
+                        (R[0] as i64 + p[0]) as u32,
+                        (R[1] as i64 + p[1]) as u32,
+                        0,
+                    ]);
+                }
+                None => entries.push(NONE),
+            }
+        }
+        let mut ring = Ring::default();
+        prop_assert!(ring.set_vertices(&entries));
+        let mut pf = PositionsFirst::default();
+        let got = pf.free_points(&positions, R, &ring);
+        let expected = spec_free_points(&q);
+        prop_assert_eq!(got, expected.as_ref().map(Vec::len));
+        if let Some(expected) = expected {
+            for (j, p) in expected.iter().enumerate() {
+                prop_assert_eq!(pf.point_at(j), Some(*p), "rank {}", j);
+            }
+            prop_assert_eq!(pf.point_at(expected.len()), None);
+        }
+    }
+}

@@ -1,0 +1,119 @@
+//! Criterion benchmark of `free_points` (SPEC §7.4 "Positions first"), the
+//! largest single cost of decoding a level read positions first: the
+//! fans of every split of the positions-first levels of a synthetic
+//! terrain (`splitstream demo`'s, constrained mode) are gathered once by
+//! decoding it, then `PositionsFirst::free_points` runs over all of them,
+//! in decoding order, so its branches see the real mix of fan shapes. The
+//! fans are copied out of the mesh (a fan's ring entries renumbered from
+//! 1, R as 0) and stay in cache far better than the mesh does: the figure
+//! is the function's own work, without the cache misses of a decode.
+//! The stream is encoded once and kept in target/bench-data/.
+
+use std::path::PathBuf;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use splitstream_decoder_core::limits::{NONE, VERSION_MAJOR, VERSION_MINOR};
+use splitstream_decoder_core::owned::OwnedWorkspace;
+use splitstream_decoder_core::positions_first::PositionsFirst;
+use splitstream_decoder_core::{MeshState, RecordOrder, Ring, SplitObserver, SplitRecord};
+use splitstream_encoder::emit::{EncodeOptions, encode};
+use splitstream_encoder::input::fractal_terrain;
+
+const SIDE: usize = 512;
+
+fn terrain_stream() -> Vec<u8> {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/bench-data");
+    let path = dir.join(format!(
+        "terrain-{SIDE}-v{VERSION_MAJOR}.{VERSION_MINOR}-constrained.sps"
+    ));
+    if let Ok(bytes) = std::fs::read(&path) {
+        return bytes;
+    }
+    let mesh = fractal_terrain(SIDE, 2012);
+    let encoded = encode(&mesh, &EncodeOptions::default(), |_| {}).expect("encode the terrain");
+    std::fs::create_dir_all(&dir).expect("create target/bench-data");
+    std::fs::write(&path, &encoded.stream).expect("cache the stream");
+    encoded.stream
+}
+
+/// Every split's fan, flattened: R's position then its ring entries'
+/// (the ghost as `None`).
+#[derive(Default)]
+struct Fans {
+    positions: Vec<[u32; 3]>,
+    /// Per fan: where its positions start, and its ring (local ids).
+    starts: Vec<usize>,
+    rings: Vec<Vec<u32>>,
+}
+
+impl SplitObserver for Fans {
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, _: &SplitRecord) {
+        let all = state.positions();
+        self.starts.push(self.positions.len());
+        self.positions.push(all[r as usize]);
+        let mut local = Vec::with_capacity(ring.len());
+        for &v in ring.vertices() {
+            if v == NONE {
+                local.push(NONE);
+            } else {
+                local.push((self.positions.len() - self.starts.last().unwrap()) as u32);
+                self.positions.push(all[v as usize]);
+            }
+        }
+        self.rings.push(local);
+    }
+}
+
+fn gather(stream: &[u8]) -> Fans {
+    let mut ws = OwnedWorkspace::for_stream(stream).expect("valid stream");
+    let mut decoder = ws.decoder(stream).expect("valid stream");
+    let mut fans = Fans::default();
+    while let Some(k) = decoder.next_level() {
+        let bytes = decoder.level_bytes(k, stream).expect("level");
+        let order = decoder
+            .level_table()
+            .level_header(k, bytes, decoder.header().level_rules())
+            .expect("level header")
+            .record_order;
+        let mut level = decoder.begin_level(k, bytes).expect("level");
+        if order == RecordOrder::PositionsFirst {
+            while level
+                .next_round_observed(&mut fans)
+                .expect("decodes")
+                .is_some()
+            {}
+        } else {
+            while level.next_round().expect("decodes").is_some() {}
+        }
+    }
+    fans
+}
+
+fn free_points(c: &mut Criterion) {
+    let stream = terrain_stream();
+    let fans = gather(&stream);
+    assert!(
+        !fans.rings.is_empty(),
+        "the terrain has positions-first levels"
+    );
+    let mut group = c.benchmark_group("positions-first");
+    group.throughput(Throughput::Elements(fans.rings.len() as u64));
+    let mut pf = PositionsFirst::default();
+    let mut ring = Ring::default();
+    group.bench_function(format!("free_points, fans of terrain {SIDE}x{SIDE}"), |b| {
+        b.iter(|| {
+            let mut total = 0;
+            for (i, local) in fans.rings.iter().enumerate() {
+                let start = fans.starts[i];
+                let positions = &fans.positions[start..start + local.len() + 1];
+                ring.set_vertices(local);
+                total += pf.free_points(positions, positions[0], &ring).unwrap_or(0);
+            }
+            total
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, free_points);
+criterion_main!(benches);
