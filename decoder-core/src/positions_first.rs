@@ -108,6 +108,49 @@ fn incircle(a: [i64; 2], b: [i64; 2], c: [i64; 2], p: [i64; 2]) -> i64 {
     ax * (by * cl - bl * cy) - ay * (bx * cl - bl * cx) + al * (bx * cy - by * cx)
 }
 
+/// The greatest common divisor (`gcd(0, 0) = 0`): the lattice points on
+/// a segment, less one end. Most fan edges are a few steps long: a table
+/// answers those (a division per step of Euclid's algorithm cost more than
+/// the rest of a fan's count), Stein's binary algorithm the others.
+fn gcd(a: u64, b: u64) -> u64 {
+    if a < SMALL_GCD as u64 && b < SMALL_GCD as u64 {
+        return SMALL_GCDS[a as usize][b as usize] as u64;
+    }
+    if a == 0 || b == 0 {
+        return a | b;
+    }
+    let shift = (a | b).trailing_zeros();
+    let (mut a, mut b) = (a >> a.trailing_zeros(), b);
+    while b != 0 {
+        b >>= b.trailing_zeros();
+        if a > b {
+            (a, b) = (b, a);
+        }
+        b -= a;
+    }
+    a << shift
+}
+
+/// [`gcd`]'s table: `SMALL_GCDS[a][b]` for `a, b < SMALL_GCD`.
+const SMALL_GCD: usize = 16;
+const SMALL_GCDS: [[u8; SMALL_GCD]; SMALL_GCD] = {
+    let mut table = [[0u8; SMALL_GCD]; SMALL_GCD];
+    let mut a = 0;
+    while a < SMALL_GCD {
+        let mut b = 0;
+        while b < SMALL_GCD {
+            let (mut x, mut y) = (a, b);
+            while y != 0 {
+                (x, y) = (y, x % y);
+            }
+            table[a][b] = x as u8;
+            b += 1;
+        }
+        a += 1;
+    }
+    table
+};
+
 /// Words of the free-point map: [`POINT_CAP`] bits and a spare word.
 const INSIDE_WORDS: usize = POINT_CAP as usize / 64 + 1;
 
@@ -229,9 +272,18 @@ pub struct PositionsFirst {
     x0: i64,
     y0: i64,
     width: i64,
-    /// Free points as packed keys (`key`), unordered, `keys[..free]`.
+    /// The box's height, and the real entries' count and coordinate sums
+    /// (the centroid is `(sx, sy) / n`).
+    height: i64,
+    n: i64,
+    sx: i64,
+    sy: i64,
+    /// Free points as packed keys (`key`), unordered, `keys[..free]`,
+    /// once `listed`: a simple fan is only counted ([`Self::count_simple`])
+    /// and listed when a rank needs more than the points near its centroid.
     keys: [u64; LIST_CAP],
     free: usize,
+    listed: bool,
     /// The points of the bounding box inside a wedge, by `(y − y0) width +
     /// (x − x0)`.
     inside: [u64; INSIDE_WORDS],
@@ -259,8 +311,13 @@ impl Default for PositionsFirst {
             x0: 0,
             y0: 0,
             width: 1,
+            height: 1,
+            n: 1,
+            sx: 0,
+            sy: 0,
             keys: [0; LIST_CAP],
             free: 0,
+            listed: true,
             inside: [0; INSIDE_WORDS],
             choices: [0; MAX_SPLIT_VALENCE],
             list_edge: [[0; 2]; 2],
@@ -332,7 +389,28 @@ impl PositionsFirst {
         if width * height > POINT_CAP {
             return None;
         }
-        (self.x0, self.y0, self.width) = (x0, y0, width);
+        (self.x0, self.y0, self.width, self.height) = (x0, y0, width, height);
+        (self.n, self.sx, self.sy) = (n, sx, sy);
+        if let Some(free) = self.count_simple() {
+            // Listed lazily, by `point_at` and `rank_of`.
+            self.listed = false;
+            self.free = if (1..=LIST_CAP).contains(&free) {
+                free
+            } else {
+                0
+            };
+            return (self.free > 0).then_some(free);
+        }
+        self.list()
+    }
+
+    /// The free points of the last fan, listed in `keys` (the part of
+    /// [`Self::free_points`] after the bounding box).
+    fn list(&mut self) -> Option<usize> {
+        self.listed = true;
+        self.free = 0;
+        let (k, x0, y0, width, height) = (self.k, self.x0, self.y0, self.width, self.height);
+        let (n, sx, sy) = (self.n, self.sx, self.sy);
         let words = ((width * height) as usize).div_ceil(64);
         self.inside[..words].fill(0);
         let mut any_wedge = false;
@@ -429,6 +507,12 @@ impl PositionsFirst {
         if j >= self.free {
             return None;
         }
+        if !self.listed {
+            if let Some(p) = self.near_point(j) {
+                return Some(p);
+            }
+            self.list();
+        }
         let keys = &mut self.keys[..self.free];
         // The nearest point is the most common rank by far.
         let key = if j == 0 {
@@ -441,10 +525,174 @@ impl PositionsFirst {
 
     /// The rank of point `p` (relative to R) among the last free points
     /// (encoder): `None` when `p` is not free.
-    pub fn rank_of(&self, p: [i64; 2]) -> Option<usize> {
+    pub fn rank_of(&mut self, p: [i64; 2]) -> Option<usize> {
+        if self.free == 0 {
+            return None;
+        }
+        if !self.listed {
+            if let Some(rank) = self.near_rank(p) {
+                return rank;
+            }
+            self.list();
+        }
         let keys = &self.keys[..self.free];
         let key = keys.iter().copied().find(|&key| self.point_of(key) == p)?;
         Some(keys.iter().filter(|&&other| other < key).count())
+    }
+
+    /// The number of free points of a *simple* fan, without listing them:
+    /// no ghost, every wedge counter-clockwise with an area, and the ring
+    /// around R once (one wedge crosses the ray from R along +x; a wedge
+    /// `(a, b)` spans less than half a turn, so `a_y < 0 ≤ b_y` means it
+    /// crosses that ray). Then the wedges tile the ring's polygon, a simple
+    /// polygon around R with the ring entries as vertices, and Pick's
+    /// theorem counts its lattice points, boundary included: `A + B/2 + 1`
+    /// for area A and B lattice points on the boundary. R and the k
+    /// entries are among them, not free. `None` for any other fan (most
+    /// terrain fans are simple; the others are listed).
+    fn count_simple(&self) -> Option<usize> {
+        let k = self.k;
+        let (mut twice_area, mut boundary, mut crossings) = (0i64, 0i64, 0);
+        for i in 0..k {
+            let j = if i + 1 == k { 0 } else { i + 1 };
+            if !(self.real[i] && self.real[j]) {
+                return None;
+            }
+            let (a, b) = (self.q(i), self.q(j));
+            let area = orient([0, 0], a, b);
+            if area <= 0 {
+                return None;
+            }
+            twice_area += area;
+            boundary += gcd((b[0] - a[0]).unsigned_abs(), (b[1] - a[1]).unsigned_abs()) as i64;
+            crossings += i32::from(a[1] < 0 && b[1] >= 0);
+        }
+        if crossings != 1 {
+            return None;
+        }
+        // 2A + B is even (Pick); R and the entries are inside, so the
+        // difference is not negative.
+        let points = (twice_area + boundary) / 2 + 1;
+        Some((points - 1 - k as i64) as usize)
+    }
+
+    /// `F[j]` of a simple fan not listed, from the points near the
+    /// centroid `c`: those of the 4 × 4 points around `floor(c)` whose
+    /// scaled distance `|n p − S|` is below `2n`, every point that near
+    /// (a point outside the window is at least 2 away from `c` on an
+    /// axis), taken in key order. `None` when fewer than `j + 1` of them
+    /// are free: then the fan is listed.
+    fn near_point(&self, j: usize) -> Option<[i64; 2]> {
+        let (fx, fy) = (self.sx.div_euclid(self.n), self.sy.div_euclid(self.n));
+        if j == 0 {
+            // The nearest lattice point to the centroid is a corner of the
+            // unit square that holds it (per axis the nearer integer), and
+            // so are the points as near (the centroid halfway): the least
+            // of the four keys is the least key of all.
+            let key = (0..4)
+                .map(|i| {
+                    let p = [fx + (i & 1), fy + (i >> 1)];
+                    self.key_near(p).unwrap_or(u64::MAX)
+                })
+                .min()
+                .unwrap_or(u64::MAX);
+            if key != u64::MAX && self.is_free(self.point_of(key)) {
+                return Some(self.point_of(key));
+            }
+        }
+        let mut window = self.window(fx, fy);
+        let mut found = 0;
+        loop {
+            let mut slot = 0;
+            for (i, &key) in window.iter().enumerate() {
+                if key < window[slot] {
+                    slot = i;
+                }
+            }
+            let key = window[slot];
+            if key == u64::MAX {
+                return None;
+            }
+            window[slot] = u64::MAX;
+            let p = self.point_of(key);
+            if self.is_free(p) {
+                if found == j {
+                    return Some(p);
+                }
+                found += 1;
+            }
+        }
+    }
+
+    /// [`Self::rank_of`] for a simple fan not listed: `Some(rank)` when
+    /// `p` is near the centroid (see [`Self::near_point`]), `None` when
+    /// the fan must be listed.
+    fn near_rank(&self, p: [i64; 2]) -> Option<Option<usize>> {
+        let key = self.key_near(p)?;
+        if !self.is_free(p) {
+            return Some(None);
+        }
+        let (fx, fy) = (self.sx.div_euclid(self.n), self.sy.div_euclid(self.n));
+        let nearer = self
+            .window(fx, fy)
+            .iter()
+            .filter(|&&other| other < key && self.is_free(self.point_of(other)))
+            .count();
+        Some(Some(nearer))
+    }
+
+    /// The keys of the 4 × 4 points around the centroid (`floor` of it:
+    /// `fx`, `fy`) that lie in the
+    /// bounding box within scaled distance `2n` of it; `u64::MAX` for the
+    /// others.
+    fn window(&self, fx: i64, fy: i64) -> [u64; 16] {
+        core::array::from_fn(|i| {
+            let p = [fx - 1 + (i % 4) as i64, fy - 1 + (i / 4) as i64];
+            self.key_near(p).unwrap_or(u64::MAX)
+        })
+    }
+
+    /// The key of `p` (relative to R) when it lies in the bounding box
+    /// within scaled distance `2n` of the centroid.
+    fn key_near(&self, p: [i64; 2]) -> Option<u64> {
+        let (dx, dy) = (p[0] - self.x0, p[1] - self.y0);
+        if !(0..self.width).contains(&dx) || !(0..self.height).contains(&dy) {
+            return None;
+        }
+        let (ex, ey) = (self.n * p[0] - self.sx, self.n * p[1] - self.sy);
+        let distance = ex * ex + ey * ey;
+        (distance < 4 * self.n * self.n)
+            .then_some((distance as u64) << 20 | (dy as u64) << 10 | dx as u64)
+    }
+
+    /// Whether lattice point `p` (relative to R, in the bounding box) is
+    /// free: in a wedge, and neither R nor an entry (SPEC §7.4; the
+    /// wedges of a simple fan are all counter-clockwise).
+    fn is_free(&self, p: [i64; 2]) -> bool {
+        if p == [0, 0] {
+            return false;
+        }
+        // p lies in the cone of wedge (a, b), which spans less than half a
+        // turn, when orient(0, a, p) ≥ 0 ≥ orient(0, b, p); in the wedge
+        // when also orient(a, b, p) ≥ 0. The cone's test is the next
+        // entry's first half, so each entry costs one orientation.
+        let k = self.k;
+        let side = |i: usize| orient([0, 0], self.q(i), p);
+        let first = side(0);
+        let (mut this, mut inside) = (first, false);
+        for i in 0..k {
+            let a = self.q(i);
+            if a == p {
+                return false;
+            }
+            let j = if i + 1 == k { 0 } else { i + 1 };
+            let next = if j == 0 { first } else { side(j) };
+            if this >= 0 && next <= 0 {
+                inside |= orient(a, self.q(j), p) >= 0;
+            }
+            this = next;
+        }
+        inside
     }
 
     /// Prepares the tests of SPEC §7.4 `pair` for the new edge `e`: which
@@ -744,6 +992,22 @@ mod tests {
         assert_eq!(wings_and_code(5, 1, false), (1, 4, 0));
         // A pair that would fold a triangle is not one.
         assert_eq!(pf.rank_of_choice(n, 3), None);
+    }
+
+    #[test]
+    fn gcd_agrees_with_euclid() {
+        let euclid = |mut a: u64, mut b: u64| {
+            while b != 0 {
+                (a, b) = (b, a % b);
+            }
+            a
+        };
+        let values = (0..40).chain([63, 64, 96, 1000, 1023, 1024, 4096, 12_345, u32::MAX as u64]);
+        for a in values.clone() {
+            for b in values.clone() {
+                assert_eq!(gcd(a, b), euclid(a, b), "gcd({a}, {b})");
+            }
+        }
     }
 
     #[test]

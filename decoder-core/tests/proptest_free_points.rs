@@ -3,8 +3,10 @@
 //! the fan's bounding box tested against every real wedge, the free ones
 //! sorted by their key. decoder-core marks rows of points at a time, keeps
 //! boxes of one word in a register and finds rows by a multiplication;
-//! these fans (folded, flat, with a ghost, up to the 1,024-point cap and
-//! past it) check that none of that changes a list.
+//! a simple fan (no ghost, no fold) is counted by Pick's theorem and its
+//! nearest points found without a list. These fans (simple, folded, flat,
+//! with a ghost, up to the 1,024-point cap and past it) check that none of
+//! that changes a list, a count or a rank.
 
 use proptest::prelude::*;
 use splitstream_decoder_core::Ring;
@@ -86,11 +88,29 @@ fn fans() -> impl Strategy<Value = Vec<Option<[i64; 2]>>> {
         })
 }
 
+/// A fan around R: 3 to 12 entries sorted by angle, most of them simple
+/// (every wedge counter-clockwise, the ring once around R), sometimes
+/// with a ghost.
+fn star_fans() -> impl Strategy<Value = Vec<Option<[i64; 2]>>> {
+    (fans(), prop::bool::weighted(0.2)).prop_map(|(q, ghost)| {
+        let mut points: Vec<[i64; 2]> = q.into_iter().flatten().filter(|p| *p != [0, 0]).collect();
+        let angle = |p: &[i64; 2]| (p[1] as f64).atan2(p[0] as f64);
+        points.sort_by(|a, b| angle(a).total_cmp(&angle(b)));
+        points.dedup_by(|a, b| angle(a) == angle(b));
+        let mut fan: Vec<Option<[i64; 2]>> = points.into_iter().map(Some).collect();
+        if ghost && fan.len() > 2 {
+            fan[0] = None;
+        }
+        fan
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(4000))]
 
     #[test]
-    fn free_points_are_the_spec_list(q in fans()) {
+    fn free_points_are_the_spec_list(q in prop_oneof![fans(), star_fans()]) {
+        prop_assume!(q.len() >= 3);
         let mut positions = vec![R];
         let mut entries = Vec::new();
         for p in &q {
@@ -117,6 +137,19 @@ proptest! {
                 prop_assert_eq!(pf.point_at(j), Some(*p), "rank {}", j);
             }
             prop_assert_eq!(pf.point_at(expected.len()), None);
+            // Ranks, each asked of a fan just counted (a simple fan is
+            // listed only when a rank is far from its centroid).
+            for (j, p) in expected.iter().enumerate() {
+                pf.free_points(&positions, R, &ring);
+                prop_assert_eq!(pf.rank_of(*p), Some(j), "point {:?}", p);
+            }
+            pf.free_points(&positions, R, &ring);
+            prop_assert_eq!(pf.rank_of([0, 0]), None);
+            // Ranks in decreasing order, the fan counted once.
+            pf.free_points(&positions, R, &ring);
+            for j in (0..expected.len()).rev() {
+                prop_assert_eq!(pf.point_at(j), Some(expected[j]), "rank {}", j);
+            }
         }
     }
 }

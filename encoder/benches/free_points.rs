@@ -3,7 +3,8 @@
 //! fans of every split of the positions-first levels of a synthetic
 //! terrain (`splitstream demo`'s, constrained mode) are gathered once by
 //! decoding it, then `PositionsFirst::free_points` runs over all of them,
-//! in decoding order, so its branches see the real mix of fan shapes. The
+//! in decoding order, so its branches see the real mix of fan shapes,
+//! each followed by `point_at` of the rank the stream names. The
 //! fans are copied out of the mesh (a fan's ring entries renumbered from
 //! 1, R as 0) and stay in cache far better than the mesh does: the figure
 //! is the function's own work, without the cache misses of a decode.
@@ -41,13 +42,16 @@ fn terrain_stream() -> Vec<u8> {
 #[derive(Default)]
 struct Fans {
     positions: Vec<[u32; 3]>,
-    /// Per fan: where its positions start, and its ring (local ids).
+    /// Per fan: where its positions start, its ring (local ids) and the
+    /// rank of its new vertex among its free points (0 where it has none).
     starts: Vec<usize>,
     rings: Vec<Vec<u32>>,
+    ranks: Vec<usize>,
+    pf: PositionsFirst,
 }
 
 impl SplitObserver for Fans {
-    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, _: &SplitRecord) {
+    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, record: &SplitRecord) {
         let all = state.positions();
         self.starts.push(self.positions.len());
         self.positions.push(all[r as usize]);
@@ -60,6 +64,17 @@ impl SplitObserver for Fans {
                 self.positions.push(all[v as usize]);
             }
         }
+        // The new vertex: P or C, whichever is a free point (SPEC §7.4).
+        let parent = all[r as usize];
+        let rank = [record.position_c, record.position_p]
+            .into_iter()
+            .find_map(|v| {
+                self.pf.free_points(all, parent, ring)?;
+                let relative = [0, 1].map(|a| v[a] as i64 - parent[a] as i64);
+                self.pf.rank_of(relative)
+            })
+            .unwrap_or(0);
+        self.ranks.push(rank);
         self.rings.push(local);
     }
 }
@@ -100,14 +115,17 @@ fn free_points(c: &mut Criterion) {
     group.throughput(Throughput::Elements(fans.rings.len() as u64));
     let mut pf = PositionsFirst::default();
     let mut ring = Ring::default();
-    group.bench_function(format!("free_points, fans of terrain {SIDE}x{SIDE}"), |b| {
+    let name = format!("free_points and point_at, fans of terrain {SIDE}x{SIDE}");
+    group.bench_function(name, |b| {
         b.iter(|| {
-            let mut total = 0;
+            let mut total = 0i64;
             for (i, local) in fans.rings.iter().enumerate() {
                 let start = fans.starts[i];
                 let positions = &fans.positions[start..start + local.len() + 1];
                 ring.set_vertices(local);
-                total += pf.free_points(positions, positions[0], &ring).unwrap_or(0);
+                if pf.free_points(positions, positions[0], &ring).is_some() {
+                    total += pf.point_at(fans.ranks[i]).map_or(0, |p| p[0]);
+                }
             }
             total
         })
