@@ -111,6 +111,14 @@ fn free_points(c: &mut Criterion) {
         !fans.rings.is_empty(),
         "the terrain has positions-first levels"
     );
+    let mut ranks = [0usize; 6];
+    for &r in &fans.ranks {
+        ranks[r.min(5)] += 1;
+    }
+    eprintln!(
+        "{} fans; by rank 0, 1, 2, 3, 4, 5 or more: {ranks:?}",
+        fans.rings.len()
+    );
     let mut group = c.benchmark_group("positions-first");
     group.throughput(Throughput::Elements(fans.rings.len() as u64));
     let mut pf = PositionsFirst::default();
