@@ -577,11 +577,11 @@ impl PositionsFirst {
     }
 
     /// `F[j]` of a simple fan not listed, from the points near the
-    /// centroid `c`: those of the 4 × 4 points around `floor(c)` whose
-    /// scaled distance `|n p − S|` is below `2n`, every point that near
-    /// (a point outside the window is at least 2 away from `c` on an
-    /// axis), taken in key order. `None` when fewer than `j + 1` of them
-    /// are free: then the fan is listed.
+    /// centroid `c`: those of the 3 × 3 points around `round(c)` whose
+    /// distance to `c` is below 1.5 (`4 |n p − S|² < 9 n²`), every point
+    /// that near (a point outside the window is at least 1.5 away from `c`
+    /// on an axis), taken in key order. `None` when fewer than `j + 1` of
+    /// them are free: then the fan is listed.
     fn near_point(&self, j: usize) -> Option<[i64; 2]> {
         let (fx, fy) = (self.sx.div_euclid(self.n), self.sy.div_euclid(self.n));
         if j == 0 {
@@ -600,7 +600,7 @@ impl PositionsFirst {
                 return Some(self.point_of(key));
             }
         }
-        let mut window = self.window(fx, fy);
+        let mut window = self.window();
         let mut found = 0;
         loop {
             let mut slot = 0;
@@ -632,28 +632,29 @@ impl PositionsFirst {
         if !self.is_free(p) {
             return Some(None);
         }
-        let (fx, fy) = (self.sx.div_euclid(self.n), self.sy.div_euclid(self.n));
         let nearer = self
-            .window(fx, fy)
+            .window()
             .iter()
             .filter(|&&other| other < key && self.is_free(self.point_of(other)))
             .count();
         Some(Some(nearer))
     }
 
-    /// The keys of the 4 × 4 points around the centroid (`floor` of it:
-    /// `fx`, `fy`) that lie in the
-    /// bounding box within scaled distance `2n` of it; `u64::MAX` for the
-    /// others.
-    fn window(&self, fx: i64, fy: i64) -> [u64; 16] {
+    /// The keys of the 3 × 3 points around the centroid's nearest lattice
+    /// point that lie in the bounding box within 1.5 of the centroid;
+    /// `u64::MAX` for the others.
+    fn window(&self) -> [u64; 9] {
+        // round(S / n) per axis: floor((2S + n) / 2n).
+        let round = |s: i64| (2 * s + self.n).div_euclid(2 * self.n);
+        let (cx, cy) = (round(self.sx), round(self.sy));
         core::array::from_fn(|i| {
-            let p = [fx - 1 + (i % 4) as i64, fy - 1 + (i / 4) as i64];
+            let p = [cx - 1 + (i % 3) as i64, cy - 1 + (i / 3) as i64];
             self.key_near(p).unwrap_or(u64::MAX)
         })
     }
 
     /// The key of `p` (relative to R) when it lies in the bounding box
-    /// within scaled distance `2n` of the centroid.
+    /// within 1.5 of the centroid.
     fn key_near(&self, p: [i64; 2]) -> Option<u64> {
         let (dx, dy) = (p[0] - self.x0, p[1] - self.y0);
         if !(0..self.width).contains(&dx) || !(0..self.height).contains(&dy) {
@@ -661,7 +662,7 @@ impl PositionsFirst {
         }
         let (ex, ey) = (self.n * p[0] - self.sx, self.n * p[1] - self.sy);
         let distance = ex * ex + ey * ey;
-        (distance < 4 * self.n * self.n)
+        (4 * distance < 9 * self.n * self.n)
             .then_some((distance as u64) << 20 | (dy as u64) << 10 | dx as u64)
     }
 
