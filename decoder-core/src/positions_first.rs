@@ -157,25 +157,13 @@ const INSIDE_WORDS: usize = POINT_CAP as usize / 64 + 1;
 /// Rows of at most this many points take one fixed-length pass.
 const SHORT_ROW: usize = 4;
 
-/// Whether each of the first `N` points of a row is inside a triangle, as
-/// bits: `f` holds the three orientations at the row's first point,
-/// `steps` what they gain per point. Inside when none is negative: no
-/// sign bit in their OR (branch-free: the test is not predictable).
+/// Whether each of the first `len` (1..=64) points of a row is inside a
+/// triangle, as bits: `f` holds the three orientations at the row's first
+/// point, `steps` what they gain per point. Inside when none is negative:
+/// no sign bit in their OR (branch-free: the test is not predictable).
+/// Inlined, so that a constant `len` gives a fixed-length pass.
 #[inline(always)]
-fn row_bits<const N: usize>(f: [i64; 3], steps: [i64; 3]) -> u64 {
-    let mut bits = 0u64;
-    let mut f = f;
-    for i in 0..N {
-        bits |= u64::from((f[0] | f[1] | f[2]) >= 0) << i;
-        for (f, step) in f.iter_mut().zip(steps) {
-            *f += step;
-        }
-    }
-    bits
-}
-
-/// [`row_bits`] for `len` (1..=64) points.
-fn long_row_bits(f: [i64; 3], steps: [i64; 3], len: usize) -> u64 {
+fn row_bits(f: [i64; 3], steps: [i64; 3], len: usize) -> u64 {
     let mut bits = 0u64;
     let mut f = f;
     for i in 0..len {
@@ -223,11 +211,11 @@ fn triangle_rows(
         // the short rows, most of them, take a fixed number of tests
         // (points past the row are outside the triangle).
         let bits = if len <= SHORT_ROW {
-            row_bits::<SHORT_ROW>(f, steps)
+            row_bits(f, steps, SHORT_ROW)
         } else if len <= 8 {
-            row_bits::<8>(f, steps)
+            row_bits(f, steps, 8)
         } else {
-            long_row_bits(f, steps, len.min(64))
+            row_bits(f, steps, len.min(64))
         };
         emit(start, bits);
         let mut done = 64;
@@ -235,7 +223,7 @@ fn triangle_rows(
             // Rows this long are rare: the box holds at most
             // [`POINT_CAP`] points.
             let at: [i64; 3] = core::array::from_fn(|e| f[e] + done as i64 * steps[e]);
-            emit(start + done, long_row_bits(at, steps, (len - done).min(64)));
+            emit(start + done, row_bits(at, steps, (len - done).min(64)));
             done += 64;
         }
         for (f, e) in f.iter_mut().zip(&edges) {

@@ -5,28 +5,18 @@
 //! Each stream is encoded once and kept in target/bench-data/ (encoding
 //! takes a while); the file name carries the format version and the codec.
 
-use std::path::PathBuf;
-
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use splitstream_decoder_core::PositionMode;
-use splitstream_decoder_core::limits::{VERSION_MAJOR, VERSION_MINOR};
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_encoder::emit::{EncodeOptions, encode};
-use splitstream_encoder::input::fractal_terrain;
+use splitstream_encoder::emit::EncodeOptions;
 use splitstream_sdk_native::threaded::{self, TwoThreadMemory};
 
 const SIDE: usize = 1000;
 
+mod common;
+
 fn terrain_stream(name: &str, codec: ChunkCodec) -> Vec<u8> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/bench-data");
-    let path = dir.join(format!(
-        "terrain-{SIDE}-v{VERSION_MAJOR}.{VERSION_MINOR}-{name}.sps"
-    ));
-    if let Ok(bytes) = std::fs::read(&path) {
-        return bytes;
-    }
-    let mesh = fractal_terrain(SIDE, 2012);
     // Optimal mode, as in every figure recorded with this benchmark (the
     // encoder's default until 2026-12-03; `splitstream demo` writes the
     // terrain in constrained mode).
@@ -35,10 +25,7 @@ fn terrain_stream(name: &str, codec: ChunkCodec) -> Vec<u8> {
         position_mode: PositionMode::Optimal,
         ..EncodeOptions::default()
     };
-    let encoded = encode(&mesh, &options, |_| {}).expect("encode the terrain");
-    std::fs::create_dir_all(&dir).expect("create target/bench-data");
-    std::fs::write(&path, &encoded.stream).expect("cache the stream");
-    encoded.stream
+    common::terrain_stream(SIDE, name, &options)
 }
 
 /// Splits in `stream`: every vertex but the seed's.

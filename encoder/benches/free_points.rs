@@ -10,32 +10,16 @@
 //! is the function's own work, without the cache misses of a decode.
 //! The stream is encoded once and kept in target/bench-data/.
 
-use std::path::PathBuf;
-
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use splitstream_decoder_core::limits::{NONE, VERSION_MAJOR, VERSION_MINOR};
+use splitstream_decoder_core::limits::NONE;
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::positions_first::PositionsFirst;
 use splitstream_decoder_core::{MeshState, RecordOrder, Ring, SplitObserver, SplitRecord};
-use splitstream_encoder::emit::{EncodeOptions, encode};
-use splitstream_encoder::input::fractal_terrain;
+use splitstream_encoder::emit::EncodeOptions;
 
 const SIDE: usize = 512;
 
-fn terrain_stream() -> Vec<u8> {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/bench-data");
-    let path = dir.join(format!(
-        "terrain-{SIDE}-v{VERSION_MAJOR}.{VERSION_MINOR}-constrained.sps"
-    ));
-    if let Ok(bytes) = std::fs::read(&path) {
-        return bytes;
-    }
-    let mesh = fractal_terrain(SIDE, 2012);
-    let encoded = encode(&mesh, &EncodeOptions::default(), |_| {}).expect("encode the terrain");
-    std::fs::create_dir_all(&dir).expect("create target/bench-data");
-    std::fs::write(&path, &encoded.stream).expect("cache the stream");
-    encoded.stream
-}
+mod common;
 
 /// Every split's fan, flattened: R's position then its ring entries'
 /// (the ghost as `None`).
@@ -105,7 +89,7 @@ fn gather(stream: &[u8]) -> Fans {
 }
 
 fn free_points(c: &mut Criterion) {
-    let stream = terrain_stream();
+    let stream = common::terrain_stream(SIDE, "constrained", &EncodeOptions::default());
     let fans = gather(&stream);
     assert!(
         !fans.rings.is_empty(),
