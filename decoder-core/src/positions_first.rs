@@ -499,7 +499,13 @@ impl PositionsFirst {
             if let Some(p) = self.near_point(j) {
                 return Some(p);
             }
+            // The list holds as many points as the count said (Pick's
+            // theorem); should it ever hold fewer, `j` is out of range
+            // rather than a selection in too short a list.
             self.list();
+            if j >= self.free {
+                return None;
+            }
         }
         let keys = &mut self.keys[..self.free];
         // The nearest point is the most common rank by far.
