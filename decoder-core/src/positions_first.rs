@@ -95,8 +95,10 @@ fn orient(a: [i64; 2], b: [i64; 2], c: [i64; 2]) -> i64 {
 }
 
 /// `incircle(a, b, c, p)` of SPEC §7.4: positive when `p` lies inside the
-/// circle through `a`, `b`, `c` (counter-clockwise).
-#[inline]
+/// circle through `a`, `b`, `c` (counter-clockwise). The decoder orders the
+/// wing choices by [`angle_of`] instead, which gives the same order (a test
+/// below holds them equal).
+#[cfg(test)]
 fn incircle(a: [i64; 2], b: [i64; 2], c: [i64; 2], p: [i64; 2]) -> i64 {
     let row = |v: [i64; 2]| {
         let (dx, dy) = (v[0] - p[0], v[1] - p[1]);
@@ -106,6 +108,27 @@ fn incircle(a: [i64; 2], b: [i64; 2], c: [i64; 2], p: [i64; 2]) -> i64 {
     let (bx, by, bl) = row(b);
     let (cx, cy, cl) = row(c);
     ax * (by * cl - bl * cy) - ay * (bx * cl - bl * cx) + al * (bx * cy - by * cx)
+}
+
+/// How wide the angle is under which `q` sees the segment `e f`, as the
+/// pair `(dot, cross)` of `e − q` and `f − q`: for `q` strictly left of
+/// `e → f` (`cross > 0`), the angle's cotangent is `dot / cross`, smaller
+/// for a wider angle. Inscribed angles on one side of a chord grow inside
+/// the circle, so `incircle(e, f, c, p) > 0` exactly when `p`'s cotangent
+/// is below `c`'s ([`wider`]): two products where the determinant takes a
+/// dozen. Under the point cap every coordinate is below 2^12 in magnitude,
+/// so both values are below 2^25 and their products below 2^50.
+#[inline]
+fn angle_of(e: [i64; 2], f: [i64; 2], q: [i64; 2]) -> [i64; 2] {
+    let (u, v) = ([e[0] - q[0], e[1] - q[1]], [f[0] - q[0], f[1] - q[1]]);
+    [u[0] * v[0] + u[1] * v[1], u[0] * v[1] - u[1] * v[0]]
+}
+
+/// `Less` when angle `p` (of [`angle_of`]) is wider than angle `c`,
+/// `Equal` when they are the same (the four points on one circle).
+#[inline]
+fn wider(p: [i64; 2], c: [i64; 2]) -> core::cmp::Ordering {
+    (p[0] * c[1]).cmp(&(c[0] * p[1]))
 }
 
 /// The greatest common divisor (`gcd(0, 0) = 0`): the lattice points on
@@ -288,6 +311,10 @@ pub struct PositionsFirst {
     a_ok: [bool; MAX_SPLIT_VALENCE],
     b_ok: [bool; MAX_SPLIT_VALENCE],
     run_b: [u8; MAX_SPLIT_VALENCE],
+    /// Whether every wedge keeps its orientation under both a and b (the
+    /// common case: both inside the ring's kernel): then any x and y on
+    /// their sides of the edge pair.
+    all_ok: bool,
 }
 
 impl Default for PositionsFirst {
@@ -315,6 +342,7 @@ impl Default for PositionsFirst {
             a_ok: [false; MAX_SPLIT_VALENCE],
             b_ok: [false; MAX_SPLIT_VALENCE],
             run_b: [0; MAX_SPLIT_VALENCE],
+            all_ok: false,
         }
     }
 }
@@ -341,6 +369,28 @@ impl PositionsFirst {
         parent: [u32; 3],
         ring: &Ring,
     ) -> Option<usize> {
+        if !self.set_ring(positions, parent, ring) {
+            return None;
+        }
+        if let Some(free) = self.count_simple() {
+            // Listed lazily, by `point_at` and `rank_of`.
+            self.listed = false;
+            self.free = if (1..=LIST_CAP).contains(&free) {
+                free
+            } else {
+                0
+            };
+            return (self.free > 0).then_some(free);
+        }
+        self.list()
+    }
+
+    /// The first step of [`Self::free_points`]: the ring's entries
+    /// relative to R, their bounding box and centroid; false when the box
+    /// holds more than [`POINT_CAP`] points (an escape). The wing choice
+    /// ([`Self::order_xs`]) reads only these (benches call it alone).
+    #[inline]
+    pub fn set_ring(&mut self, positions: &[[u32; 3]], parent: [u32; 3], ring: &Ring) -> bool {
         let vertices = ring.vertices();
         let k = vertices.len();
         self.k = k;
@@ -375,21 +425,11 @@ impl PositionsFirst {
         }
         let (width, height) = (x1 - x0 + 1, y1 - y0 + 1);
         if width * height > POINT_CAP {
-            return None;
+            return false;
         }
         (self.x0, self.y0, self.width, self.height) = (x0, y0, width, height);
         (self.n, self.sx, self.sy) = (n, sx, sy);
-        if let Some(free) = self.count_simple() {
-            // Listed lazily, by `point_at` and `rank_of`.
-            self.listed = false;
-            self.free = if (1..=LIST_CAP).contains(&free) {
-                free
-            } else {
-                0
-            };
-            return (self.free > 0).then_some(free);
-        }
-        self.list()
+        true
     }
 
     /// The free points of the last fan, listed in `keys` (the part of
@@ -671,23 +711,21 @@ impl PositionsFirst {
         // turn, when orient(0, a, p) ≥ 0 ≥ orient(0, b, p); in the wedge
         // when also orient(a, b, p) ≥ 0. The cone's test is the next
         // entry's first half, so each entry costs one orientation.
+        // Branch-free (`&`, `|`): which wedge holds p is data, and a
+        // branch on it mispredicted often; the wedge test costs less.
         let k = self.k;
         let side = |i: usize| orient([0, 0], self.q(i), p);
         let first = side(0);
-        let (mut this, mut inside) = (first, false);
+        let (mut this, mut inside, mut entry) = (first, false, false);
         for i in 0..k {
             let a = self.q(i);
-            if a == p {
-                return false;
-            }
+            entry |= a == p;
             let j = if i + 1 == k { 0 } else { i + 1 };
             let next = if j == 0 { first } else { side(j) };
-            if this >= 0 && next <= 0 {
-                inside |= orient(a, self.q(j), p) >= 0;
-            }
+            inside |= (this >= 0) & (next <= 0) & (orient(a, self.q(j), p) >= 0);
             this = next;
         }
-        inside
+        inside & !entry
     }
 
     /// Prepares the tests of SPEC §7.4 `pair` for the new edge `e`: which
@@ -697,25 +735,41 @@ impl PositionsFirst {
     /// comparisons.
     fn prepare(&mut self, eligible: &WingCandidates, e: &NewEdge) {
         let k = self.k;
+        let mut all_ok = true;
+        // Non-short-circuit `&` and `|` throughout: the flags are data
+        // (a branch on each mispredicted often).
         for i in 0..k {
             let (real, q) = (self.real[i], self.q(i));
             let j = if i + 1 == k { 0 } else { i + 1 };
-            // A wedge touching the ghost is virtual: it always keeps it.
-            let virtual_wedge = !(real && self.real[j]);
+            // orient(b, a, q) is −orient(a, b, q): one side test.
+            let side = orient(e.a, e.b, q);
             let eligible = eligible.contains(i);
-            self.x_ok[i] = eligible && (!real || orient(e.a, e.b, q) > 0);
-            self.y_ok[i] = eligible && (!real || orient(e.b, e.a, q) > 0);
+            self.x_ok[i] = eligible & (!real | (side > 0));
+            self.y_ok[i] = eligible & (!real | (side < 0));
+            // A wedge touching the ghost is virtual: it always keeps it.
+            let virtual_wedge = !(real & self.real[j]);
             let next = self.q(j);
-            self.a_ok[i] = virtual_wedge || orient(e.a, q, next) > 0;
-            self.b_ok[i] = virtual_wedge || orient(e.b, q, next) > 0;
+            let a_ok = virtual_wedge | (orient(e.a, q, next) > 0);
+            let b_ok = virtual_wedge | (orient(e.b, q, next) > 0);
+            (self.a_ok[i], self.b_ok[i]) = (a_ok, b_ok);
+            all_ok &= a_ok & b_ok;
+        }
+        self.all_ok = all_ok;
+        if all_ok {
+            // `ys_of` reads no runs then.
+            return;
         }
         // run_b[t]: how many wedges from t on keep their orientation under
-        // b, capped at k: backwards twice around the ring.
+        // b, capped at k: backwards twice around the ring (the first pass
+        // carries the run across the ring's end). Branch-free and without a
+        // `%`: a division per entry and a mispredicted branch per wedge had
+        // cost more than the orientations above.
         let mut run = 0usize;
-        for i in (0..2 * k).rev() {
-            let t = i % k;
-            run = if self.b_ok[t] { (run + 1).min(k) } else { 0 };
-            self.run_b[t] = run as u8;
+        for _ in 0..2 {
+            for t in (0..k).rev() {
+                run = (run + 1).min(k) * usize::from(self.b_ok[t]);
+                self.run_b[t] = run as u8;
+            }
         }
     }
 
@@ -729,6 +783,21 @@ impl PositionsFirst {
             return 0;
         }
         let mut count = 0;
+        if self.all_ok {
+            // Every arc keeps its wedges: any y on its side pairs (after x
+            // under kind 1). The list's order is `before`'s, not this one.
+            let from = if midpoint { x + 1 } else { 0 };
+            for y in from..k {
+                if y != x && self.y_ok[y] {
+                    if any {
+                        return 1;
+                    }
+                    self.choices[count] = y as u8;
+                    count += 1;
+                }
+            }
+            return count;
+        }
         // A's arc, wedges x .. y − 1, grows wedge by wedge; once a wedge
         // fails under a, every longer arc fails too.
         let mut y = x;
@@ -758,16 +827,18 @@ impl PositionsFirst {
     /// widest angle on the segment `a b` first, then by ring position.
     #[inline]
     fn before(&self, u: usize, w: usize) -> bool {
+        let [a, b] = self.list_edge;
+        self.before_seen(u, angle_of(a, b, self.q(u)), w, angle_of(a, b, self.q(w)))
+    }
+
+    /// [`Self::before`] with the angles of `u` and `w` given.
+    #[inline]
+    fn before_seen(&self, u: usize, angle_u: [i64; 2], w: usize, angle_w: [i64; 2]) -> bool {
         match (self.real[u], self.real[w]) {
             (true, false) => true,
             (false, true) => false,
             (false, false) => u < w,
-            (true, true) => {
-                let [a, b] = self.list_edge;
-                // > 0: u sees a b under a wider angle than w.
-                let wider = incircle(a, b, self.q(w), self.q(u));
-                wider > 0 || (wider == 0 && u < w)
-            }
+            (true, true) => wider(angle_u, angle_w).then(u.cmp(&w)).is_lt(),
         }
     }
 
@@ -776,11 +847,30 @@ impl PositionsFirst {
     /// then names them in their order.
     pub fn order_xs(&mut self, eligible: &WingCandidates, e: &NewEdge) -> usize {
         self.prepare(eligible, e);
+        let k = self.k;
         let mut n = 0;
-        for x in 0..self.k {
-            if self.ys_of(e.midpoint, x, true) > 0 {
-                self.choices[n] = x as u8;
-                n += 1;
+        if self.all_ok {
+            // x pairs when some y ≠ x is on the other side (after x under
+            // kind 1): the y's are counted once, not searched per x.
+            let ys = self.y_ok[..k].iter().filter(|&&ok| ok).count();
+            let last_y = self.y_ok[..k].iter().rposition(|&ok| ok);
+            for x in 0..k {
+                let paired = if e.midpoint {
+                    last_y.is_some_and(|y| y > x)
+                } else {
+                    ys > usize::from(self.y_ok[x])
+                };
+                if self.x_ok[x] && paired {
+                    self.choices[n] = x as u8;
+                    n += 1;
+                }
+            }
+        } else {
+            for x in 0..k {
+                if self.ys_of(e.midpoint, x, true) > 0 {
+                    self.choices[n] = x as u8;
+                    n += 1;
+                }
             }
         }
         self.list_edge = [e.a, e.b];
@@ -809,11 +899,16 @@ impl PositionsFirst {
             return None;
         }
         if i == 0 {
-            // The first choice, by far the most common: one pass.
+            // The first choice, by far the most common: one pass, each
+            // choice's angle taken once.
+            let [a, b] = self.list_edge;
             let mut best = self.choices[0] as usize;
+            let mut best_angle = angle_of(a, b, self.q(best));
             for &c in &self.choices[1..n] {
-                if self.before(c as usize, best) {
-                    best = c as usize;
+                let c = c as usize;
+                let angle = angle_of(a, b, self.q(c));
+                if self.before_seen(c, angle, best, best_angle) {
+                    (best, best_angle) = (c, angle);
                 }
             }
             return Some(best);
@@ -840,8 +935,14 @@ impl PositionsFirst {
     pub fn rank_of_choice(&self, n: usize, entry: usize) -> Option<usize> {
         let list = &self.choices[..n];
         list.iter().any(|&c| c as usize == entry).then(|| {
+            // Entry's angle once, not once per comparison.
+            let [a, b] = self.list_edge;
+            let seen = angle_of(a, b, self.q(entry));
             list.iter()
-                .filter(|&&c| c as usize != entry && self.before(c as usize, entry))
+                .map(|&c| c as usize)
+                .filter(|&c| {
+                    c != entry && self.before_seen(c, angle_of(a, b, self.q(c)), entry, seen)
+                })
                 .count()
         })
     }

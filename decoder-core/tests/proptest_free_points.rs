@@ -7,11 +7,18 @@
 //! nearest points found without a list. These fans (simple, folded, flat,
 //! with a ghost, up to the 1,024-point cap and past it) check that none of
 //! that changes a list, a count or a rank.
+//!
+//! The wing choices of the same fans (`order_xs`, `order_ys`, `choice`,
+//! `rank_of_choice`) are checked against `pair` and `before` written out
+//! the same way: every pair tested wedge by wedge, the lists sorted by
+//! the SPEC's `incircle`. decoder-core skips the wedge tests when every
+//! wedge keeps its orientation under both ends of the new edge, and orders
+//! by the angles' cotangents instead of the determinant.
 
 use proptest::prelude::*;
-use splitstream_decoder_core::Ring;
 use splitstream_decoder_core::limits::NONE;
-use splitstream_decoder_core::positions_first::{LIST_CAP, POINT_CAP, PositionsFirst};
+use splitstream_decoder_core::positions_first::{LIST_CAP, NewEdge, POINT_CAP, PositionsFirst};
+use splitstream_decoder_core::{Ring, WingCandidates};
 
 /// R's position: far enough from 0 that no entry leaves the grid.
 const R: [u32; 3] = [4096, 4096, 7];
@@ -67,6 +74,76 @@ fn spec_free_points(q: &[Option<[i64; 2]>]) -> Option<Vec<[i64; 2]>> {
     Some(free.into_iter().map(|(_, y, x)| [x, y]).collect())
 }
 
+/// `incircle(a, b, c, p)` of SPEC §7.4.
+fn incircle(a: [i64; 2], b: [i64; 2], c: [i64; 2], p: [i64; 2]) -> i64 {
+    let row = |v: [i64; 2]| {
+        let (dx, dy) = (v[0] - p[0], v[1] - p[1]);
+        [dx, dy, dx * dx + dy * dy]
+    };
+    let ([ax, ay, al], [bx, by, bl], [cx, cy, cl]) = (row(a), row(b), row(c));
+    ax * (by * cl - bl * cy) - ay * (bx * cl - bl * cx) + al * (bx * cy - by * cx)
+}
+
+/// `pair(x, y)` of SPEC §7.4 (every entry eligible, as under the schedule
+/// `every-vertex`) for the new edge `a b`.
+fn spec_pair(
+    q: &[Option<[i64; 2]>],
+    a: [i64; 2],
+    b: [i64; 2],
+    kind: u8,
+    x: usize,
+    y: usize,
+) -> bool {
+    let k = q.len();
+    let keeps = |end: [i64; 2], from: usize, to: usize| {
+        let mut i = from;
+        while i != to {
+            let j = (i + 1) % k;
+            if let (Some(p), Some(n)) = (q[i], q[j])
+                && orient(end, p, n) <= 0
+            {
+                return false;
+            }
+            i = j;
+        }
+        true
+    };
+    x != y
+        && (kind == 0 || x < y)
+        && q[x].is_none_or(|p| orient(a, b, p) > 0)
+        && q[y].is_none_or(|p| orient(b, a, p) > 0)
+        && keeps(a, x, y)
+        && keeps(b, y, x)
+}
+
+/// A list of wing choices sorted by `before(e, f)` of SPEC §7.4.
+fn spec_sorted(
+    q: &[Option<[i64; 2]>],
+    e: [i64; 2],
+    f: [i64; 2],
+    mut list: Vec<usize>,
+) -> Vec<usize> {
+    let before = |i: usize, j: usize| match (q[i], q[j]) {
+        (Some(_), None) => true,
+        (None, Some(_)) => false,
+        (None, None) => i < j,
+        (Some(qi), Some(qj)) => {
+            let c = incircle(e, f, qj, qi);
+            c > 0 || (c == 0 && i < j)
+        }
+    };
+    list.sort_by(|&i, &j| {
+        if i == j {
+            std::cmp::Ordering::Equal
+        } else if before(i, j) {
+            std::cmp::Ordering::Less
+        } else {
+            std::cmp::Ordering::Greater
+        }
+    });
+    list
+}
+
 /// A fan: 3 to 12 entries within `reach` of R, at most one the ghost.
 fn fans() -> impl Strategy<Value = Vec<Option<[i64; 2]>>> {
     (
@@ -105,8 +182,85 @@ fn star_fans() -> impl Strategy<Value = Vec<Option<[i64; 2]>>> {
     })
 }
 
+/// The positions (R first) and the ring of fan `q`.
+fn fan_of(q: &[Option<[i64; 2]>]) -> (Vec<[u32; 3]>, Ring) {
+    let mut positions = vec![R];
+    let mut entries = Vec::new();
+    for p in q {
+        match p {
+            Some(p) => {
+                entries.push(positions.len() as u32);
+                positions.push([(R[0] as i64 + p[0]) as u32, (R[1] as i64 + p[1]) as u32, 0]);
+            }
+            None => entries.push(NONE),
+        }
+    }
+    let mut ring = Ring::default();
+    assert!(ring.set_vertices(&entries));
+    (positions, ring)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(4000))]
+
+    /// The wing lists of every new edge from R to a free point (kind 0)
+    /// and of a midpoint split around it (kind 1, offset `t`).
+    #[test]
+    fn wing_choices_are_the_spec_lists(
+        q in prop_oneof![fans(), star_fans()],
+        pick in 0usize..1000,
+        t in 0i64..4,
+    ) {
+        prop_assume!(q.len() >= 3);
+        let Some(free) = spec_free_points(&q) else {
+            return Ok(());
+        };
+        let (positions, ring) = fan_of(&q);
+        let mut pf = PositionsFirst::default();
+        prop_assert!(pf.free_points(&positions, R, &ring).is_some());
+        let n = free[pick % free.len()];
+        let k = q.len();
+        let eligible = WingCandidates::all(k);
+        for kind in [0u8, 1] {
+            let (a, b) = if kind == 0 {
+                (n, [0, 0])
+            } else {
+                ([(t & 1) - n[0], (t >> 1) - n[1]], n)
+            };
+            let edge = NewEdge { a, b, midpoint: kind == 1 };
+            let xs: Vec<usize> = (0..k)
+                .filter(|&x| (0..k).any(|y| spec_pair(&q, a, b, kind, x, y)))
+                .collect();
+            let xs = spec_sorted(&q, a, b, xs);
+            // Each choice asked of a list just collected, and then all of
+            // them of one list (the first choice after the others).
+            for (u, &x) in xs.iter().enumerate() {
+                prop_assert_eq!(pf.order_xs(&eligible, &edge), xs.len());
+                prop_assert_eq!(pf.choice(xs.len(), u), Some(x), "{:?} x {}", edge, u);
+            }
+            prop_assert_eq!(pf.order_xs(&eligible, &edge), xs.len());
+            for u in (0..=xs.len()).rev() {
+                prop_assert_eq!(pf.choice(xs.len(), u), xs.get(u).copied());
+            }
+            for (u, &x) in xs.iter().enumerate() {
+                pf.order_xs(&eligible, &edge);
+                prop_assert_eq!(pf.rank_of_choice(xs.len(), x), Some(u));
+                let ys: Vec<usize> = (0..k).filter(|&y| spec_pair(&q, a, b, kind, x, y)).collect();
+                let ys = spec_sorted(&q, b, a, ys);
+                prop_assert!(!ys.is_empty());
+                for (v, &y) in ys.iter().enumerate() {
+                    prop_assert_eq!(pf.order_ys(&edge, x), ys.len());
+                    prop_assert_eq!(pf.choice(ys.len(), v), Some(y), "{:?} x {} y {}", edge, x, v);
+                    prop_assert_eq!(pf.rank_of_choice(ys.len(), y), Some(v));
+                }
+            }
+            // An entry that is not a choice has no rank.
+            if let Some(other) = (0..k).find(|x| !xs.contains(x)) {
+                pf.order_xs(&eligible, &edge);
+                prop_assert_eq!(pf.rank_of_choice(xs.len(), other), None);
+            }
+        }
+    }
 
     #[test]
     fn free_points_are_the_spec_list(q in prop_oneof![fans(), star_fans()]) {

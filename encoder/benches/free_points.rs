@@ -9,12 +9,19 @@
 //! 1, R as 0) and stay in cache far better than the mesh does: the figure
 //! is the function's own work, without the cache misses of a decode.
 //! The stream is encoded once and kept in target/bench-data/.
+//!
+//! A second function times the wing choice of the same records: with the
+//! new edge known, `order_xs` and `choice` of the wing x the stream names,
+//! then `order_ys` and `choice` of wing y (the splits named positions
+//! first; escapes are left out).
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use splitstream_decoder_core::limits::NONE;
 use splitstream_decoder_core::owned::OwnedWorkspace;
-use splitstream_decoder_core::positions_first::PositionsFirst;
-use splitstream_decoder_core::{MeshState, RecordOrder, Ring, SplitObserver, SplitRecord};
+use splitstream_decoder_core::positions_first::{NewEdge, PositionsFirst};
+use splitstream_decoder_core::{
+    MeshState, RecordOrder, Ring, SplitObserver, SplitRecord, WingCandidates,
+};
 use splitstream_encoder::emit::EncodeOptions;
 
 const SIDE: usize = 512;
@@ -31,7 +38,51 @@ struct Fans {
     starts: Vec<usize>,
     rings: Vec<Vec<u32>>,
     ranks: Vec<usize>,
+    /// Per fan named positions first: its index, new edge and the ranks
+    /// `u`, `v` of its wings among the choices (SPEC §7.4).
+    wings: Vec<(usize, NewEdge, usize, usize)>,
     pf: PositionsFirst,
+}
+
+/// The new edge and the wings `(x, y)` of a split read positions first
+/// (SPEC §7.4; the encoder's `emit/positions_first.rs` backwards): code 0
+/// when P stays on R, 1 when C does, else a midpoint.
+fn new_edge(parent: [u32; 3], record: &SplitRecord) -> (NewEdge, (usize, usize)) {
+    let rel = |v: [u32; 3]| [0, 1].map(|a| v[a] as i64 - parent[a] as i64);
+    let (o, b) = (
+        record.wing_offset as usize,
+        (record.wing_offset + record.wing_distance) as usize,
+    );
+    let (p, c) = (rel(record.position_p), rel(record.position_c));
+    if p == [0, 0] {
+        let a = c;
+        (
+            NewEdge {
+                a,
+                b: p,
+                midpoint: false,
+            },
+            (b, o),
+        )
+    } else if c == [0, 0] {
+        (
+            NewEdge {
+                a: p,
+                b: c,
+                midpoint: false,
+            },
+            (o, b),
+        )
+    } else {
+        (
+            NewEdge {
+                a: p,
+                b: c,
+                midpoint: true,
+            },
+            (o, b),
+        )
+    }
 }
 
 impl SplitObserver for Fans {
@@ -60,6 +111,18 @@ impl SplitObserver for Fans {
             .unwrap_or(0);
         self.ranks.push(rank);
         self.rings.push(local);
+        // The wing ranks, where the split is named positions first.
+        let (edge, (x, y)) = new_edge(parent, record);
+        let eligible = WingCandidates::all(ring.len());
+        if self.pf.free_points(all, parent, ring).is_some() {
+            let xs = self.pf.order_xs(&eligible, &edge);
+            if let Some(u) = self.pf.rank_of_choice(xs, x) {
+                let ys = self.pf.order_ys(&edge, x);
+                if let Some(v) = self.pf.rank_of_choice(ys, y) {
+                    self.wings.push((self.rings.len() - 1, edge, u, v));
+                }
+            }
+        }
     }
 }
 
@@ -103,6 +166,15 @@ fn free_points(c: &mut Criterion) {
         "{} fans; by rank 0, 1, 2, 3, 4, 5 or more: {ranks:?}",
         fans.rings.len()
     );
+    let (mut u0, mut v0) = (0, 0);
+    for &(_, _, u, v) in &fans.wings {
+        u0 += usize::from(u == 0);
+        v0 += usize::from(v == 0);
+    }
+    eprintln!(
+        "{} fans named positions first; wing x first choice {u0}, wing y first choice {v0}",
+        fans.wings.len()
+    );
     let mut group = c.benchmark_group("positions-first");
     group.throughput(Throughput::Elements(fans.rings.len() as u64));
     let mut pf = PositionsFirst::default();
@@ -118,6 +190,31 @@ fn free_points(c: &mut Criterion) {
                 if pf.free_points(positions, positions[0], &ring).is_some() {
                     total += pf.point_at(fans.ranks[i]).map_or(0, |p| p[0]);
                 }
+            }
+            total
+        })
+    });
+    let name = format!(
+        "wing choice, {} fans of terrain {SIDE}x{SIDE}",
+        fans.wings.len()
+    );
+    group.throughput(Throughput::Elements(fans.wings.len() as u64));
+    group.bench_function(name, |b| {
+        b.iter(|| {
+            let mut total = 0usize;
+            for &(i, edge, u, v) in &fans.wings {
+                let local = &fans.rings[i];
+                let start = fans.starts[i];
+                let positions = &fans.positions[start..start + local.len() + 1];
+                ring.set_vertices(local);
+                // Sets the ring's entries (the part of `free_points` that
+                // the wings read) in one pass: the count stays out of it.
+                pf.set_ring(positions, positions[0], &ring);
+                let eligible = WingCandidates::all(local.len());
+                let xs = pf.order_xs(&eligible, &edge);
+                let x = pf.choice(xs, u).unwrap_or(0);
+                let ys = pf.order_ys(&edge, x);
+                total += pf.choice(ys, v).unwrap_or(0);
             }
             total
         })
