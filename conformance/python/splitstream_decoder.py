@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.7 decoder, in Python, written from
+"""A second splitstream 3.8 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
@@ -10,7 +10,8 @@ seed_triangles above its table entry's triangle_count failing
 count-mismatch before the seed is read; 3.6's schedule `every-vertex`,
 header flag bit 1, was added with the SPEC sections that define it, and
 3.7's record order `positions-first`, level header byte 11, with SPEC §7.4
-"Positions first".) It speaks the conformance protocol (a stream
+"Positions first", and 3.8's tie rules of record orders 2 and 3 with
+`off` of SPEC §7.4 `before`.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -434,10 +435,25 @@ def pair(x, y, q, Eset, kind, A, B):
     return True
 
 
-def before(a, b, q):
+def off(a, b, p, order):
+    """SPEC §7.4 off(i) (3.8): how many of the ends a, b see p along the
+    diagonal the record order disfavours: dx = -dy under 2
+    (positions-first-rising), dx = dy under 3 (positions-first-falling),
+    none under 1."""
+    n = 0
+    for e in (a, b):
+        dx, dy = p[0] - e[0], p[1] - e[1]
+        if order == 2 and dx != 0 and dx == -dy:
+            n += 1
+        elif order == 3 and dx != 0 and dx == dy:
+            n += 1
+    return n
+
+
+def before(a, b, q, order):
     """A sort key for the ring positions: u comes before w when w is the
     ghost and u is real, or both are real and incircle(a, b, q_w, q_u) > 0,
-    or it is 0 and u < w."""
+    or it is 0 and off(u) < off(w), or both are equal too and u < w."""
 
     def precedes(u, w):
         if q[w] is None and q[u] is not None:
@@ -445,7 +461,10 @@ def before(a, b, q):
         if q[u] is None or q[w] is None:
             return False
         c = incircle(a, b, q[w], q[u])
-        return c > 0 or (c == 0 and u < w)
+        if c != 0:
+            return c > 0
+        ou, ow = off(a, b, q[u], order), off(a, b, q[w], order)
+        return ou < ow or (ou == ow and u < w)
 
     def cmp(u, w):
         if u == w:
@@ -610,9 +629,9 @@ class Decoder:
             raise Fail("malformed")
         if lvl[10] != 0 and self.every:  # no split-valence symbols (3.6)
             raise Fail("malformed")
-        if lvl[11] > 1:  # record order (3.7)
+        if lvl[11] > 3:  # record order (3.7; 2 and 3 since 3.8)
             raise Fail("malformed")
-        if lvl[11] == 1 and (not self.constrained or lvl[8] != 5):
+        if lvl[11] >= 1 and (not self.constrained or lvl[8] != 5):
             raise Fail("malformed")  # positions-first: constrained mode, plane policy height
         if li == 0 and (SV == 0 or ST == 0):
             raise Fail("malformed")
@@ -670,14 +689,16 @@ class Decoder:
         for sid in range(1, 11):
             lst = [(c, rl, crc, bytes(lvl[off:off + sl])) for (c, rl, crc, off, sl) in chunks.get(sid, [])]
             nctx = (NCTX_EVERY if self.every else NCTX_VALENCE if lvl[10] == 1 else NCTX)[sid]
-            if lvl[11] == 1:  # positions-first (3.7)
+            if lvl[11] >= 1:  # positions first (3.7, 3.8)
                 nctx = NCTX_PF.get(sid, nctx)
             subs[sid] = Sub(sid, lst, self.lane_count, nctx)
         self.subs = subs
         self.policy = lvl[8]
         self.wing_policy = lvl[9]
         self.deficit_contexts = lvl[10]
-        self.record_order = lvl[11]  # 0 wings-first, 1 positions-first (3.7)
+        # 0 wings-first, 1 positions-first (3.7), 2 positions-first-rising,
+        # 3 positions-first-falling (3.8)
+        self.record_order = lvl[11]
         self.T_l = entry["T"]
         if li == 0:
             self.read_base(SV, ST)
@@ -847,7 +868,7 @@ class Decoder:
             raise Fail("count-mismatch")
         for j, R in enumerate(flagged):
             ring, tof = self.ring(R)
-            if self.record_order == 1:  # positions-first (3.7)
+            if self.record_order >= 1:  # positions first (3.7, 3.8)
                 rec = self.read_record_pf(R, ring, candset)
             else:
                 rec = self.read_record(R, ring, candset)
@@ -1022,13 +1043,13 @@ class Decoder:
         E = self.eligible(ring, candset)
         Eset = set(E)
         xs = [x for x in E if any(pair(x, y, q, Eset, kind, A, B) for y in E)]
-        xs.sort(key=before(A, B, q))
+        xs.sort(key=before(A, B, q, self.record_order))
         u = subs[2].byte(min(max(len(xs), 1), 8) - 1)
         if u >= len(xs):
             raise Fail("ring-offset-out-of-range")
         x = xs[u]
         ys = [y for y in E if pair(x, y, q, Eset, kind, A, B)]
-        ys.sort(key=before(B, A, q))
+        ys.sort(key=before(B, A, q, self.record_order))
         v = subs[3].byte(min(len(ys), 8) - 1)
         if v >= len(ys):
             raise Fail("ring-offset-out-of-range")

@@ -180,6 +180,7 @@ pub fn level_with(
         wings: WingPolicy::Ranks,
         deficits: DeficitContexts::Plain,
         records: crate::RecordOrder::WingsFirst,
+        ties: crate::Ties::Ring,
         substreams: s,
         vertex_count: v,
         triangle_count: t,

@@ -5,7 +5,7 @@ use crate::bytes::{crc32, u8_at, u16_at, u32_at};
 use crate::context::DeficitContexts;
 use crate::header::{PositionMode, Schedule};
 use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
-use crate::positions_first::RecordOrder;
+use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
 use crate::wing_order::WingPolicy;
 use crate::{ChecksumScope, Error};
@@ -73,6 +73,9 @@ pub struct LevelHeader<'l> {
     /// How this level's split records are read (SPEC §5.1, §7.4; format
     /// 3.7); the raw byte is checked by [`LevelHeader::parse`].
     pub record_order: RecordOrder,
+    /// Under `positions-first`, how the wing choices' ties are broken
+    /// (the same byte; format 3.8).
+    pub ties: Ties,
     record_byte: u8,
     /// The stream's position mode: `positions-first` needs constrained
     /// mode.
@@ -142,6 +145,7 @@ impl<'l> LevelHeader<'l> {
                 .unwrap_or(DeficitContexts::Plain),
             deficit_byte,
             record_order: RecordOrder::from_byte(record_byte).unwrap_or_default(),
+            ties: Ties::from_record_byte(record_byte).unwrap_or_default(),
             record_byte,
             mode,
             schedule,

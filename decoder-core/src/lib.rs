@@ -69,7 +69,7 @@ pub use inflate::Inflater;
 pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader, LevelRules};
 pub use level_table::{LevelInfo, LevelTable, head_len, level_within_error, write_level_table};
-pub use positions_first::RecordOrder;
+pub use positions_first::{RecordOrder, Ties};
 pub use predict::{
     ArcMeans, Plane, PlanePolicy, SplitFan, Target, add_residual, arc_means, constrained_positions,
     height_prediction, predict, residual, surface_height,

@@ -8,7 +8,11 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 /// stream; 3.5 added a check and no feature, so no stream is written with
 /// minor version 5 (the writer uses the constants below).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 7;
+pub const VERSION_MINOR: u8 = 8;
+/// The minor version written when a positions-first level breaks the wing
+/// choices' ties by a lattice diagonal (SPEC §5.1, §7.4): 3.7 decoders
+/// reject its record order byte.
+pub const VERSION_MINOR_TIES: u8 = 8;
 /// The first minor version with the record order `positions-first` (SPEC
 /// §5.1, §7.4).
 pub const VERSION_MINOR_RECORDS: u8 = 7;

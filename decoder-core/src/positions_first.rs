@@ -34,15 +34,27 @@ pub enum RecordOrder {
 }
 
 impl RecordOrder {
-    /// Every choice, in byte order.
+    /// Every choice.
     pub const ALL: [RecordOrder; 2] = [RecordOrder::WingsFirst, RecordOrder::PositionsFirst];
 
+    /// The order of a level header's byte 11 (SPEC §5.1): 0 `wings-first`,
+    /// 1 to 3 `positions-first` (with the [`Ties`] of
+    /// [`Ties::from_record_byte`]).
     pub fn from_byte(b: u8) -> Option<RecordOrder> {
-        RecordOrder::ALL.get(b as usize).copied()
+        match b {
+            0 => Some(RecordOrder::WingsFirst),
+            1..=3 => Some(RecordOrder::PositionsFirst),
+            _ => None,
+        }
     }
 
-    pub fn to_byte(self) -> u8 {
-        self as u8
+    /// Byte 11 of a level header for this order and, positions first, its
+    /// ties (SPEC §5.1).
+    pub fn to_byte(self, ties: Ties) -> u8 {
+        match self {
+            RecordOrder::WingsFirst => 0,
+            RecordOrder::PositionsFirst => 1 + ties as u8,
+        }
     }
 
     /// The name `splitstream info` and the SPEC use.
@@ -50,6 +62,68 @@ impl RecordOrder {
         match self {
             RecordOrder::WingsFirst => "wings-first",
             RecordOrder::PositionsFirst => "positions-first",
+        }
+    }
+
+    /// The SPEC's name of byte 11 for this order and, positions first,
+    /// its ties (SPEC §5.1): `wings-first`, `positions-first`,
+    /// `positions-first-rising`, `positions-first-falling`.
+    pub fn name_with(self, ties: Ties) -> &'static str {
+        match (self, ties) {
+            (RecordOrder::WingsFirst, _) => "wings-first",
+            (RecordOrder::PositionsFirst, Ties::Ring) => "positions-first",
+            (RecordOrder::PositionsFirst, Ties::Rising) => "positions-first-rising",
+            (RecordOrder::PositionsFirst, Ties::Falling) => "positions-first-falling",
+        }
+    }
+}
+
+/// How a positions-first level orders wing choices that see the new edge
+/// under the same angle (SPEC §5.1, §7.4 `before`; format 3.8). On a
+/// raster whose cells the mesh splits along one diagonal, four lattice
+/// points on one circle are common (the corners of a cell), and the
+/// finest levels' edges never run along the other diagonal: a choice
+/// whose new edges would is most likely not the wing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Ties {
+    /// By ring position alone (3.7's `positions-first`).
+    #[default]
+    Ring,
+    /// First the choice with fewer new edges along the falling diagonal
+    /// (`dx = −dy ≠ 0`): the cells are split along the rising one.
+    Rising,
+    /// First the choice with fewer new edges along the rising diagonal
+    /// (`dx = dy ≠ 0`): the cells are split along the falling one.
+    Falling,
+}
+
+impl Ties {
+    /// Every rule, in byte order.
+    pub const ALL: [Ties; 3] = [Ties::Ring, Ties::Rising, Ties::Falling];
+
+    /// The ties of a positions-first level's byte 11 (SPEC §5.1): 1
+    /// `ring`, 2 `rising`, 3 `falling`.
+    pub fn from_record_byte(b: u8) -> Option<Ties> {
+        Ties::ALL.get((b as usize).wrapping_sub(1)).copied()
+    }
+
+    /// The name `splitstream info` and the SPEC use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Ties::Ring => "ring",
+            Ties::Rising => "rising",
+            Ties::Falling => "falling",
+        }
+    }
+
+    /// Whether an edge of direction `d` runs along the diagonal this rule
+    /// disfavours.
+    #[inline]
+    fn off_diagonal(self, d: [i64; 2]) -> bool {
+        match self {
+            Ties::Ring => false,
+            Ties::Rising => d[0] != 0 && d[0] == -d[1],
+            Ties::Falling => d[0] != 0 && d[0] == d[1],
         }
     }
 }
@@ -315,6 +389,8 @@ pub struct PositionsFirst {
     /// common case: both inside the ring's kernel): then any x and y on
     /// their sides of the edge pair.
     all_ok: bool,
+    /// The level's tie-break between choices of equal angle.
+    ties: Ties,
 }
 
 impl Default for PositionsFirst {
@@ -343,6 +419,7 @@ impl Default for PositionsFirst {
             b_ok: [false; MAX_SPLIT_VALENCE],
             run_b: [0; MAX_SPLIT_VALENCE],
             all_ok: false,
+            ties: Ties::Ring,
         }
     }
 }
@@ -838,8 +915,30 @@ impl PositionsFirst {
             (true, false) => true,
             (false, true) => false,
             (false, false) => u < w,
-            (true, true) => wider(angle_u, angle_w).then(u.cmp(&w)).is_lt(),
+            (true, true) => wider(angle_u, angle_w)
+                .then_with(|| self.off_diagonal_edges(u).cmp(&self.off_diagonal_edges(w)))
+                .then(u.cmp(&w))
+                .is_lt(),
         }
+    }
+
+    /// How many of the new edges from the list's edge ends to real entry
+    /// `i` run along the diagonal the level's ties disfavour (SPEC §7.4
+    /// `off(i)`; always 0 under `ring`).
+    #[inline]
+    fn off_diagonal_edges(&self, i: usize) -> u8 {
+        let q = self.q(i);
+        self.list_edge
+            .iter()
+            .map(|e| u8::from(self.ties.off_diagonal([q[0] - e[0], q[1] - e[1]])))
+            .sum()
+    }
+
+    /// Sets the tie-break of the wing choices (the level's record order,
+    /// SPEC §5.1): [`Self::choice`] and [`Self::rank_of_choice`] follow it.
+    #[inline]
+    pub fn set_ties(&mut self, ties: Ties) {
+        self.ties = ties;
     }
 
     /// Collects the choices of wing x for the new edge `e` (SPEC §7.4

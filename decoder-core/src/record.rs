@@ -6,7 +6,7 @@ use crate::header::{PositionMode, Schedule};
 use crate::limits::MAX_SPLIT_VALENCE;
 use crate::limits::substream::{self, SLOTS};
 use crate::positions_first::{
-    self, KIND_CONTEXT, KIND_ESCAPE, NewEdge, OFFSET_CONTEXT, PositionsFirst, RecordOrder,
+    self, KIND_CONTEXT, KIND_ESCAPE, NewEdge, OFFSET_CONTEXT, PositionsFirst, RecordOrder, Ties,
     Z_CONTEXT, choice_context, rank_context,
 };
 use crate::predict::{
@@ -49,6 +49,8 @@ pub struct StreamSource<'s, 'l, 'b> {
     pub schedule: Schedule,
     /// The level's record order (SPEC §5.1, 3.7).
     pub records: RecordOrder,
+    /// Its wing choices' tie-break under `positions-first` (SPEC §5.1, 3.8).
+    pub ties: Ties,
     /// What reading a record needs besides the substreams.
     scratch: RecordScratch,
 }
@@ -81,6 +83,7 @@ impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
         let deficits = subs.level_header().deficit_contexts;
         let schedule = subs.level_header().schedule;
         let records = subs.level_header().record_order;
+        let ties = subs.level_header().ties;
         StreamSource {
             subs,
             mode,
@@ -89,6 +92,7 @@ impl<'s, 'l, 'b> StreamSource<'s, 'l, 'b> {
             deficits,
             schedule,
             records,
+            ties,
             scratch: RecordScratch::default(),
         }
     }
@@ -115,6 +119,7 @@ impl StreamSource<'_, '_, '_> {
             deficits: self.deficits,
             schedule: self.schedule,
             records: self.records,
+            ties: self.ties,
         }
     }
 }
@@ -185,6 +190,7 @@ pub(crate) struct RecordCoding {
     pub(crate) deficits: DeficitContexts,
     pub(crate) schedule: Schedule,
     pub(crate) records: RecordOrder,
+    pub(crate) ties: Ties,
 }
 
 /// What a split record is read against (SPEC §7.4): the positions, R and
@@ -283,6 +289,7 @@ fn read_positions_first(
             [0, 0],
         )
     };
+    pf.set_ties(coding.ties);
     let xs = pf.order_xs(eligible, &edge);
     let u = byte_out_of_line(s, slot(substream::WING_OFFSET), choice_context(xs))?;
     let x = pf

@@ -12,9 +12,9 @@ use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
     CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_BASELINE, VERSION_MINOR_DEFICITS,
     VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_RECORDS, VERSION_MINOR_SCHEDULE,
-    VERSION_MINOR_WINGS, codec, substream,
+    VERSION_MINOR_TIES, VERSION_MINOR_WINGS, codec, substream,
 };
-use crate::positions_first::RecordOrder;
+use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
 use crate::rans_segments::rans_segments;
 use crate::rans_writer::{Symbol, encode_chunk};
@@ -164,6 +164,9 @@ pub struct LevelPayload {
     /// How the level's records are read (SPEC §5.1, §7.4; 3.7): it also
     /// sets how many tables edge and placement have.
     pub records: RecordOrder,
+    /// Under `positions-first`, how the wing choices' ties are broken
+    /// (SPEC §5.1, §7.4; 3.8).
+    pub ties: Ties,
     /// Substreams in id order: ids 1..=7 for rounds (index 0 is id 1), or
     /// ids 8..=10 for a base level given to [`write_stream`].
     pub substreams: Vec<SubstreamWriter>,
@@ -261,6 +264,7 @@ impl SeedPayload {
             wings: WingPolicy::Ranks,
             deficits: DeficitContexts::Plain,
             records: RecordOrder::WingsFirst,
+            ties: Ties::Ring,
             vertex_count: self.vertices,
             triangle_count: self.triangles,
             substreams: self.substreams,
@@ -356,12 +360,18 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.7 where a level reads its records positions first, 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
+    // SPEC §1: 3.8 where a positions-first level breaks ties by a
+    // diagonal, 3.7 where a level reads its records positions first, 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
     // `max_chunk_len`) is used, 3.3 where a 3.3 feature (the deficit
     // contexts `valence`) is, 3.2 where a 3.2 feature (a wing policy other
     // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
     // is; every other stream stays readable by 3.0 decoders.
     let version_minor = if levels
+        .iter()
+        .any(|l| l.records == RecordOrder::PositionsFirst && l.ties != Ties::Ring)
+    {
+        VERSION_MINOR_TIES
+    } else if levels
         .iter()
         .any(|l| l.records == RecordOrder::PositionsFirst)
     {
@@ -471,7 +481,7 @@ pub fn frame_level_with(
         level.plane.to_byte(),
         level.wings.to_byte(),
         level.deficits.to_byte(),
-        level.records.to_byte(),
+        level.records.to_byte(level.ties),
     ]);
     if let Some(seed) = seed {
         out.extend_from_slice(&seed.vertices.to_le_bytes());

@@ -45,6 +45,7 @@ fn level() -> LevelPayload {
         wings: WingPolicy::Ranks,
         deficits: DeficitContexts::Plain,
         records: splitstream_decoder_core::RecordOrder::WingsFirst,
+        ties: splitstream_decoder_core::Ties::Ring,
         substreams,
         vertex_count: 420,
         triangle_count: 836,

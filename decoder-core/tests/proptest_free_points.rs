@@ -18,7 +18,7 @@
 use proptest::prelude::*;
 use splitstream_decoder_core::limits::NONE;
 use splitstream_decoder_core::positions_first::{LIST_CAP, NewEdge, POINT_CAP, PositionsFirst};
-use splitstream_decoder_core::{Ring, WingCandidates};
+use splitstream_decoder_core::{Ring, Ties, WingCandidates};
 
 /// R's position: far enough from 0 that no entry leaves the grid.
 const R: [u32; 3] = [4096, 4096, 7];
@@ -116,11 +116,29 @@ fn spec_pair(
         && keeps(b, y, x)
 }
 
-/// A list of wing choices sorted by `before(e, f)` of SPEC §7.4.
+/// `off(i)` of SPEC §7.4: how many of the edges from `e` and `f` to `p`
+/// run along the diagonal that `ties` disfavours.
+fn spec_off(ties: Ties, e: [i64; 2], f: [i64; 2], p: [i64; 2]) -> i64 {
+    [e, f]
+        .iter()
+        .filter(|end| {
+            let (dx, dy) = (p[0] - end[0], p[1] - end[1]);
+            match ties {
+                Ties::Ring => false,
+                Ties::Rising => dx != 0 && dx == -dy,
+                Ties::Falling => dx != 0 && dx == dy,
+            }
+        })
+        .count() as i64
+}
+
+/// A list of wing choices sorted by `before(e, f)` of SPEC §7.4 under the
+/// tie rule `ties`.
 fn spec_sorted(
     q: &[Option<[i64; 2]>],
     e: [i64; 2],
     f: [i64; 2],
+    ties: Ties,
     mut list: Vec<usize>,
 ) -> Vec<usize> {
     let before = |i: usize, j: usize| match (q[i], q[j]) {
@@ -129,7 +147,8 @@ fn spec_sorted(
         (None, None) => i < j,
         (Some(qi), Some(qj)) => {
             let c = incircle(e, f, qj, qi);
-            c > 0 || (c == 0 && i < j)
+            let (oi, oj) = (spec_off(ties, e, f, qi), spec_off(ties, e, f, qj));
+            c > 0 || (c == 0 && (oi < oj || (oi == oj && i < j)))
         }
     };
     list.sort_by(|&i, &j| {
@@ -204,7 +223,8 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(4000))]
 
     /// The wing lists of every new edge from R to a free point (kind 0)
-    /// and of a midpoint split around it (kind 1, offset `t`).
+    /// and of a midpoint split around it (kind 1, offset `t`), under each
+    /// tie rule (3.8).
     #[test]
     fn wing_choices_are_the_spec_lists(
         q in prop_oneof![fans(), star_fans()],
@@ -221,7 +241,8 @@ proptest! {
         let n = free[pick % free.len()];
         let k = q.len();
         let eligible = WingCandidates::all(k);
-        for kind in [0u8, 1] {
+        for (kind, ties) in [0u8, 1].into_iter().flat_map(|kind| Ties::ALL.map(|t| (kind, t))) {
+            pf.set_ties(ties);
             let (a, b) = if kind == 0 {
                 (n, [0, 0])
             } else {
@@ -231,7 +252,7 @@ proptest! {
             let xs: Vec<usize> = (0..k)
                 .filter(|&x| (0..k).any(|y| spec_pair(&q, a, b, kind, x, y)))
                 .collect();
-            let xs = spec_sorted(&q, a, b, xs);
+            let xs = spec_sorted(&q, a, b, ties, xs);
             // Each choice asked of a list just collected, and then all of
             // them of one list (the first choice after the others).
             for (u, &x) in xs.iter().enumerate() {
@@ -246,7 +267,7 @@ proptest! {
                 pf.order_xs(&eligible, &edge);
                 prop_assert_eq!(pf.rank_of_choice(xs.len(), x), Some(u));
                 let ys: Vec<usize> = (0..k).filter(|&y| spec_pair(&q, a, b, kind, x, y)).collect();
-                let ys = spec_sorted(&q, b, a, ys);
+                let ys = spec_sorted(&q, b, a, ties, ys);
                 prop_assert!(!ys.is_empty());
                 for (v, &y) in ys.iter().enumerate() {
                     prop_assert_eq!(pf.order_ys(&edge, x), ys.len());

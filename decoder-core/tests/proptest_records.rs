@@ -91,6 +91,7 @@ proptest! {
             wings: WingPolicy::Ranks,
             deficits: DeficitContexts::Plain,
             records: splitstream_decoder_core::RecordOrder::WingsFirst,
+            ties: splitstream_decoder_core::Ties::Ring,
             substreams: subs
                 .iter()
                 .map(|s| {

@@ -29,6 +29,8 @@ pub struct Level {
     pub deficits: DeficitContexts,
     /// The level's record order (SPEC §5.1, 3.7).
     pub records: splitstream_decoder_core::RecordOrder,
+    /// Its wing choices' tie rule under `positions-first` (SPEC §5.1, 3.8).
+    pub ties: splitstream_decoder_core::Ties,
     /// The rounds' substreams, ids 1..=7.
     pub substreams: Vec<Vec<u8>>,
     pub vertex_count: u32,
@@ -86,6 +88,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
             wings: lh.wing_policy,
             deficits: lh.deficit_contexts,
             records: lh.record_order,
+            ties: lh.ties,
             substreams,
             vertex_count: info.vertex_count,
             triangle_count: info.triangle_count,
@@ -135,6 +138,7 @@ pub fn reframe(u: &Unframed) -> Vec<u8> {
             wings: l.wings,
             deficits: l.deficits,
             records: l.records,
+            ties: l.ties,
             substreams: writers(&l.substreams),
             vertex_count: l.vertex_count,
             triangle_count: l.triangle_count,

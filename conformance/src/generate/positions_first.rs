@@ -1,10 +1,11 @@
-//! Vectors of the record order `positions-first` (SPEC §5.1, §7.4,
-//! format 3.7): terrains whose records read the new vertex first, with
-//! and without boundaries, under both schedules and codecs, a stream whose
-//! fans all escape, and the faults a decoder must find in them.
+//! Vectors of the record orders that read positions first (SPEC §5.1,
+//! §7.4, formats 3.7 and 3.8): terrains whose records read the new vertex
+//! first, with and without boundaries, under both schedules and codecs,
+//! under each tie rule, a stream whose fans all escape, and the faults a
+//! decoder must find in them.
 
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{DeficitContexts, PositionMode, RecordOrder, Schedule};
+use splitstream_decoder_core::{DeficitContexts, PositionMode, RecordOrder, Schedule, Ties};
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::EncodeOptions;
 
@@ -87,7 +88,7 @@ pub(super) fn positions_first_valid(s: &mut Specs) {
     );
     s.valid(
         "positions-first-stepped-terrain",
-        "40x40 height field of whole-unit heights 0..3 read positions first (3.7): many free points at equal distances from the ring's centroid (ties by y, then x) and cocircular wings (ties by ring position).",
+        "40x40 height field of whole-unit heights 0..3 read positions first (3.7, 3.8): many free points at equal distances from the ring's centroid (ties by y, then x) and cocircular wings (ties by the level's rule, the encoder's choice).",
         &["encoded", "terrain", "rans", "positions-first", "ties"],
         encoded(
             &meshes::checked(meshes::stepped_grid(40, 40, 1), "stepped grid"),
@@ -98,6 +99,40 @@ pub(super) fn positions_first_valid(s: &mut Specs) {
             }),
         ),
     );
+    for (ties, name, why) in [
+        (
+            Ties::Ring,
+            "positions-first-terrain-ties-ring",
+            "record order 1 in every level, its cocircular wing choices by ring position (a 3.7 stream)",
+        ),
+        (
+            Ties::Rising,
+            "positions-first-terrain-ties-rising",
+            "record order 2 in every level (3.8): of cocircular wing choices, those whose new edges would run along the falling diagonal last; the terrain's cells are split along the rising one",
+        ),
+        (
+            Ties::Falling,
+            "positions-first-terrain-ties-falling",
+            "record order 3 in every level (3.8): of cocircular wing choices, those whose new edges would run along the rising diagonal last, against the terrain's own cells",
+        ),
+    ] {
+        s.valid(
+            name,
+            &format!(
+                "33x33 fractal terrain read positions first, rANS, the tie rule forced: {why}."
+            ),
+            &["encoded", "terrain", "rans", "positions-first", "ties"],
+            encoded(
+                &terrain(),
+                positions_first(EncodeOptions {
+                    codec: ChunkCodec::RansAlways { lanes: 4 },
+                    schedule: Schedule::EveryVertex,
+                    ties: Some(ties),
+                    ..opts()
+                }),
+            ),
+        );
+    }
     s.valid(
         "positions-first-all-escapes",
         "33x33 fractal terrain at 20 bits per axis, its x and y not kept on the raster's lattice: every fan's bounding box holds more than 1,024 lattice points, so every record of the positions-first levels is read wings first (an escape without a kind, SPEC §7.4).",
@@ -136,13 +171,16 @@ fn first_failing(
 pub(super) fn positions_first_invalid(s: &mut Specs) {
     let subject = deflated_terrain();
     let record_at = |k: u16| plane_policy_at(&subject, k) + 3;
-    assert_eq!(subject[record_at(1)], 1, "level 1 is read positions first");
+    assert!(
+        (1..=3).contains(&subject[record_at(1)]),
+        "level 1 is read positions first"
+    );
     s.invalid(
-        "record-order-2",
+        "record-order-4",
         "malformed",
-        "Level 1's record order (level header byte 11) is 2, a reserved value (level header CRC recomputed).",
+        "Level 1's record order (level header byte 11) is 4, a reserved value (2 and 3 are the tie rules of 3.8; level header CRC recomputed).",
         &["positions-first", "level-header"],
-        with_level_header_byte(&subject, 1, record_at(1), 2),
+        with_level_header_byte(&subject, 1, record_at(1), 4),
     );
     s.invalid(
         "positions-first-plane-off",

@@ -25,7 +25,7 @@ use splitstream_decoder_core::handmade;
 use splitstream_decoder_core::limits::{LEAF, NONE};
 use splitstream_decoder_core::pipe::{InPlacePipe, PendingSplit, PendingSplits};
 use splitstream_decoder_core::positions_first::{
-    self, KIND_CONTEXT, KIND_ESCAPE, NewEdge, OFFSET_CONTEXT, PositionsFirst, Z_CONTEXT,
+    self, KIND_CONTEXT, KIND_ESCAPE, NewEdge, OFFSET_CONTEXT, PositionsFirst, Ties, Z_CONTEXT,
     choice_context, rank_context,
 };
 use splitstream_decoder_core::predict::wrap;
@@ -198,8 +198,10 @@ struct GenSource<'g, 'c> {
     plane: PlanePolicy,
     wings: WingPolicy,
     deficits: DeficitContexts,
-    /// The level's record order (3.7) and the positions-first scratch.
+    /// The level's record order (3.7), its tie rule (3.8) and the
+    /// positions-first scratch.
     records: RecordOrder,
+    ties: Ties,
     pf: PositionsFirst,
     bits: u8,
     allow_invalid: bool,
@@ -358,6 +360,7 @@ impl GenSource<'_, '_> {
         // Every pair, as ranks, whose wings still have a deficit left.
         let eligible = state.wing_candidates(ring);
         let v = ring.vertices();
+        self.pf.set_ties(self.ties);
         let nx = self.pf.order_xs(&eligible, &edge);
         let xs: Vec<usize> = (0..nx).filter_map(|u| self.pf.choice(nx, u)).collect();
         let mut pairs = Vec::new();
@@ -685,6 +688,12 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         } else {
             RecordOrder::WingsFirst
         };
+        // Its tie rule (3.8) by the level's index, again without a choice.
+        let ties = if records == RecordOrder::PositionsFirst {
+            Ties::ALL[levels.len() % Ties::ALL.len()]
+        } else {
+            Ties::Ring
+        };
         let rounds = 3 - choices.below(3);
         for _ in 0..rounds {
             let n = state.vertex_count();
@@ -753,6 +762,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                 wings,
                 deficits,
                 records,
+                ties,
                 pf: PositionsFirst::default(),
                 bits,
                 allow_invalid,
@@ -768,6 +778,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                         wings,
                         deficits,
                         records,
+                        ties,
                         substreams: subs,
                         vertex_count: n + declared,
                         triangle_count: state.triangle_count() + remaining,
@@ -788,6 +799,7 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
             wings,
             deficits,
             records,
+            ties,
             substreams: subs,
             vertex_count: state.vertex_count(),
             triangle_count: state.triangle_count(),
@@ -1058,7 +1070,8 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
             )
         })
         .collect();
-    let mut records: Vec<RecordOrder> = g.levels.iter().map(|l| l.records).collect();
+    let mut records: Vec<(RecordOrder, Ties)> =
+        g.levels.iter().map(|l| (l.records, l.ties)).collect();
     let mut n_ops = 0;
     while !ops.exhausted() && n_ops < 32 {
         n_ops += 1;
@@ -1166,9 +1179,21 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                     1 => meta[l].4 = WingPolicy::ALL[ops.below(WingPolicy::ALL.len())],
                     2 => meta[l].5 = DeficitContexts::ALL[ops.below(DeficitContexts::ALL.len())],
                     _ => {
+                        // The next of wings first and positions first
+                        // under each tie rule.
                         records[l] = match records[l] {
-                            RecordOrder::WingsFirst => RecordOrder::PositionsFirst,
-                            RecordOrder::PositionsFirst => RecordOrder::WingsFirst,
+                            (RecordOrder::WingsFirst, _) => {
+                                (RecordOrder::PositionsFirst, Ties::Ring)
+                            }
+                            (RecordOrder::PositionsFirst, Ties::Ring) => {
+                                (RecordOrder::PositionsFirst, Ties::Rising)
+                            }
+                            (RecordOrder::PositionsFirst, Ties::Rising) => {
+                                (RecordOrder::PositionsFirst, Ties::Falling)
+                            }
+                            (RecordOrder::PositionsFirst, Ties::Falling) => {
+                                (RecordOrder::WingsFirst, Ties::Ring)
+                            }
                         }
                     }
                 }
@@ -1190,7 +1215,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
         .map(
             |(
                 (s, (round_splits, vertex_count, triangle_count, plane, wings, deficits)),
-                records,
+                (records, ties),
             )| {
                 LevelPayload {
                     round_splits,
@@ -1198,6 +1223,7 @@ pub fn mutate_levels(g: &Generated, ops: &mut Choices<'_>) -> (StreamParams, Vec
                     wings,
                     deficits,
                     records,
+                    ties,
                     substreams: s
                         .into_iter()
                         .map(|b| {

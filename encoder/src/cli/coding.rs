@@ -2,9 +2,11 @@
 //! `transcode` share.
 
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{DeficitContexts, PlanePolicy, RecordOrder, Schedule, WingPolicy};
+use splitstream_decoder_core::{
+    DeficitContexts, PlanePolicy, RecordOrder, Schedule, Ties, WingPolicy,
+};
 
-use super::{CliResult, Codec, DeficitsArg, PlaneArg, RecordsArg, ScheduleArg, WingsArg};
+use super::{CliResult, Codec, DeficitsArg, PlaneArg, RecordsArg, ScheduleArg, TiesArg, WingsArg};
 use splitstream_encoder::emit::check_coding;
 
 #[derive(clap::Args)]
@@ -49,6 +51,13 @@ pub struct CodingArgs {
     /// smaller per level.
     #[arg(long, value_enum, default_value_t = RecordsArg::Auto)]
     pub records: RecordsArg,
+    /// How a positions-first level orders wing choices that see the new
+    /// edge under the same angle: `ring` by ring position (format 3.7), or
+    /// `rising`/`falling`, choices whose new edges would run along the
+    /// other diagonal of the raster's cells last (format 3.8) (SPEC §7.4);
+    /// `auto` picks the cheapest per level.
+    #[arg(long, value_enum, default_value_t = TiesArg::Auto)]
+    pub ties: TiesArg,
     /// How the stream says which vertices split in which round:
     /// `every-vertex`, a flag for every vertex (format 3.6, smaller), or
     /// `split-valences`, the paper's split valences (read by every 3.x
@@ -87,6 +96,10 @@ impl CodingArgs {
 
     pub fn records(&self) -> Option<RecordOrder> {
         self.records.order()
+    }
+
+    pub fn ties(&self) -> Option<Ties> {
+        self.ties.ties()
     }
 
     pub fn schedule(&self) -> Schedule {

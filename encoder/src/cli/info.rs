@@ -231,7 +231,7 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
                         lh.plane_policy.name(),
                         lh.wing_policy.name(),
                         deficits,
-                        lh.record_order.name(),
+                        lh.record_order.name_with(lh.ties),
                     )
                 })
         })
@@ -395,12 +395,12 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
         header.max_chunk_len
     );
     println!(
-        "  level    offset     bytes   vertices  triangles rounds  plane     wings    deficits  records          decoder memory  geometric error"
+        "  level    offset     bytes   vertices  triangles rounds  plane     wings    deficits  records                  decoder memory  geometric error"
     );
     for k in 0..table.len() {
         let e = table.get(k);
         println!(
-            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:<8} {:<15} {:>15}  {:.6}",
+            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:<8} {:<23} {:>15}  {:.6}",
             k,
             e.offset,
             e.length,

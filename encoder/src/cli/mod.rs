@@ -194,6 +194,34 @@ impl RecordsArg {
     }
 }
 
+/// How a positions-first level breaks its wing choices' ties (SPEC §5.1,
+/// §7.4; format 3.8).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum TiesArg {
+    /// Per level, the rule whose wings code smallest.
+    #[default]
+    Auto,
+    /// By ring position alone (3.7).
+    Ring,
+    /// Fewer new edges along the falling diagonal first: cells split along
+    /// the rising one.
+    Rising,
+    /// Fewer new edges along the rising diagonal first.
+    Falling,
+}
+
+impl TiesArg {
+    pub fn ties(self) -> Option<splitstream_decoder_core::Ties> {
+        use splitstream_decoder_core::Ties;
+        match self {
+            TiesArg::Auto => None,
+            TiesArg::Ring => Some(Ties::Ring),
+            TiesArg::Rising => Some(Ties::Rising),
+            TiesArg::Falling => Some(Ties::Falling),
+        }
+    }
+}
+
 /// How a stream says which vertices split in which round (SPEC §3.2).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum ScheduleArg {

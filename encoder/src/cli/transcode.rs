@@ -30,6 +30,7 @@ pub fn run(a: Args) -> CliResult {
         plane: a.coding.plane(),
         wings: a.coding.wings(),
         records: a.coding.records(),
+        ties: a.coding.ties(),
         deficits: a.coding.deficits(),
         schedule: a.coding.schedule(),
     };

@@ -14,7 +14,7 @@ mod wings;
 use splitstream_decoder_core::limits::rans::MAX_LANES;
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
 use splitstream_decoder_core::{
-    DeficitContexts, PlanePolicy, PositionMode, RecordOrder, Schedule, WingPolicy,
+    DeficitContexts, PlanePolicy, PositionMode, RecordOrder, Schedule, Ties, WingPolicy,
 };
 
 use crate::input::{MeshError, MeshStats, check_mesh};
@@ -89,6 +89,10 @@ pub struct EncodeOptions {
     /// mode, the plane policy and the wing policy not forced to others
     /// than `height` and `ranks`) and smaller.
     pub records: Option<RecordOrder>,
+    /// How every positions-first level breaks its wing choices' ties
+    /// (SPEC §5.1, §7.4, format 3.8); `None`: per level, the rule whose
+    /// wings code smallest.
+    pub ties: Option<Ties>,
     /// How the stream says which vertices split in which round (SPEC
     /// §3.2): by default `every-vertex` (format 3.6), the smaller.
     pub schedule: Schedule,
@@ -115,6 +119,7 @@ impl Default for EncodeOptions {
             wings: None,
             deficits: None,
             records: None,
+            ties: None,
             schedule: Schedule::EveryVertex,
         }
     }
@@ -368,6 +373,7 @@ fn encode_checked(
             wings: options.wings,
             deficits: options.deficits,
             records: options.records,
+            ties: options.ties,
             final_hash: false,
         },
     )

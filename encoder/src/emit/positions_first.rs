@@ -17,7 +17,7 @@ use splitstream_decoder_core::positions_first::{
 };
 use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter, coded_len_under};
 use splitstream_decoder_core::{
-    DeficitContexts, RecordOrder, Ring, Target, WingCandidates, context, height_prediction,
+    DeficitContexts, RecordOrder, Ring, Target, Ties, WingCandidates, context, height_prediction,
 };
 
 use splitstream_decoder_core::predict::wrap;
@@ -31,8 +31,13 @@ use super::policies::ranking_params;
 pub struct PositionsFirstCoding {
     pf: PositionsFirst,
     /// Substreams 2, 3, 6 and 7 (wing-offset, wing-distance, edge,
-    /// placement) of the level under this order.
+    /// placement) of the level under this order; the wing ranks of the
+    /// first two are those under [`Ties::Ring`].
     subs: [SubstreamWriter; 4],
+    /// The wing-offset and wing-distance substreams under the other tie
+    /// rules ([`Ties::Rising`], [`Ties::Falling`]): the level keeps the
+    /// rule whose wings code smallest (SPEC §5.1, §7.4; 3.8).
+    diagonal_wings: [[SubstreamWriter; 2]; 2],
     /// Splits read positions first, and escapes.
     pub named: usize,
     pub escaped: usize,
@@ -81,9 +86,13 @@ impl PositionsFirstCoding {
                 if let Some(t) = named.offset {
                     placement.byte_in(OFFSET_CONTEXT, t);
                 }
-                offset.byte_in(choice_context(named.xs), named.u as u8);
-                distance.byte_in(choice_context(named.ys), named.v as u8);
+                offset.byte_in(choice_context(named.xs), named.u[0] as u8);
+                distance.byte_in(choice_context(named.ys), named.v[0] as u8);
                 edge.signed_in(Z_CONTEXT, named.r_z as i32);
+                for (t, [offset, distance]) in self.diagonal_wings.iter_mut().enumerate() {
+                    offset.byte_in(choice_context(named.xs), named.u[t + 1] as u8);
+                    distance.byte_in(choice_context(named.ys), named.v[t + 1] as u8);
+                }
                 self.named += 1;
             }
             Err(has_free_points) => {
@@ -93,6 +102,10 @@ impl PositionsFirstCoding {
                 let [offset, distance, edge, placement] = &mut self.subs;
                 offset.byte_in(escape.wing_context, escape.ranks.0);
                 distance.byte_in(escape.wing_context, escape.ranks.1);
+                for [offset, distance] in &mut self.diagonal_wings {
+                    offset.byte_in(escape.wing_context, escape.ranks.0);
+                    distance.byte_in(escape.wing_context, escape.ranks.1);
+                }
                 placement.byte_in(escape.placement_context, s.code);
                 for (axis, &r) in escape.vector.iter().enumerate() {
                     edge.signed_in(axis as u8, r as i32);
@@ -154,10 +167,19 @@ impl PositionsFirstCoding {
             }
         };
         let rank = self.pf.rank_of(n)?;
+        // The lists do not depend on the tie rule, only their order.
         let xs = self.pf.order_xs(s.eligible, &edge);
-        let u = self.pf.rank_of_choice(xs, pair.0)?;
+        let mut u = [0; 3];
+        for (u, ties) in u.iter_mut().zip(Ties::ALL) {
+            self.pf.set_ties(ties);
+            *u = self.pf.rank_of_choice(xs, pair.0)?;
+        }
         let ys = self.pf.order_ys(&edge, pair.0);
-        let v = self.pf.rank_of_choice(ys, pair.1)?;
+        let mut v = [0; 3];
+        for (v, ties) in v.iter_mut().zip(Ties::ALL) {
+            self.pf.set_ties(ties);
+            *v = self.pf.rank_of_choice(ys, pair.1)?;
+        }
         // z: the fan's surface at the new x and y, or 0 where no wedge
         // holds it.
         let target = Target::of_code(s.code)?;
@@ -181,26 +203,66 @@ impl PositionsFirstCoding {
     }
 
     /// The four substreams' cost under `params`' ranking parameters, in a
-    /// positions-first level.
-    pub fn cost(&self, params: &StreamParams) -> usize {
-        let ranking = ranking_params(params);
-        IDS.par_iter()
-            .zip(&self.subs)
-            .map(|(&id, sub)| {
-                coded_len_under(
-                    sub,
-                    id,
-                    DeficitContexts::Plain,
-                    RecordOrder::PositionsFirst,
-                    &ranking,
-                )
-            })
-            .sum()
+    /// positions-first level, with the wings under the tie rule that codes
+    /// them smallest (the lowest rule of equal cost: `ring` keeps the
+    /// stream readable by 3.7 decoders); and that rule.
+    pub fn cost(&self, params: &StreamParams) -> (usize, Ties) {
+        self.costs(params, None)
     }
 
-    /// Puts the four substreams into `subs` (ids 1..=7 at 0..=6).
-    pub fn install(self, subs: &mut [SubstreamWriter]) {
-        for (id, sub) in IDS.into_iter().zip(self.subs) {
+    /// [`Self::cost`] with the wings under `ties`.
+    pub fn cost_under(&self, params: &StreamParams, ties: Ties) -> usize {
+        self.costs(params, Some(ties)).0
+    }
+
+    fn costs(&self, params: &StreamParams, only: Option<Ties>) -> (usize, Ties) {
+        let ranking = ranking_params(params);
+        let cost = |id: u8, sub: &SubstreamWriter| {
+            coded_len_under(
+                sub,
+                id,
+                DeficitContexts::Plain,
+                RecordOrder::PositionsFirst,
+                &ranking,
+            )
+        };
+        let [offset, distance, edge, placement] = &self.subs;
+        let [rising, falling] = &self.diagonal_wings;
+        let wings: Vec<[&SubstreamWriter; 2]> = vec![
+            [offset, distance],
+            [&rising[0], &rising[1]],
+            [&falling[0], &falling[1]],
+        ];
+        let (rest, wing_costs) = rayon::join(
+            || cost(IDS[EDGE], edge) + cost(IDS[PLACEMENT], placement),
+            || {
+                wings
+                    .par_iter()
+                    .map(|[o, d]| cost(IDS[WING_OFFSET], o) + cost(IDS[WING_DISTANCE], d))
+                    .collect::<Vec<usize>>()
+            },
+        );
+        let (best, wing_cost) = wing_costs
+            .iter()
+            .enumerate()
+            .filter(|&(t, _)| only.is_none_or(|ties| ties == Ties::ALL[t]))
+            .min_by_key(|&(t, &c)| (c, t))
+            .map(|(t, &c)| (Ties::ALL[t], c))
+            .unwrap_or((Ties::Ring, 0));
+        (rest + wing_cost, best)
+    }
+
+    /// Puts the four substreams into `subs` (ids 1..=7 at 0..=6), the wings
+    /// those under `ties`.
+    pub fn install(self, ties: Ties, subs: &mut [SubstreamWriter]) {
+        let [offset, distance, edge, placement] = self.subs;
+        let [rising, falling] = self.diagonal_wings;
+        let [offset, distance] = match ties {
+            Ties::Ring => [offset, distance],
+            Ties::Rising => rising,
+            Ties::Falling => falling,
+        };
+        for (id, sub) in IDS.into_iter().zip([offset, distance, edge, placement]) {
             subs[(id - substream::FLAGS) as usize] = sub;
         }
     }
@@ -229,9 +291,10 @@ struct Named {
     rank: usize,
     offset: Option<u8>,
     xs: usize,
-    u: usize,
+    /// The ranks of the wings under each rule of [`Ties::ALL`].
+    u: [usize; 3],
     ys: usize,
-    v: usize,
+    v: [usize; 3],
     r_z: i64,
 }
 

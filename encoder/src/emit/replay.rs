@@ -10,7 +10,8 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     CornerRefs, DeficitContexts, Error, MeshState, PlanePolicy, PositionMode, RecordOrder,
-    RecordSource, Ring, Schedule, SplitOutcome, SplitRecord, StateMemory, WingPolicy, context,
+    RecordSource, Ring, Schedule, SplitOutcome, SplitRecord, StateMemory, Ties, WingPolicy,
+    context,
 };
 
 use std::sync::mpsc;
@@ -72,6 +73,9 @@ pub struct ReplayOptions {
     /// level's cheaper where `positions-first` is allowed
     /// ([`positions_first_allowed`]).
     pub records: Option<RecordOrder>,
+    /// The tie rule of every positions-first level (format 3.8); by
+    /// default each level's cheapest.
+    pub ties: Option<Ties>,
     /// Whether to hash the final state (SPEC §8; a serial pass over the
     /// whole state, about 45 ms on the 1M terrain, which `encode` does not
     /// need and `transcode` compares).
@@ -335,6 +339,7 @@ pub fn replay(
         wings: wing_policy,
         deficits: deficit_contexts,
         records,
+        ties: forced_ties,
         final_hash,
     } = options;
     // Positions first is tried where the level could declare it: in
@@ -407,163 +412,162 @@ pub fn replay(
     // level run on another while the next level replays (same bytes: the
     // replay itself is sequential).
     let seed_ref = &seed;
-    let done =
-        std::thread::scope(|scope| -> LevelsAndHash {
-            let mut choosing = Vec::with_capacity(plan.rounds.len());
-            let mut input_sorted = None;
-            for (l, steps) in plan.rounds.iter().enumerate() {
-                if l + 1 == plan.rounds.len() {
-                    // The input's side of the exactness check needs nothing
-                    // from the replay: it is sorted beside the last level,
-                    // whose replay leaves the other core mostly idle once the
-                    // level's policies are chosen.
-                    input_sorted = Some(scope.spawn(|| sorted_canonical(&mesh.triangles, None)));
-                }
-                let mut subs = vec![SubstreamWriter::default(); 7];
-                // Under `every-vertex` no split valences are coded, and the
-                // level header says `plain` (SPEC §5.1, 3.6).
-                let mut deficit_coding = DeficitCoding::new(match params.schedule {
-                    Schedule::SplitValences => deficit_contexts,
-                    Schedule::EveryVertex => Some(DeficitContexts::Plain),
-                });
-                // The level's split geometry goes round by round to a thread
-                // that codes the wings and computes the residual vectors, and
-                // they on to a thread that codes them under every plane policy.
-                let (batches, coded_batches) = mpsc::channel();
-                let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
-                let coder =
-                    scope.spawn(move || code_policies(coded_batches, params, plane, splits));
-                let (geometry_batches, geometry_in) = geometry_channels();
-                let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
-                let wing_coding = WingCoding::new(wing_policy);
-                let positions_first = try_positions_first.then(PositionsFirstCoding::default);
-                let geometry_coder = scope.spawn(move || {
-                    code_geometry(
-                        geometry_in,
-                        batches,
-                        wing_coding,
-                        positions_first,
-                        params,
-                        splits,
-                        heights,
-                    )
-                });
-                let mut geometry = GeometryBatch::new();
-                let mut round_splits = Vec::with_capacity(steps.len());
-                // A large level chooses its deficit contexts after the round
-                // that completes its first eighth, as it chooses its plane and
-                // wing policies (`policies::EARLY_CHOICE_SPLITS`); the symbols
-                // after it are written in the chosen contexts only.
-                let (mut early, mut seen) = (early_choice_at(splits), 0);
-                for &k in steps {
-                    let collapses = &s.steps[k];
-                    flagged.clear();
-                    wings.clear();
-                    let dec = |enc: u32| {
-                        if enc == NONE {
-                            NONE
-                        } else {
-                            enc2dec[enc as usize]
-                        }
-                    };
-                    for (i, col) in collapses.iter().enumerate() {
-                        let r = enc2dec[col.p as usize];
-                        current[r as usize] = i as u32;
-                        flagged.push(r);
-                        wings.push([dec(col.wing_a), dec(col.wing_b)]);
-                    }
-                    let mut source = StepSource {
-                        collapses,
-                        wings: &wings,
-                        current: &mut current,
-                        enc2dec: &mut enc2dec,
-                        dec2enc: &mut dec2enc,
-                        subs: &mut subs,
-                        deficit_coding: &mut deficit_coding,
-                        geometry: &mut geometry,
-                        geometry_out: &geometry_batches,
-                        pending: None,
-                        swapped: false,
-                        problem: None,
-                    };
-                    let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
-                    if let Err(e) = result {
-                        let why = source.problem.take().unwrap_or_else(|| e.to_string());
-                        return Err(ReplayError(format!("step {k}: {why}")));
-                    }
-                    for &r in &flagged {
-                        current[r as usize] = NONE;
-                    }
-                    round_splits.push(collapses.len() as u32);
-                    seen += collapses.len();
-                    if early.is_some_and(|at| seen >= at) {
-                        early = None;
-                        deficit_coding.choose_early(params);
-                    }
-                }
-                let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
-                let geometric_error = plan.errors[l];
-                geometry_batches.send(&mut geometry);
-                drop(geometry_batches);
-                choosing.push(scope.spawn(move || {
-                    let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
-                    let LevelGeometry {
-                        wings: wing_coding,
-                        placement,
-                        positions_first,
-                    } = geometry_coder
-                        .join()
-                        .expect("coding the split geometry does not panic")
-                        .map_err(level_error)?;
-                    if mode == PositionMode::Constrained {
-                        subs[slot(substream::PLACEMENT)] = placement;
-                    }
-                    let residuals = coder
-                        .join()
-                        .expect("coding residuals does not panic")
-                        .map_err(level_error)?;
-                    let plane = choose_policy(&mut subs, residuals, params, plane)
-                        .map_err(|why| level_error(why.to_string()))?;
-                    let wings = wing_coding.choose(&mut subs, params);
-                    let deficits = deficit_coding.choose(&mut subs, params);
-                    let (plane, wings, records) =
-                        choose_record_order(&mut subs, positions_first, params, records)
-                            .unwrap_or((plane, wings, RecordOrder::WingsFirst));
-                    let level = LevelPayload {
-                        round_splits,
-                        plane,
-                        wings,
-                        deficits,
-                        records,
-                        substreams: subs,
-                        vertex_count,
-                        triangle_count,
-                        geometric_error,
-                    };
-                    // The level's chunks are coded in parallel (same bytes).
-                    let parallel = |n: usize, job: &(dyn Fn(usize) -> Chunk + Sync)| {
-                        (0..n).into_par_iter().map(job).collect()
-                    };
-                    let framed =
-                        frame_level_with(&level, (l == 0).then_some(seed_ref), params, &parallel);
-                    Ok((level, framed))
-                }));
+    let done = std::thread::scope(|scope| -> LevelsAndHash {
+        let mut choosing = Vec::with_capacity(plan.rounds.len());
+        let mut input_sorted = None;
+        for (l, steps) in plan.rounds.iter().enumerate() {
+            if l + 1 == plan.rounds.len() {
+                // The input's side of the exactness check needs nothing
+                // from the replay: it is sorted beside the last level,
+                // whose replay leaves the other core mostly idle once the
+                // level's policies are chosen.
+                input_sorted = Some(scope.spawn(|| sorted_canonical(&mesh.triangles, None)));
             }
-            // The replay is over: check it (and hash it, if asked) while the last levels
-            // are still being chosen and framed.
-            let input_sorted =
-                input_sorted.map(|h| h.join().expect("sorting triangles does not panic"));
-            let (checked, hash) = rayon::join(
-                || check_exact(mesh, &state, &dec2enc, input_sorted),
-                || final_hash.then(|| state.state_hash()),
-            );
-            let checked = checked.map(|()| hash);
-            let levels = choosing
-                .into_iter()
-                .map(|h| h.join().expect("choosing a plane policy does not panic"))
-                .collect::<Result<Vec<_>, _>>()?;
-            Ok((levels, checked?))
-        })?;
+            let mut subs = vec![SubstreamWriter::default(); 7];
+            // Under `every-vertex` no split valences are coded, and the
+            // level header says `plain` (SPEC §5.1, 3.6).
+            let mut deficit_coding = DeficitCoding::new(match params.schedule {
+                Schedule::SplitValences => deficit_contexts,
+                Schedule::EveryVertex => Some(DeficitContexts::Plain),
+            });
+            // The level's split geometry goes round by round to a thread
+            // that codes the wings and computes the residual vectors, and
+            // they on to a thread that codes them under every plane policy.
+            let (batches, coded_batches) = mpsc::channel();
+            let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
+            let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
+            let (geometry_batches, geometry_in) = geometry_channels();
+            let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
+            let wing_coding = WingCoding::new(wing_policy);
+            let positions_first = try_positions_first.then(PositionsFirstCoding::default);
+            let geometry_coder = scope.spawn(move || {
+                code_geometry(
+                    geometry_in,
+                    batches,
+                    wing_coding,
+                    positions_first,
+                    params,
+                    splits,
+                    heights,
+                )
+            });
+            let mut geometry = GeometryBatch::new();
+            let mut round_splits = Vec::with_capacity(steps.len());
+            // A large level chooses its deficit contexts after the round
+            // that completes its first eighth, as it chooses its plane and
+            // wing policies (`policies::EARLY_CHOICE_SPLITS`); the symbols
+            // after it are written in the chosen contexts only.
+            let (mut early, mut seen) = (early_choice_at(splits), 0);
+            for &k in steps {
+                let collapses = &s.steps[k];
+                flagged.clear();
+                wings.clear();
+                let dec = |enc: u32| {
+                    if enc == NONE {
+                        NONE
+                    } else {
+                        enc2dec[enc as usize]
+                    }
+                };
+                for (i, col) in collapses.iter().enumerate() {
+                    let r = enc2dec[col.p as usize];
+                    current[r as usize] = i as u32;
+                    flagged.push(r);
+                    wings.push([dec(col.wing_a), dec(col.wing_b)]);
+                }
+                let mut source = StepSource {
+                    collapses,
+                    wings: &wings,
+                    current: &mut current,
+                    enc2dec: &mut enc2dec,
+                    dec2enc: &mut dec2enc,
+                    subs: &mut subs,
+                    deficit_coding: &mut deficit_coding,
+                    geometry: &mut geometry,
+                    geometry_out: &geometry_batches,
+                    pending: None,
+                    swapped: false,
+                    problem: None,
+                };
+                let result = state.run_round(collapses.len() as u32, &mut source, &mut ring);
+                if let Err(e) = result {
+                    let why = source.problem.take().unwrap_or_else(|| e.to_string());
+                    return Err(ReplayError(format!("step {k}: {why}")));
+                }
+                for &r in &flagged {
+                    current[r as usize] = NONE;
+                }
+                round_splits.push(collapses.len() as u32);
+                seen += collapses.len();
+                if early.is_some_and(|at| seen >= at) {
+                    early = None;
+                    deficit_coding.choose_early(params);
+                }
+            }
+            let (vertex_count, triangle_count) = (state.vertex_count(), state.triangle_count());
+            let geometric_error = plan.errors[l];
+            geometry_batches.send(&mut geometry);
+            drop(geometry_batches);
+            choosing.push(scope.spawn(move || {
+                let level_error = |why: String| ReplayError(format!("level {l}: {why}"));
+                let LevelGeometry {
+                    wings: wing_coding,
+                    placement,
+                    positions_first,
+                } = geometry_coder
+                    .join()
+                    .expect("coding the split geometry does not panic")
+                    .map_err(level_error)?;
+                if mode == PositionMode::Constrained {
+                    subs[slot(substream::PLACEMENT)] = placement;
+                }
+                let residuals = coder
+                    .join()
+                    .expect("coding residuals does not panic")
+                    .map_err(level_error)?;
+                let plane = choose_policy(&mut subs, residuals, params, plane)
+                    .map_err(|why| level_error(why.to_string()))?;
+                let wings = wing_coding.choose(&mut subs, params);
+                let deficits = deficit_coding.choose(&mut subs, params);
+                let (plane, wings, records, ties) =
+                    choose_record_order(&mut subs, positions_first, params, records, forced_ties)
+                        .unwrap_or((plane, wings, RecordOrder::WingsFirst, Ties::Ring));
+                let level = LevelPayload {
+                    round_splits,
+                    plane,
+                    wings,
+                    deficits,
+                    records,
+                    ties,
+                    substreams: subs,
+                    vertex_count,
+                    triangle_count,
+                    geometric_error,
+                };
+                // The level's chunks are coded in parallel (same bytes).
+                let parallel = |n: usize, job: &(dyn Fn(usize) -> Chunk + Sync)| {
+                    (0..n).into_par_iter().map(job).collect()
+                };
+                let framed =
+                    frame_level_with(&level, (l == 0).then_some(seed_ref), params, &parallel);
+                Ok((level, framed))
+            }));
+        }
+        // The replay is over: check it (and hash it, if asked) while the last levels
+        // are still being chosen and framed.
+        let input_sorted =
+            input_sorted.map(|h| h.join().expect("sorting triangles does not panic"));
+        let (checked, hash) = rayon::join(
+            || check_exact(mesh, &state, &dec2enc, input_sorted),
+            || final_hash.then(|| state.state_hash()),
+        );
+        let checked = checked.map(|()| hash);
+        let levels = choosing
+            .into_iter()
+            .map(|h| h.join().expect("choosing a plane policy does not panic"))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok((levels, checked?))
+    })?;
     let (done, final_hash) = done;
     let (levels, framed) = done.into_iter().unzip();
     Ok(Replayed {
@@ -590,16 +594,20 @@ pub fn positions_first_allowed(
 
 /// The positions-first records of a level when they are forced, or when
 /// their four substreams code smaller than the wings-first ones already in
-/// `subs`: they replace those, and the level's plane and wing policies and
-/// record order are returned. `None` keeps the wings-first records.
+/// `subs`: they replace those, and the level's plane and wing policies,
+/// record order and tie rule are returned. `None` keeps the wings-first
+/// records.
 fn choose_record_order(
     subs: &mut [SubstreamWriter],
     positions_first: Option<PositionsFirstCoding>,
     params: &StreamParams,
     forced: Option<RecordOrder>,
-) -> Option<(PlanePolicy, WingPolicy, RecordOrder)> {
+    forced_ties: Option<Ties>,
+) -> Option<(PlanePolicy, WingPolicy, RecordOrder, Ties)> {
     let pf = positions_first?;
-    if forced != Some(RecordOrder::PositionsFirst) {
+    let ties = if forced == Some(RecordOrder::PositionsFirst) {
+        forced_ties.unwrap_or_else(|| pf.cost(params).1)
+    } else {
         // The eight substreams are costed in parallel: after the last
         // level's replay this is on the emission's critical path.
         let ranking = ranking_params(params);
@@ -625,17 +633,23 @@ fn choose_record_order(
                     })
                     .sum::<usize>()
             },
-            || pf.cost(params),
+            || match forced_ties {
+                Some(ties) => (pf.cost_under(params, ties), ties),
+                None => pf.cost(params),
+            },
         );
+        let (positions_first, ties) = positions_first;
         if positions_first >= wings_first {
             return None;
         }
-    }
-    pf.install(subs);
+        ties
+    };
+    pf.install(ties, subs);
     Some((
         PlanePolicy::Height,
         WingPolicy::Ranks,
         RecordOrder::PositionsFirst,
+        ties,
     ))
 }
 

@@ -17,7 +17,7 @@ use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, assemble_stream};
 use splitstream_decoder_core::{
     DeficitContexts, MeshState, PlanePolicy, RecordOrder, Ring, Schedule, SplitObserver,
-    SplitRecord, WingPolicy,
+    SplitRecord, Ties, WingPolicy,
 };
 
 use super::levels::LevelPlan;
@@ -46,6 +46,9 @@ pub struct TranscodeOptions {
     /// The record order of every level (format 3.7); `None`: chosen per
     /// level by size where positions first is allowed.
     pub records: Option<RecordOrder>,
+    /// The tie rule of every positions-first level (format 3.8); `None`:
+    /// chosen per level by size.
+    pub ties: Option<Ties>,
     /// The schedule of the stream written (SPEC §3.2), whatever the
     /// input's.
     pub schedule: Schedule,
@@ -64,6 +67,7 @@ impl Default for TranscodeOptions {
             wings: None,
             deficits: None,
             records: None,
+            ties: None,
             schedule: Schedule::EveryVertex,
         }
     }
@@ -141,6 +145,7 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
             wings: options.wings,
             deficits: options.deficits,
             records: options.records,
+            ties: options.ties,
             final_hash: true,
         },
     )
