@@ -54,6 +54,9 @@ fn options(choices: &mut Choices<'_>, input: Schedule, mode: PositionMode) -> Tr
         // The input's schedule, or the other one (SPEC §3.2).
         schedule,
         records,
+        // The tie rule (3.8): per level, the cheapest (no choice byte of its
+        // own, so that existing corpora keep their meaning).
+        ties: None,
     }
 }
 
