@@ -1190,6 +1190,30 @@ mod tests {
     }
 
     #[test]
+    fn record_order_byte_holds_the_order_and_the_ties() {
+        // SPEC §5.1 byte 11: 0 wings-first, 1 to 3 positions first under
+        // the tie rules ring, rising, falling (3.8); 4 and above reserved.
+        for b in 0..=255u8 {
+            let order = RecordOrder::from_byte(b);
+            assert_eq!(order.is_some(), b <= 3, "{b}");
+            if let Some(order) = order {
+                let ties = Ties::from_record_byte(b).unwrap_or_default();
+                assert_eq!(order.to_byte(ties), b);
+                assert_eq!(order == RecordOrder::PositionsFirst, b >= 1);
+            }
+        }
+        assert_eq!(RecordOrder::WingsFirst.to_byte(Ties::Falling), 0);
+        assert_eq!(
+            RecordOrder::PositionsFirst.name_with(Ties::Rising),
+            "positions-first-rising"
+        );
+        // The disfavoured diagonals.
+        assert!(Ties::Rising.off_diagonal([2, -2]) && !Ties::Rising.off_diagonal([2, 2]));
+        assert!(Ties::Falling.off_diagonal([-1, -1]) && !Ties::Falling.off_diagonal([1, -1]));
+        assert!(!Ties::Rising.off_diagonal([0, 0]) && !Ties::Ring.off_diagonal([1, -1]));
+    }
+
+    #[test]
     fn gcd_agrees_with_euclid() {
         let euclid = |mut a: u64, mut b: u64| {
             while b != 0 {

@@ -9,7 +9,7 @@ use roundtrip_check::assert_roundtrip;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{
     DeficitContexts, Header, LevelHeader, LevelTable, PlanePolicy, PositionMode, RecordOrder,
-    Schedule, WingPolicy,
+    Schedule, Ties, WingPolicy,
 };
 use splitstream_encoder::emit::{EncodeOptions, encode};
 use splitstream_encoder::quantize::{Lattice, Quantization, Units};
@@ -473,8 +473,9 @@ fn the_stream_does_not_depend_on_the_input_order() {
 /// Format 3.7's record order `positions-first`, forced in every level, on
 /// terrain with and without a boundary and on a closed mesh (whose fans
 /// fold over in xy: escapes), under both schedules and both codecs: the
-/// round trip is exact, the minor version is 7 and the level headers say
-/// so (SPEC §1, §5.1, §7.4).
+/// round trip is exact, the minor version is 7, or 8 where a level breaks
+/// its ties by a diagonal (3.8), and the level headers say so (SPEC §1,
+/// §5.1, §7.4).
 #[test]
 fn positions_first_roundtrips_and_sets_the_minor_version() {
     let meshes = [
@@ -494,9 +495,9 @@ fn positions_first_roundtrips_and_sets_the_minor_version() {
                 assert_roundtrip(mesh, &options);
                 let encoded = encode(mesh, &options, |_| {}).expect("encode");
                 let stream = &encoded.stream;
-                assert_eq!(stream[9], 7, "{schedule:?} {codec:?}");
                 let header = Header::parse(stream).expect("header");
                 let table = LevelTable::parse(stream, &header).expect("table");
+                let mut diagonal = false;
                 for k in 0..table.len() {
                     let e = table.get(k);
                     let bytes = &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
@@ -505,10 +506,58 @@ fn positions_first_roundtrips_and_sets_the_minor_version() {
                     assert_eq!(lh.record_order, RecordOrder::PositionsFirst);
                     assert_eq!(lh.plane_policy, PlanePolicy::Height);
                     assert_eq!(lh.wing_policy, WingPolicy::Ranks);
+                    diagonal |= lh.ties != Ties::Ring;
                 }
+                let minor = if diagonal { 8 } else { 7 };
+                assert_eq!(stream[9], minor, "{schedule:?} {codec:?}");
             }
         }
     }
+}
+
+/// Format 3.8's tie rules, each forced in every positions-first level of
+/// a terrain: the round trip is exact, every level declares the rule, and
+/// the minor version is 7 under `ring` (a 3.7 stream), 8 otherwise; by
+/// default the encoder keeps per level the rule that codes smallest, never
+/// larger than the others forced.
+#[test]
+fn every_tie_rule_roundtrips_and_the_default_is_the_smallest() {
+    let terrain = splitstream_encoder::input::fractal_terrain(40, 3);
+    let mut sizes = Vec::new();
+    for ties in Ties::ALL {
+        let options = EncodeOptions {
+            records: Some(RecordOrder::PositionsFirst),
+            ties: Some(ties),
+            ..EncodeOptions::default()
+        };
+        assert_roundtrip(&terrain, &options);
+        let stream = encode(&terrain, &options, |_| {}).expect("encode").stream;
+        let header = Header::parse(&stream).expect("header");
+        let table = LevelTable::parse(&stream, &header).expect("table");
+        for k in 0..table.len() {
+            let e = table.get(k);
+            let bytes = &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
+            let lh = LevelHeader::parse(bytes, k == 0, header.level_rules()).expect("level");
+            assert_eq!(lh.ties, ties, "level {k}");
+        }
+        let minor = if ties == Ties::Ring { 7 } else { 8 };
+        assert_eq!(stream[9], minor, "{ties:?}");
+        sizes.push(stream.len());
+    }
+    let options = EncodeOptions {
+        records: Some(RecordOrder::PositionsFirst),
+        ..EncodeOptions::default()
+    };
+    let chosen = encode(&terrain, &options, |_| {})
+        .expect("encode")
+        .stream
+        .len();
+    // A few bytes of slack: the rule is chosen by the wings' rANS sizes,
+    // and framing may then pick another codec for a chunk.
+    assert!(
+        chosen <= sizes.iter().min().unwrap() + 16,
+        "{chosen} against {sizes:?}"
+    );
 }
 
 /// By default a raster's levels read their records positions first where
