@@ -130,8 +130,9 @@ fn smaller_chunks_lower_the_workspace_and_keep_every_round() {
         assert!(long.stream.len() < short.stream.len(), "{name}");
         // Minor 6: the schedule every-vertex (the default, 3.6), a later
         // feature than 3.4's long rANS chunks; 7 where a level of the
-        // grid reads its records positions first (3.7, chosen by size).
-        let positions_first = long_header.version_minor == 7;
+        // grid reads its records positions first (3.7, chosen by size), 8
+        // where one also breaks its ties by a diagonal (3.8).
+        let positions_first = matches!(long_header.version_minor, 7 | 8);
         assert!(
             long_header.version_minor == 6 || (positions_first && name == "bumpy grid"),
             "{name}: minor {}",
