@@ -228,27 +228,34 @@ impl PositionsFirstCoding {
         };
         let [offset, distance, edge, placement] = &self.subs;
         let [rising, falling] = &self.diagonal_wings;
-        let wings: Vec<[&SubstreamWriter; 2]> = vec![
-            [offset, distance],
-            [&rising[0], &rising[1]],
-            [&falling[0], &falling[1]],
-        ];
+        // Only the forced rule's wings are costed when one is forced.
+        let wings: Vec<(Ties, [&SubstreamWriter; 2])> = [
+            (Ties::Ring, [offset, distance]),
+            (Ties::Rising, [&rising[0], &rising[1]]),
+            (Ties::Falling, [&falling[0], &falling[1]]),
+        ]
+        .into_iter()
+        .filter(|&(ties, _)| only.is_none_or(|forced| forced == ties))
+        .collect();
         let (rest, wing_costs) = rayon::join(
             || cost(IDS[EDGE], edge) + cost(IDS[PLACEMENT], placement),
             || {
                 wings
                     .par_iter()
-                    .map(|[o, d]| cost(IDS[WING_OFFSET], o) + cost(IDS[WING_DISTANCE], d))
-                    .collect::<Vec<usize>>()
+                    .map(|&(ties, [o, d])| {
+                        (
+                            cost(IDS[WING_OFFSET], o) + cost(IDS[WING_DISTANCE], d),
+                            ties,
+                        )
+                    })
+                    .collect::<Vec<(usize, Ties)>>()
             },
         );
-        let (best, wing_cost) = wing_costs
-            .iter()
-            .enumerate()
-            .filter(|&(t, _)| only.is_none_or(|ties| ties == Ties::ALL[t]))
-            .min_by_key(|&(t, &c)| (c, t))
-            .map(|(t, &c)| (Ties::ALL[t], c))
-            .unwrap_or((Ties::Ring, 0));
+        // The cheapest, the lowest rule of equal cost (`Ties::ALL` order).
+        let (wing_cost, best) = wing_costs
+            .into_iter()
+            .min_by_key(|&(c, ties)| (c, ties as u8))
+            .unwrap_or((0, Ties::Ring));
         (rest + wing_cost, best)
     }
 
