@@ -778,31 +778,33 @@ impl PositionsFirst {
     }
 
     /// Whether lattice point `p` (relative to R, in the bounding box) is
-    /// free: in a wedge, and neither R nor an entry (SPEC §7.4; the
-    /// wedges of a simple fan are all counter-clockwise).
+    /// free in a *simple* fan ([`Self::count_simple`]): in a wedge, and
+    /// neither R nor an entry (SPEC §7.4 `free_points`).
     fn is_free(&self, p: [i64; 2]) -> bool {
         if p == [0, 0] {
             return false;
         }
-        // p lies in the cone of wedge (a, b), which spans less than half a
-        // turn, when orient(0, a, p) ≥ 0 ≥ orient(0, b, p); in the wedge
-        // when also orient(a, b, p) ≥ 0. The cone's test is the next
-        // entry's first half, so each entry costs one orientation.
-        // Branch-free (`&`, `|`): which wedge holds p is data, and a
-        // branch on it mispredicted often; the wedge test costs less.
+        // The wedges of a simple fan are counter-clockwise, each spans less
+        // than half a turn, and together they turn once around R: every
+        // direction lies in the cone of some wedge (a, b), `orient(0, a, p)
+        // ≥ 0 ≥ orient(0, b, p)`, and p is in the fan exactly when it is in
+        // that wedge, `orient(a, b, p) ≥ 0`. Two cones share only a ray
+        // (through an entry), whose points both wedges hold alike (up to
+        // the entry), so any cone that holds p will do. The cone is found
+        // with one orientation per entry and a conditional move: which
+        // wedge holds p is data, and a branch on it mispredicted often.
         let k = self.k;
         let side = |i: usize| orient([0, 0], self.q(i), p);
         let first = side(0);
-        let (mut this, mut inside, mut entry) = (first, false, false);
+        let (mut this, mut wedge, mut entry) = (first, 0, false);
         for i in 0..k {
-            let a = self.q(i);
-            entry |= a == p;
-            let j = if i + 1 == k { 0 } else { i + 1 };
-            let next = if j == 0 { first } else { side(j) };
-            inside |= (this >= 0) & (next <= 0) & (orient(a, self.q(j), p) >= 0);
+            entry |= self.q(i) == p;
+            let next = if i + 1 == k { first } else { side(i + 1) };
+            wedge = if (this >= 0) & (next <= 0) { i } else { wedge };
             this = next;
         }
-        inside & !entry
+        let next = if wedge + 1 == k { 0 } else { wedge + 1 };
+        !entry & (orient(self.q(wedge), self.q(next), p) >= 0)
     }
 
     /// Prepares the tests of SPEC §7.4 `pair` for the new edge `e`: which
