@@ -11,15 +11,17 @@
 //! the round within it; the candidate's index; the flag; whether the
 //! candidate was created in this level (`new`) or in the round before
 //! (`fresh`); for how many rounds of this level just before this one it was
-//! already a candidate (`waited`; 0 for a vertex that was not), and how many
-//! of those flags were coded rather than inferred (`coded_before`).
+//! already a candidate (`waited`; 0 for a vertex that was not), how many
+//! of those flags were coded rather than inferred (`coded_before`), and its
+//! deficit at the start of the round (`deficit`; under the schedule
+//! `every-vertex` its valence, which gives the flag's context).
 
 use std::io::Write;
 
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::{Error, MeshState, Ring, SplitObserver, SplitRecord};
 
-const COLUMNS: &str = "level\tround\tv\tflag\tnew\tfresh\twaited\tcoded_before";
+const COLUMNS: &str = "level\tround\tv\tflag\tnew\tfresh\twaited\tcoded_before\tdeficit";
 
 /// The splits of one round, as the decoder shows them: the split vertex and
 /// its ring at round start.
@@ -85,6 +87,9 @@ fn write_flags(stream: &[u8], out: &mut dyn Write) -> Result<std::io::Result<()>
         loop {
             let before = level.state().vertex_count();
             let cands = candidates(level.state());
+            // Round-start deficits (under `every-vertex`, the valences:
+            // the flags' context, SPEC §5.5.5).
+            let deficits = level.state().deficits().to_vec();
             splits.rings.clear();
             if level.next_round_observed(&mut splits)?.is_none() {
                 break;
@@ -115,10 +120,11 @@ fn write_flags(stream: &[u8], out: &mut dyn Write) -> Result<std::io::Result<()>
                 if !is_inferred {
                     let line = writeln!(
                         out,
-                        "{k}\t{round}\t{v}\t{}\t{}\t{}\t{w}\t{coded}",
+                        "{k}\t{round}\t{v}\t{}\t{}\t{}\t{w}\t{coded}\t{}",
                         flagged[v as usize] as u8,
                         (v >= level_start) as u8,
                         (v >= fresh_from) as u8,
+                        deficits[v as usize],
                     );
                     if let Err(e) = line {
                         return Ok(Err(e));
