@@ -140,7 +140,7 @@ impl<S: RecordSource> RecordSource for SwapPositions<S> {
         self.0.flag(state, v)
     }
 
-    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u128 {
         self.0.likely_flags(state, upcoming)
     }
 

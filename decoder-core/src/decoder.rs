@@ -59,7 +59,7 @@ impl<S: RecordSource, O: SplitObserver> RecordSource for Observed<'_, S, O> {
     }
 
     #[inline(always)]
-    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u128 {
         self.source.likely_flags(state, upcoming)
     }
 }

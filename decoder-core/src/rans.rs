@@ -296,10 +296,10 @@ impl<'b> ChunkDecoder<'b> {
 
     /// The next bits as [`ChunkDecoder::decode`] would give them in
     /// `contexts`, one context per value, without consuming anything: `(bits,
-    /// count)`, bit i the i-th next value, `count` at most 64 and at most
+    /// count)`, bit i the i-th next value, `count` at most 128 and at most
     /// `remaining` (the values left in the chunk), and nothing from a value
     /// that is not a bit or fails. Works on copies of the lanes.
-    pub fn peek_bits(&self, bytes: &[u8], contexts: &[u8], remaining: usize) -> (u64, u32) {
+    pub fn peek_bits(&self, bytes: &[u8], contexts: &[u8], remaining: usize) -> (u128, u32) {
         let mut lanes = [[0u32; LANE_WORDS]; MAX_LANES as usize];
         let count = self.lane_count.min(MAX_LANES as usize);
         lanes[..count].copy_from_slice(&self.lanes[..count]);
@@ -309,8 +309,10 @@ impl<'b> ChunkDecoder<'b> {
             buckets: self.buckets,
         };
         let mut lane = self.lane;
-        let (mut bits, mut known) = (0u64, 0u32);
-        for &context in contexts.iter().take(remaining.min(64)) {
+        // By 64-bit halves: a variable 128-bit shift is a library call on
+        // 32-bit targets.
+        let (mut halves, mut known) = ([0u64; 2], 0u32);
+        for &context in contexts.iter().take(remaining.min(128)) {
             let l = &mut lanes[lane & (MAX_LANES as usize - 1)];
             lane = if lane + 1 >= self.lane_count {
                 0
@@ -318,12 +320,12 @@ impl<'b> ChunkDecoder<'b> {
                 lane + 1
             };
             match decode_in(tables, l, bytes, context as usize) {
-                Ok(v @ (0 | 1)) => bits |= (v as u64) << known,
+                Ok(v @ (0 | 1)) => halves[known as usize / 64] |= (v as u64) << (known % 64),
                 _ => break,
             }
             known += 1;
         }
-        (bits, known)
+        ((halves[1] as u128) << 64 | halves[0] as u128, known)
     }
 }
 

@@ -14,7 +14,7 @@ use crate::predict::{
     predict, wrap,
 };
 use crate::ring::Ring;
-use crate::round::{RecordSource, all_ones};
+use crate::round::{RecordSource, all_ones_wide};
 use crate::split::SplitRecord;
 use crate::state::MeshState;
 use crate::substream::Substreams;
@@ -140,16 +140,19 @@ impl RecordSource for StreamSource<'_, '_, '_> {
     }
 
     #[inline]
-    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u128 {
         // The next flags of the stream, as far as the loaded chunk shows
         // them; the candidates past them are all taken as likely. Under
         // `every-vertex` each is peeked in its vertex's context, as if no
         // upcoming vertex blocked a later one (a hint only).
         let (bits, known) = match self.schedule {
-            Schedule::SplitValences => self.subs.peek_bits(slot(substream::FLAGS), SINGLE),
+            Schedule::SplitValences => {
+                let (bits, known) = self.subs.peek_bits(slot(substream::FLAGS), SINGLE);
+                (bits as u128, known)
+            }
             Schedule::EveryVertex => {
-                let mut contexts = [0u8; 64];
-                let n = upcoming.len().min(64);
+                let mut contexts = [0u8; 128];
+                let n = upcoming.len().min(128);
                 for (c, &v) in contexts.iter_mut().zip(&upcoming[..n]) {
                     let byte = state.deficits().get(v as usize).copied().unwrap_or(0);
                     *c = context::flag(self.schedule, byte);
@@ -158,7 +161,8 @@ impl RecordSource for StreamSource<'_, '_, '_> {
                     .peek_bits_in(slot(substream::FLAGS), &contexts[..n])
             }
         };
-        bits & all_ones(known as usize) | !all_ones(known as usize) & all_ones(upcoming.len())
+        bits & all_ones_wide(known as usize)
+            | !all_ones_wide(known as usize) & all_ones_wide(upcoming.len())
     }
 
     /// SPEC §7.4, fields in order: wing ranks (in ring order, or in the near

@@ -56,8 +56,9 @@ pub(crate) struct FansAhead {
     pub(crate) cursor: usize,
 }
 
-/// Fans walked ahead at once.
-pub(crate) const FANS: usize = 24;
+/// Fans walked ahead at once (`walk_fans` follows them in a 32-bit mask).
+pub(crate) const FANS: usize = 32;
+const _: () = assert!(FANS <= 32);
 /// Longest fan kept when walked ahead (typical valences; longer rings are
 /// walked when their vertex splits).
 pub(crate) const FAN_LEN: usize = 12;

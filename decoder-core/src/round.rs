@@ -15,8 +15,11 @@ use crate::split::{SplitOutcome, SplitRecord};
 use crate::state::{MeshState, next};
 
 /// Candidates taken together, whose likely flagged ones have their fans
-/// walked ahead at once (see `walk_fans`).
-const WARM_BATCH: usize = 32;
+/// walked ahead at once (see `walk_fans`): about a fifth of them are
+/// flagged under `every-vertex`, so a batch fills most of [`FANS`]. (32,
+/// within one bitmap word, walked 6 or so fans at a time: the 1M demo
+/// terrain decoded about 1.1x slower.)
+const WARM_BATCH: usize = 128;
 /// By default fans are walked ahead only from this vertex count on
 /// ([`MeshState::set_fans_ahead_from`]): a smaller state (about 58 bytes a
 /// vertex, SPEC §9) mostly stays in the caches, where the extra bookkeeping
@@ -33,11 +36,11 @@ pub trait RecordSource {
     fn applied(&mut self, _r: u32, _c: u32, _outcome: &SplitOutcome) {}
     /// Which of `upcoming`, the next candidates whose flags will be read
     /// (in order, as if none of them blocked another), are likely to be
-    /// flagged: bit i for `upcoming[i]` (at most 64). Only a hint for
+    /// flagged: bit i for `upcoming[i]` (at most 128). Only a hint for
     /// prefetching (a wrong hint costs speed, never correctness); the
     /// default says all of them.
-    fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
-        all_ones(upcoming.len())
+    fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u128 {
+        all_ones_wide(upcoming.len())
     }
 }
 
@@ -45,6 +48,13 @@ pub trait RecordSource {
 #[inline]
 pub fn all_ones(n: usize) -> u64 {
     if n >= 64 { u64::MAX } else { (1u64 << n) - 1 }
+}
+
+/// The low `n` bits set (n at most 128), from two 64-bit halves: a
+/// variable 128-bit shift is a library call on 32-bit targets.
+#[inline]
+pub fn all_ones_wide(n: usize) -> u128 {
+    (all_ones(n.saturating_sub(64)) as u128) << 64 | all_ones(n) as u128
 }
 
 /// What one round did.
@@ -149,60 +159,71 @@ impl MeshState<'_> {
         let mut split_error = None;
         let mut batch = [0u32; WARM_BATCH];
         let warm_up = n >= self.fans_ahead_from;
-        for w in 0..words {
-            // Candidates at round start: vertices below n with deficit 0.
-            // Splits of this round only change the bits of blocked vertices
-            // and of new vertices (n and above), so reading the word now is
-            // reading it as it was at the start.
+        // Candidates at round start: vertices below n with deficit 0 (or
+        // all below n, `every-vertex`). Splits of this round only change the
+        // bits of blocked vertices and of new vertices (n and above), so
+        // reading a word before the splits of the candidates before it is
+        // reading it as it was at the start; a vertex blocked since is
+        // skipped when its turn comes.
+        let unblocked = |state: &Self, w: usize| {
             let below_n = if (w + 1) * 64 <= n as usize {
                 u64::MAX
             } else {
                 (1u64 << (n as usize - w * 64)) - 1
             };
-            let mut bits = self.bitmaps().0[w] & !self.bitmaps().2[w] & below_n;
-            while bits != 0 {
-                let mut len = 0;
-                while bits != 0 && len < WARM_BATCH {
-                    batch[len] = (w * 64) as u32 + bits.trailing_zeros();
-                    bits &= bits - 1;
-                    len += 1;
-                }
-                // Warm the fans of the batch's candidates that the next
-                // flags say will be flagged, together, so that their fan
-                // walks hit the cache instead of waiting for one miss after
-                // another. (Where the flags are not known yet, every
-                // candidate's fan is warmed.)
-                if warm_up {
-                    self.walk_batch(
-                        &batch[..len],
-                        w,
-                        source,
-                        &mut ring.ahead,
-                        F::READS_POSITIONS,
-                    );
-                }
-                for &v in &batch[..len] {
-                    if self.bitmaps().2[w] & (1u64 << (v % 64)) != 0 {
-                        continue;
+            let third = state.candidates.len() / 3;
+            state.candidates[w] & !state.candidates[2 * third + w] & below_n
+        };
+        let (mut w, mut bits) = (0, if words > 0 { unblocked(self, 0) } else { 0 });
+        loop {
+            // A batch runs across bitmap words: the more flagged fans one
+            // lockstep walk holds, the more of their misses overlap.
+            let mut len = 0;
+            while len < WARM_BATCH {
+                if bits == 0 {
+                    w += 1;
+                    if w >= words {
+                        break;
                     }
-                    if !source.flag(self, v)? {
-                        continue;
-                    }
-                    stats.splits += 1;
-                    // The ring is the one at round start (no neighbour of v
-                    // has split: they would have blocked v). Its vertices'
-                    // flags are inferred from now on (SPEC §7.2).
-                    self.ring(v, ring)?;
-                    self.block(ring);
-                    if split_error.is_some() {
-                        continue;
-                    }
-                    let c = n + stats.splits - 1;
-                    splits.flagged(self, source, v, c, ring, stats, &mut split_error);
+                    bits = unblocked(self, w);
+                    continue;
                 }
-                // The fans walked ahead are the batch's: none outlives it.
-                ring.ahead.owner = [NONE; FANS];
+                batch[len] = (w * 64) as u32 + bits.trailing_zeros();
+                bits &= bits - 1;
+                len += 1;
             }
+            if len == 0 {
+                break;
+            }
+            // Warm the fans of the batch's candidates that the next
+            // flags say will be flagged, together, so that their fan
+            // walks hit the cache instead of waiting for one miss after
+            // another. (Where the flags are not known yet, every
+            // candidate's fan is warmed.)
+            if warm_up {
+                self.walk_batch(&batch[..len], source, &mut ring.ahead, F::READS_POSITIONS);
+            }
+            for &v in &batch[..len] {
+                if self.is_blocked(v) {
+                    continue;
+                }
+                if !source.flag(self, v)? {
+                    continue;
+                }
+                stats.splits += 1;
+                // The ring is the one at round start (no neighbour of v
+                // has split: they would have blocked v). Its vertices'
+                // flags are inferred from now on (SPEC §7.2).
+                self.ring(v, ring)?;
+                self.block(ring);
+                if split_error.is_some() {
+                    continue;
+                }
+                let c = n + stats.splits - 1;
+                splits.flagged(self, source, v, c, ring, stats, &mut split_error);
+            }
+            // The fans walked ahead are the batch's: none outlives it.
+            ring.ahead.owner = [NONE; FANS];
         }
         splits.finish(self, stats, &mut split_error);
         Ok(split_error)
@@ -223,13 +244,22 @@ impl MeshState<'_> {
         }
     }
 
-    /// Walks ahead the fans of the candidates of `batch` (all in bitmap
-    /// word `w`) that are not blocked and that `source` says are likely
-    /// flagged (see [`FansAhead`]).
+    /// Whether `v` is blocked in this round (its flag is inferred 0).
+    #[inline]
+    fn is_blocked(&self, v: u32) -> bool {
+        let third = self.candidates.len() / 3;
+        let w = 2 * third + (v / 64) as usize;
+        self.candidates
+            .get(w)
+            .is_some_and(|&word| word & (1u64 << (v % 64)) != 0)
+    }
+
+    /// Walks ahead the fans of the candidates of `batch` that are not
+    /// blocked and that `source` says are likely flagged (see
+    /// [`FansAhead`]).
     fn walk_batch<S: RecordSource>(
         &mut self,
         batch: &[u32],
-        w: usize,
         source: &mut S,
         ahead: &mut FansAhead,
         positions: bool,
@@ -237,16 +267,18 @@ impl MeshState<'_> {
         let mut upcoming = [0u32; WARM_BATCH];
         let mut upcoming_len = 0;
         for &v in batch {
-            if self.bitmaps().2[w] & (1u64 << (v % 64)) == 0 {
+            if !self.is_blocked(v) {
                 upcoming[upcoming_len] = v;
                 upcoming_len += 1;
             }
         }
         let likely = source.likely_flags(self, &upcoming[..upcoming_len]);
+        // By 64-bit halves (see `all_ones_wide`).
+        let halves = [likely as u64, (likely >> 64) as u64];
         let mut walk = [0u32; WARM_BATCH];
         let mut walk_len = 0;
         for (i, &v) in upcoming[..upcoming_len].iter().enumerate() {
-            if likely >> i & 1 != 0 {
+            if halves[i / 64] >> (i % 64) & 1 != 0 {
                 walk[walk_len] = v;
                 walk_len += 1;
             }

@@ -360,11 +360,12 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// `contexts[i]` for the i-th next one (the flags under the schedule
     /// `every-vertex`, SPEC §5.5.5): decoded from copies of the current rANS
     /// chunk's lanes, so nothing is consumed and nothing is loaded (`count`
-    /// is 0 at a chunk's end). A decoder uses it to look ahead, never to
-    /// decide.
-    pub fn peek_bits_in(&mut self, slot: usize, contexts: &[u8]) -> (u64, u32) {
+    /// is 0 at a chunk's end, at most 128, and at most 64 for a byte
+    /// codec). A decoder uses it to look ahead, never to decide.
+    pub fn peek_bits_in(&mut self, slot: usize, contexts: &[u8]) -> (u128, u32) {
         if !self.is_rans(slot) {
-            return self.peek_byte_bits(slot);
+            let (bits, count) = self.peek_byte_bits(slot);
+            return (bits as u128, count);
         }
         let r = &self.readers[slot];
         if r.ahead_len > 0 || r.ahead_error.is_some() {

@@ -179,7 +179,7 @@ impl RecordSource for StepSource<'_> {
         Ok(flagged)
     }
 
-    fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+    fn likely_flags(&mut self, _state: &MeshState<'_>, upcoming: &[u32]) -> u128 {
         // Exactly the flags flag() will give: the candidates that collapse
         // in this step. (`current` is indexed by decoder id, as in flag();
         // indexing it by encoder id warmed the fans of unrelated vertices.)
@@ -192,7 +192,7 @@ impl RecordSource for StepSource<'_> {
                 prefetch(self.collapses, index as usize);
                 prefetch(self.wings, index as usize);
             }
-            bits | ((index != NONE) as u64) << i
+            bits | ((index != NONE) as u128) << i
         })
     }
 

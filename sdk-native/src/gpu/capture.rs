@@ -112,7 +112,7 @@ impl<S: RecordSource> RecordSource for Capture<S> {
         Ok(flag)
     }
 
-    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u64 {
+    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u128 {
         self.inner.likely_flags(state, upcoming)
     }
 
