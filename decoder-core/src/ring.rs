@@ -56,9 +56,9 @@ pub(crate) struct FansAhead {
     pub(crate) cursor: usize,
 }
 
-/// Fans walked ahead at once (`walk_fans` follows them in a 32-bit mask).
-pub(crate) const FANS: usize = 32;
-const _: () = assert!(FANS <= 32);
+/// Fans walked ahead at once (`walk_fans` follows them in a 64-bit mask).
+pub(crate) const FANS: usize = 48;
+const _: () = assert!(FANS <= 64);
 /// Longest fan kept when walked ahead (typical valences; longer rings are
 /// walked when their vertex splits).
 pub(crate) const FAN_LEN: usize = 12;

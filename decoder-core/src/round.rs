@@ -306,11 +306,7 @@ impl MeshState<'_> {
         }
         let start = corner;
         // Fans still being walked, as a bit mask.
-        let mut active: u32 = if count == 32 {
-            u32::MAX
-        } else {
-            (1 << count) - 1
-        };
+        let mut active: u64 = all_ones(count);
         for step in 0..FAN_LEN {
             let mut left = active;
             while left != 0 {
@@ -318,7 +314,7 @@ impl MeshState<'_> {
                 left &= left - 1;
                 let c = corner[i];
                 let Some(&v) = self.corners.get(next(c) as usize) else {
-                    active &= !(1 << i);
+                    active &= !(1u64 << i);
                     continue;
                 };
                 ahead.vertices[i][step] = v;
@@ -327,10 +323,10 @@ impl MeshState<'_> {
                 if s == start[i] {
                     // Closed: the whole ring is held.
                     ahead.len[i] = step as u8 + 1;
-                    active &= !(1 << i);
+                    active &= !(1u64 << i);
                 } else if s == NONE {
                     // A boundary vertex: its ring is walked when it splits.
-                    active &= !(1 << i);
+                    active &= !(1u64 << i);
                 }
                 corner[i] = s;
             }
