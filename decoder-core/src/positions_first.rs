@@ -1192,6 +1192,41 @@ mod tests {
     }
 
     #[test]
+    fn a_midpoint_split_whose_p_lands_on_r_still_pairs() {
+        // SPEC §7.4: under kind 1 nothing excludes A (P) on R's x and y;
+        // the record reads as any other when a pair holds. Ring of the
+        // 3-step square around R, N = (1, 0), offset t = 1: A = (0, 0).
+        let q: [[i64; 2]; 8] = [
+            [3, 0],
+            [3, 3],
+            [0, 3],
+            [-3, 3],
+            [-3, 0],
+            [-3, -3],
+            [0, -3],
+            [3, -3],
+        ];
+        let mut positions = [[10u32, 10, 0]; 9];
+        for (i, p) in q.iter().enumerate() {
+            positions[i + 1] = [(10 + p[0]) as u32, (10 + p[1]) as u32, 0];
+        }
+        let ring = Ring::of_vertices(&[1, 2, 3, 4, 5, 6, 7, 8]);
+        let mut pf = PositionsFirst::default();
+        pf.free_points(&positions, positions[0], &ring).unwrap();
+        let e = NewEdge {
+            a: [0, 0],
+            b: [1, 0],
+            midpoint: true,
+        };
+        let n = pf.order_xs(&WingCandidates::all(8), &e);
+        let xs: [Option<usize>; 3] = core::array::from_fn(|i| pf.choice(n, i));
+        assert_eq!((n, xs), (3, [Some(2), Some(1), Some(3)]));
+        let n = pf.order_ys(&e, 2);
+        let ys: [Option<usize>; 3] = core::array::from_fn(|i| pf.choice(n, i));
+        assert_eq!((n, ys), (3, [Some(6), Some(7), Some(5)]));
+    }
+
+    #[test]
     fn record_order_byte_holds_the_order_and_the_ties() {
         // SPEC §5.1 byte 11: 0 wings-first, 1 to 3 positions first under
         // the tie rules ring, rising, falling (3.8); 4 and above reserved.
