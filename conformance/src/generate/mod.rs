@@ -3,6 +3,7 @@
 //! run and machine). Run it with `conformance/generate.sh`.
 
 mod invalid;
+mod malformed;
 mod meshes;
 mod mutate;
 mod positions_first;
@@ -128,6 +129,7 @@ pub fn generate(real_data: &Path) -> Result<Generated, String> {
     let mut specs = Specs(Vec::new());
     valid_vectors(&mut specs, real_data)?;
     invalid_vectors(&mut specs);
+    malformed::malformed_vectors(&mut specs);
     let mut files = BTreeMap::new();
     let mut vectors = Vec::new();
     for spec in specs.0 {

@@ -299,8 +299,7 @@ pub fn wrap_chunks_in_deflate_with(stream: &[u8], extra_byte: Option<(u16, usize
                     p.push(0);
                 }
                 level[entry + 1] = codec::DEFLATE;
-                level[entry + 8..entry + 12].copy_from_slice(&(p.len() as u32).to_le_bytes());
-                level[entry + 12..entry + 16].copy_from_slice(&crc32(&p).to_le_bytes());
+                set_stored_payload(&mut level[entry..entry + CHUNK_ENTRY_LEN], &p);
                 p
             } else {
                 raw.to_vec()
@@ -311,11 +310,7 @@ pub fn wrap_chunks_in_deflate_with(stream: &[u8], extra_byte: Option<(u16, usize
         let crc = crc32(&level[..crc_at]);
         level[crc_at..].copy_from_slice(&crc.to_le_bytes());
         level.extend_from_slice(&payload);
-        let entry = table_entry(k);
-        let offset = out.len() as u64;
-        out[entry..entry + 8].copy_from_slice(&offset.to_le_bytes());
-        out[entry + 8..entry + 12].copy_from_slice(&(level.len() as u32).to_le_bytes());
-        out.extend_from_slice(&level);
+        append_level(&mut out, k, &level);
     }
     fix_table_crc(&mut out);
     out
@@ -363,4 +358,47 @@ pub fn rans_layout(s: &[u8], payload: Range<usize>, contexts: usize, lanes: usiz
         token_counts,
         lanes: starts,
     }
+}
+
+/// `stream` with the payload of chunk `c` of level `k` replaced by
+/// `payload`: its directory entry's `stored_len` and CRC, the level header
+/// CRC, the level lengths and offsets in the table and the table CRC are
+/// made to match (`raw_len` is kept). For faults inside a chunk, met after
+/// every framing check passes.
+pub fn with_chunk_payload(stream: &[u8], k: u16, c: usize, payload: Vec<u8>) -> Vec<u8> {
+    let levels = level_count(stream);
+    let mut out = stream[..head_len(levels)].to_vec();
+    for l in 0..levels {
+        let range = level_range(stream, l);
+        let mut level = stream[range.clone()].to_vec();
+        if l == k {
+            let old = chunk_payload(stream, k, c);
+            let (from, to) = (old.start - range.start, old.end - range.start);
+            level.splice(from..to, payload.iter().copied());
+            let entry = chunk_entry_at(stream, k, c) - range.start;
+            set_stored_payload(&mut level[entry..entry + CHUNK_ENTRY_LEN], &payload);
+            let crc_at = level_crc_at(stream, k) - range.start;
+            let crc = crc32(&level[..crc_at]);
+            level[crc_at..crc_at + 4].copy_from_slice(&crc.to_le_bytes());
+        }
+        append_level(&mut out, l, &level);
+    }
+    fix_table_crc(&mut out);
+    out
+}
+
+/// Sets a chunk directory `entry`'s `stored_len` and CRC to `payload`'s.
+fn set_stored_payload(entry: &mut [u8], payload: &[u8]) {
+    entry[8..12].copy_from_slice(&(payload.len() as u32).to_le_bytes());
+    entry[12..16].copy_from_slice(&crc32(payload).to_le_bytes());
+}
+
+/// Appends `level` to `out` as level `k`, setting its table entry's offset
+/// and length (the table CRC is the caller's).
+fn append_level(out: &mut Vec<u8>, k: u16, level: &[u8]) {
+    let entry = table_entry(k);
+    let offset = out.len() as u64;
+    out[entry..entry + 8].copy_from_slice(&offset.to_le_bytes());
+    out[entry + 8..entry + 12].copy_from_slice(&(level.len() as u32).to_le_bytes());
+    out.extend_from_slice(level);
 }
