@@ -4,7 +4,10 @@
 //! fail in decoder-core with exactly the check it is named after (its
 //! error's detail, not only its class), and
 //! `conformance/tests/every_check_reached.rs` requires every detailed error
-//! decoder-core can return to be reached by some vector.
+//! decoder-core can return to be reached by some vector. The checks whose
+//! errors carry no detail (`Truncated`, `LevelCountMismatch`, …) were found
+//! unreached with a coverage run of decoder-core over the vector set
+//! (conformance/README.md, "Reach"); [`unmet_sites`] adds one vector each.
 
 use splitstream_decoder_core::handmade;
 use splitstream_decoder_core::limits::codec;
@@ -91,6 +94,7 @@ pub(super) fn malformed_vectors(s: &mut Specs) {
     level_header_vectors(s);
     rans_chunk_vectors(s);
     base_mesh_vectors(s);
+    unmet_sites(s);
 }
 
 /// SPEC §3.3: each header field rule, the header CRC recomputed.
@@ -384,6 +388,28 @@ fn rans_chunk_vectors(s: &mut Specs) {
             ),
         ),
         case(
+            "rans-table-varint-over-32-bits",
+            "bad varint in tables",
+            "the flags table's first count a 5-byte varint above 2^32 − 1 (last byte 0x1F)",
+            with_chunk_payload(
+                &one_lane,
+                1,
+                0,
+                [&[1u8, 0xFF, 0xFF, 0xFF, 0xFF, 0x1F, 4][..], &state].concat(),
+            ),
+        ),
+        case(
+            "rans-tables-past-chunk-at-count",
+            "tables run past the chunk",
+            "the wing-offset chunk (8 contexts) cut to its first table, unused: the second table's token count is missing",
+            {
+                let c = (0..chunk_count(&one_lane, 1))
+                    .find(|&c| one_lane[chunk_entry_at(&one_lane, 1, c)] == 2)
+                    .expect("level 1 has a wing-offset chunk");
+                with_chunk_payload(&one_lane, 1, c, vec![0])
+            },
+        ),
+        case(
             "rans-last-count-zero",
             "last token count is zero",
             "the flags table with 2 tokens, counts 1 and 0",
@@ -481,4 +507,197 @@ fn base_mesh_vectors(s: &mut Specs) {
         &["handmade", "base-only", "manifold", "malformed-detail"],
         |what| format!("{what} (SPEC §6.3)."),
     );
+}
+
+/// Checks whose errors carry no detail that no other vector met (found
+/// with a coverage run): a level too short for its header, its chunk
+/// directory or its payloads; split counts disagreeing with the level
+/// table; a level ending with fewer triangles than its entry; a rANS flag
+/// of 2 under the schedule `every-vertex`.
+fn unmet_sites(s: &mut Specs) {
+    let subject = encoded(&meshes::icosphere(2), deflate_opts());
+    let last = level_count_of(&subject) - 1;
+    let range = level_range(&subject, last);
+    let payload_start = chunk_payload(&subject, last, 0).start - range.start;
+    let with_last_length =
+        |len: usize| with_table_entry(&subject, last, |e| put_u32(e, 8, len as u32));
+    for (name, len, what) in [
+        (
+            "level-shorter-than-header",
+            8,
+            "8 bytes: its round and chunk counts, but not the rest of its 12-byte fixed part (SPEC §5.1: `len < H`)",
+        ),
+        (
+            "level-directory-past-level",
+            payload_start - 1,
+            "one byte short of its level header: the header CRC lies partly outside (SPEC §5.1: `len < payload_start`)",
+        ),
+        (
+            "level-payloads-past-level",
+            range.len() - 1,
+            "one byte short of its chunk payloads (SPEC §5.1: `total > len`)",
+        ),
+    ] {
+        s.invalid(
+            name,
+            "truncated",
+            &format!(
+                "An icosphere stream (2 subdivisions) whose last level is declared {what}; the table CRC recomputed, the bytes after the declared end ignored as trailing bytes."
+            ),
+            &["truncated", "level-header"],
+            failing_with("Truncated", with_last_length(len)),
+        );
+    }
+    s.invalid(
+        "level-split-counts-over-entry",
+        "count-mismatch",
+        "An icosphere stream (2 subdivisions) whose level 1 declares one split more in its first round than its table entry's vertex count allows (level header CRC recomputed; SPEC §5.1).",
+        &["level-header", "level-count"],
+        failing_with("LevelCountMismatch", {
+            let at = split_count_at(&subject, 1, 0);
+            let n = u32::from_le_bytes(subject[at..at + 4].try_into().expect("4 bytes"));
+            let mut b = subject.clone();
+            put_u32(&mut b, at, n + 1);
+            fix_level_header_crc(&mut b, 1);
+            b
+        }),
+    );
+    // A mesh with a boundary: its splits with the ghost as a wing add one
+    // triangle, so its entries may claim one more and still grow
+    // consistently (SPEC §4.2).
+    let open = encoded(
+        &meshes::grid(24, 20, 1, Some([8, 15, 6, 12])),
+        deflate_opts(),
+    );
+    s.invalid(
+        "level-ends-short-of-triangles",
+        "count-mismatch",
+        "A height field with a hole whose level 1 table entry claims one triangle more than its splits make (table CRC recomputed): every split fits under the entry, and the level ends one triangle short (SPEC §7.6).",
+        &["level-count", "boundary"],
+        failing_with(
+            "LevelCountMismatch",
+            with_table_entry(&open, 1, |e| {
+                let t = u32::from_le_bytes(e[16..20].try_into().expect("4 bytes"));
+                put_u32(e, 16, t + 1);
+            }),
+        ),
+    );
+    // A vertex whose ring grew past 255 entries, flagged: decoders walk
+    // rings into buffers of 255 entries (SPEC §6.2, §7.1).
+    for (name, mesh, what) in [
+        (
+            "ring-over-255-closed",
+            meshes::cone(300, 1),
+            "a closed cone of 300 sides (an apex of valence 300)",
+        ),
+        (
+            "ring-over-255-boundary",
+            fan(300),
+            "a fan of 300 triangles around a boundary vertex (valence 301)",
+        ),
+    ] {
+        let stream = encoded(
+            &meshes::checked(mesh, name),
+            super::every_vertex(deflate_opts()),
+        );
+        s.invalid(
+            name,
+            "valence-overflow",
+            &format!(
+                "{what}, the schedule every-vertex, deflate: in a round of the last levels one flag set and the next set flag cleared (re-framed, every checksum valid), the first such swap that flags the high-valence vertex once its ring is longer than 255 (SPEC §7.1: the ring of a split vertex has at most 255 entries)."
+            ),
+            &["records", "high-valence", "schedule-every-vertex"],
+            flag_swap_failing_with("ValenceOverflow", &stream),
+        );
+    }
+    // Under split valences the flags are decoded ahead of their use
+    // (decoder-core's `decode_bits_ahead`): a bad value after a good one is
+    // met ahead and must fail when its flag is read, not be skipped.
+    s.invalid(
+        "rans-flag-2-after-a-good-flag",
+        "malformed",
+        "Tetrahedron with adjacent candidates 0 and 1, rANS in one lane: vertex 0's flag 0, then vertex 1's flag 2 (SPEC §5.5: a flag above 1).",
+        &["rans", "handmade"],
+        failing_with("ValueOutOfRange(1)", {
+            let mut lvl = handmade::level(&[false, false], vec![1], &[handmade::tetra_split()], 5, 6);
+            let mut flags = splitstream_decoder_core::writer::SubstreamWriter::default();
+            flags.bit(false);
+            flags.varint(2);
+            lvl.substreams[0] = flags;
+            write_stream(
+                &handmade::params(ChunkCodec::RansAlways { lanes: 1 }),
+                &[handmade::tetrahedron_two_candidates(), lvl],
+            )
+        }),
+    );
+    // Every flag's table a single token, 2: each flag decodes to 2 in no
+    // bytes (SPEC §5.5.4), whatever the vertex's valence context.
+    let every = encoded(
+        &meshes::icosphere(2),
+        EncodeOptions {
+            codec: ChunkCodec::RansAlways { lanes: 1 },
+            ..super::every_vertex(opts())
+        },
+    );
+    assert_eq!(
+        every[chunk_entry_at(&every, 1, 0)],
+        1,
+        "level 1's first chunk holds flags"
+    );
+    let tables: Vec<u8> = [3u8, 0, 0, 1].repeat(5);
+    let state = (1u32 << 23).to_le_bytes();
+    s.invalid(
+        "every-vertex-rans-flag-2",
+        "malformed",
+        "An icosphere stream (2 subdivisions) of the schedule every-vertex, rANS in one lane, whose level 1 flags chunk codes 2 in each of its 5 contexts (tables of one token, 2): a flag above 1 (SPEC §5.5; chunk and level header CRCs, level lengths and offsets recomputed).",
+        &["rans", "schedule-every-vertex"],
+        failing_with(
+            "ValueOutOfRange(1)",
+            with_chunk_payload(&every, 1, 0, [&tables[..], &[4], &state].concat()),
+        ),
+    );
+}
+
+/// A fan of `n` triangles around vertex 0, which lies on the boundary with
+/// valence `n + 1`.
+fn fan(n: usize) -> splitstream_encoder::Mesh {
+    let mut positions = vec![[0.0, 0.0, 0.0]];
+    for i in 0..=n {
+        let a = std::f64::consts::PI * i as f64 / n as f64;
+        // Exact enough and platform-independent: a polygon on the unit
+        // square's upper half, not a circle (no libm).
+        let t = a / std::f64::consts::PI;
+        positions.push([1.0 - 2.0 * t, 1.0 - (2.0 * t - 1.0) * (2.0 * t - 1.0), 0.0]);
+    }
+    let triangles = (0..n as u32).map(|i| [0, i + 1, i + 2]).collect();
+    splitstream_encoder::Mesh {
+        positions,
+        triangles,
+    }
+}
+
+/// `stream` (byte-coded) with one flag bit set and the next set bit of the
+/// same substream cleared, so the round's flag count holds: the first such
+/// swap, from the last level back, that decoder-core rejects with `detail`.
+fn flag_swap_failing_with(detail: &str, stream: &[u8]) -> Vec<u8> {
+    let parts = unframe(stream);
+    for k in (1..parts.levels.len()).rev() {
+        let flags = &parts.levels[k].substreams[0];
+        let bit = |i: usize| flags[i / 8] >> (i % 8) & 1 == 1;
+        let bits = 8 * flags.len();
+        for j in (0..bits).filter(|&j| !bit(j)) {
+            let Some(i) = (j + 1..bits).find(|&i| bit(i)) else {
+                break;
+            };
+            let mut p = parts.clone();
+            let f = &mut p.levels[k].substreams[0];
+            f[j / 8] |= 1 << (j % 8);
+            f[i / 8] &= !(1 << (i % 8));
+            let b = reframe(&p);
+            if matches!(decode_all(&b, false), Err(e) if format!("{e:?}") == detail) {
+                return b;
+            }
+        }
+    }
+    panic!("no flag swap fails with {detail}")
 }

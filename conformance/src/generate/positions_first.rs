@@ -10,6 +10,8 @@ use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::EncodeOptions;
 use splitstream_encoder::quantize::Lattice;
 
+use splitstream_decoder_core::owned::decode_all;
+
 use super::meshes;
 use super::mutate::*;
 use super::{Specs, encoded, opts};
@@ -205,6 +207,13 @@ pub(super) fn positions_first_invalid(s: &mut Specs) {
         }),
     );
     s.invalid(
+        "positions-first-offset-4",
+        "malformed",
+        "A positions-first level's first midpoint offset t (a kind-1 record's second placement value) set to 4: t is 0 to 3 (SPEC §7.4). Found as the first placement value where 3 reads on and 4 fails.",
+        &["positions-first", "records"],
+        midpoint_offset_4(&subject),
+    );
+    s.invalid(
         "positions-first-rank-past-free-points",
         "position-out-of-range",
         "A positions-first level whose first lattice rank is 255: a fan has at most 255 free points (SPEC §7.4).",
@@ -227,4 +236,32 @@ pub(super) fn positions_first_invalid(s: &mut Specs) {
             Some(())
         }),
     );
+}
+
+/// `subject` with its first midpoint offset (SPEC §7.4 `t`) set to 4. The
+/// placement substream interleaves kinds (0 to 2), offsets (0 to 3) and
+/// escaped records' placement codes (0 to 2); only at an offset does 3
+/// read on while 4 fails.
+fn midpoint_offset_4(subject: &[u8]) -> Vec<u8> {
+    let parts = unframe(subject);
+    let invalid_placement = |b: &[u8]| {
+        matches!(
+            decode_all(b, false),
+            Err(splitstream_decoder_core::Error::InvalidPlacement)
+        )
+    };
+    for k in 1..parts.levels.len() {
+        for i in 0..parts.levels[k].substreams[6].len() {
+            let with = |v: u8| {
+                let mut p = parts.clone();
+                p.levels[k].substreams[6][i] = v;
+                reframe(&p)
+            };
+            let four = with(4);
+            if invalid_placement(&four) && !invalid_placement(&with(3)) {
+                return four;
+            }
+        }
+    }
+    panic!("no midpoint offset in the positions-first levels")
 }
