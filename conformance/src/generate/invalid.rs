@@ -48,6 +48,11 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
     let level2 = level_range(&subject, 2);
     for (name, at, what) in [
         ("truncated-signature", 5, "inside the 8-byte signature"),
+        (
+            "truncated-after-version",
+            9,
+            "after the signature and the major version, before the minor version (SPEC §3.3: `len < 10`)",
+        ),
         ("truncated-header", 60, "inside the 96-byte header"),
         ("truncated-level-table", head - 10, "inside the level table"),
         (
@@ -472,6 +477,23 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
             let mut p = parts.clone();
             p.levels[last as usize].substreams[5].push(0);
             reframe(&p)
+        },
+    );
+    s.invalid(
+        "record-trailing-data-in-chunk",
+        "count-mismatch",
+        "One byte appended to the wing-distance substream of the last level, inside its last chunk (no chunk added): a loaded chunk with a byte no record reads (SPEC §7.6).",
+        &["records", "record-count"],
+        {
+            let mut p = parts.clone();
+            p.levels[last as usize].substreams[2].push(0);
+            let b = reframe(&p);
+            assert_eq!(
+                chunk_count(&b, last),
+                chunk_count(&subject, last),
+                "the byte stays in the substream's last chunk"
+            );
+            b
         },
     );
     s.invalid(

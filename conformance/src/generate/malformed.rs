@@ -582,6 +582,30 @@ fn unmet_sites(s: &mut Specs) {
             }),
         ),
     );
+    s.invalid(
+        "non-manifold-disk-and-fan",
+        "non-manifold",
+        "Base mesh of a tetrahedron and one more triangle sharing only its vertex 0: vertex 0's link is a cycle and a separate path, two fans (SPEC §6.3).",
+        &["handmade", "base-only", "manifold"],
+        failing_with(
+            "NonManifold(\"a vertex has more than one fan\")",
+            write_stream(
+                &handmade::stored(),
+                &[handmade::base(
+                    &[
+                        [0, 0, 0],
+                        [10, 0, 0],
+                        [0, 10, 0],
+                        [0, 0, 10],
+                        [20, 20, 0],
+                        [20, 0, 20],
+                    ],
+                    &[[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3], [0, 4, 5]],
+                    &[255; 6],
+                )],
+            ),
+        ),
+    );
     // A vertex whose ring grew past 255 entries, flagged: decoders walk
     // rings into buffers of 255 entries (SPEC §6.2, §7.1).
     for (name, mesh, what) in [

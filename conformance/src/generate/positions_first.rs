@@ -213,28 +213,39 @@ pub(super) fn positions_first_invalid(s: &mut Specs) {
         &["positions-first", "records"],
         midpoint_offset_4(&subject),
     );
+    // The record faults below go to the first record of a level that is
+    // read positions first with a kind 0 or 1: a level whose first record
+    // escapes would meet them in the wings-first reading instead.
+    let (named, parts) = (first_named_level(&subject), unframe(&subject));
+    let in_named = |slot: usize, edit: &dyn Fn(&mut Vec<u8>)| {
+        let mut p = parts.clone();
+        edit(&mut p.levels[named as usize].substreams[slot]);
+        reframe(&p)
+    };
     s.invalid(
         "positions-first-rank-past-free-points",
         "position-out-of-range",
-        "A positions-first level whose first lattice rank is 255: a fan has at most 255 free points (SPEC §7.4).",
+        "A positions-first level whose first record (of kind 0 or 1) names lattice rank 255: a fan has at most 255 free points (SPEC §7.4: j >= len(F)).",
         &["positions-first", "records"],
-        first_failing(&subject, "position-out-of-range", |subs| {
-            let edge = &mut subs[5];
+        in_named(5, &|edge| {
             // The first value is a one-byte varint; 255 takes two.
-            (*edge.first()? < 0x80).then_some(())?;
+            assert!(edge[0] < 0x80);
             edge.splice(0..1, [0xFF, 0x01]);
-            Some(())
         }),
     );
     s.invalid(
         "positions-first-wing-past-choices",
         "ring-offset-out-of-range",
-        "A positions-first level whose first wing rank u is 200: more than the pairs that keep the new triangles counter-clockwise (SPEC §7.4).",
+        "A positions-first level whose first record (of kind 0 or 1) has wing rank u = 200: more than the pairs that keep the new triangles counter-clockwise (SPEC §7.4: u >= len(xs)).",
         &["positions-first", "records", "ring-offset"],
-        first_failing(&subject, "ring-offset-out-of-range", |subs| {
-            *subs[1].first_mut()? = 200;
-            Some(())
-        }),
+        in_named(1, &|offsets| offsets[0] = 200),
+    );
+    s.invalid(
+        "positions-first-second-wing-past-choices",
+        "ring-offset-out-of-range",
+        "A positions-first level whose first record (of kind 0 or 1) has second wing rank v = 200: more than the wings that pair with its first (SPEC §7.4: v >= len(ys)).",
+        &["positions-first", "records", "ring-offset"],
+        in_named(2, &|distances| distances[0] = 200),
     );
 }
 
@@ -264,4 +275,53 @@ fn midpoint_offset_4(subject: &[u8]) -> Vec<u8> {
         }
     }
     panic!("no midpoint offset in the positions-first levels")
+}
+
+/// The first level from 1 on whose first record is read positions first
+/// with a kind of 0 or 1 (SPEC §7.4): its fan has free points and its
+/// first placement value, the kind, is below 2.
+fn first_named_level(subject: &[u8]) -> u16 {
+    #[derive(Default)]
+    struct FirstRecord {
+        has_free_points: Option<bool>,
+        pf: splitstream_decoder_core::positions_first::PositionsFirst,
+    }
+    impl splitstream_decoder_core::SplitObserver for FirstRecord {
+        fn record(
+            &mut self,
+            state: &splitstream_decoder_core::MeshState<'_>,
+            r: u32,
+            ring: &splitstream_decoder_core::Ring,
+            _: &splitstream_decoder_core::SplitRecord,
+        ) {
+            if self.has_free_points.is_none() {
+                let positions = state.positions();
+                let free = self.pf.free_points(positions, positions[r as usize], ring);
+                self.has_free_points = Some(free.is_some());
+            }
+        }
+    }
+    let parts = unframe(subject);
+    let mut workspace =
+        splitstream_decoder_core::owned::OwnedWorkspace::for_stream(subject).expect("valid");
+    let mut decoder = workspace.decoder(subject).expect("valid");
+    while let Some(k) = decoder.next_level() {
+        let bytes = decoder.level_bytes(k, subject).expect("valid");
+        let mut level = decoder.begin_level(k, bytes).expect("valid");
+        let mut first = FirstRecord::default();
+        while level
+            .next_round_observed(&mut first)
+            .expect("valid")
+            .is_some()
+        {}
+        let named = parts.levels[k as usize].records == RecordOrder::PositionsFirst
+            && first.has_free_points == Some(true)
+            && parts.levels[k as usize].substreams[6]
+                .first()
+                .is_some_and(|&kind| kind < 2);
+        if k >= 1 && named {
+            return k;
+        }
+    }
+    panic!("no level whose first record is named positions first")
 }
