@@ -606,6 +606,23 @@ fn unmet_sites(s: &mut Specs) {
             ),
         ),
     );
+    s.invalid(
+        "non-manifold-pillow",
+        "non-manifold",
+        "Base mesh of two triangles back to back, (0, 1, 2) and (0, 2, 1): no directed edge twice, but every vertex has a closed fan of 2 triangles (SPEC §6.3: a closed fan needs at least 3).",
+        &["handmade", "base-only", "manifold"],
+        failing_with(
+            "NonManifold(\"a vertex has more than one fan\")",
+            write_stream(
+                &handmade::stored(),
+                &[handmade::base(
+                    &handmade::TRIANGLE_POSITIONS,
+                    &[[0, 1, 2], [0, 2, 1]],
+                    &[255; 3],
+                )],
+            ),
+        ),
+    );
     // A vertex whose ring grew past 255 entries, flagged: decoders walk
     // rings into buffers of 255 entries (SPEC §6.2, §7.1).
     for (name, mesh, what) in [
