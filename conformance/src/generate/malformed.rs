@@ -606,6 +606,37 @@ fn unmet_sites(s: &mut Specs) {
             ),
         ),
     );
+    // A deflate chunk that inflates to one byte fewer, or one more, than
+    // its directory entry's raw_len (SPEC §5.2: exactly raw_len).
+    let max_chunk = u32::from_le_bytes(subject[24..28].try_into().expect("4 bytes"));
+    let c = (0..chunk_count(&subject, 1))
+        .find(|&c| {
+            let at = chunk_entry_at(&subject, 1, c);
+            let raw = u32::from_le_bytes(subject[at + 4..at + 8].try_into().expect("4 bytes"));
+            chunk_codec(&subject, 1, c) == codec::DEFLATE && raw > 1 && raw < max_chunk
+        })
+        .expect("a deflate chunk in level 1 below the maximum length");
+    for (name, delta, what) in [
+        ("deflate-shorter-than-raw-len", 1i64, "one byte fewer than"),
+        ("deflate-longer-than-raw-len", -1, "one byte more than"),
+    ] {
+        s.invalid(
+            name,
+            "malformed",
+            &format!(
+                "An icosphere stream (2 subdivisions) whose level 1 deflate chunk {c} inflates to {what} its directory entry's raw_len (raw_len changed, level header CRC recomputed; SPEC §5.2: exactly raw_len)."
+            ),
+            &["codec"],
+            failing_with("CorruptChunk", {
+                let at = chunk_entry_at(&subject, 1, c) + 4;
+                let raw = u32::from_le_bytes(subject[at..at + 4].try_into().expect("4 bytes"));
+                let mut b = subject.clone();
+                put_u32(&mut b, at, (raw as i64 + delta) as u32);
+                fix_level_header_crc(&mut b, 1);
+                b
+            }),
+        );
+    }
     s.invalid(
         "non-manifold-pillow",
         "non-manifold",
