@@ -137,6 +137,12 @@ pub(super) fn positions_first_valid(s: &mut Specs) {
         );
     }
     s.valid(
+        "positions-first-height-outside-fan",
+        "Hand-made: a boundary vertex R at (10, 10) whose fan covers the square up to (14, 14) (two wedges, a quarter turn) splits read positions first, kind 1: C at R + (1, 1), P at R − (1, 1), outside every wedge's cone. The height prediction of the edge vector takes the surface at both ends; at P there is none, so h = 0 and z is the residual alone (SPEC §7.4 `read_record_pf`: `if h is none: h = 0`), though the fan is not flat.",
+        &["handmade", "positions-first", "boundary", "ghost-wing"],
+        height_outside_fan(),
+    );
+    s.valid(
         "positions-first-all-escapes",
         "33x33 fractal terrain at 20 bits per axis, its x and y quantized over the bounding box instead of kept on the raster's lattice (whose cells would be about 2^15 steps wide): every fan's bounding box holds more than 1,024 lattice points, so every record of the positions-first levels is read wings first (an escape without a kind, SPEC §7.4).",
         &["encoded", "terrain", "rans", "positions-first", "escape"],
@@ -324,4 +330,90 @@ fn first_named_level(subject: &[u8]) -> u16 {
         }
     }
     panic!("no level whose first record is named positions first")
+}
+
+/// The stream of the `positions-first-height-outside-fan` vector: a seed
+/// of two triangles, (R, q1, q2) and (R, q2, q3), and one split of R read
+/// positions first (stored chunks, constrained mode, `every-vertex`).
+fn height_outside_fan() -> Vec<u8> {
+    use splitstream_decoder_core::positions_first::{NewEdge, PositionsFirst};
+    use splitstream_decoder_core::writer::{
+        LevelPayload, StreamParams, SubstreamWriter, write_stream,
+    };
+    use splitstream_decoder_core::{PlanePolicy, Ring, WingPolicy, handmade};
+
+    let positions = [[10, 10, 50], [14, 10, 60], [14, 14, 80], [10, 14, 70]];
+    let triangles = [[0, 1, 2], [0, 2, 3]];
+    let params = StreamParams {
+        position_mode: PositionMode::Constrained,
+        schedule: Schedule::EveryVertex,
+        ..handmade::params(ChunkCodec::Stored)
+    };
+    // C = R + N, P = R − N + t with t = (0, 0); the new edge's z residual.
+    let (n, r_z) = ([1i64, 1], 6);
+    let build = |j: u32, u: u8, v: u8| {
+        let mut subs = vec![SubstreamWriter::default(); 7];
+        subs[0].bit(true); // R's flag; its neighbours' are inferred
+        subs[6].byte(1); // kind 1: R sat on the floor midpoint
+        subs[5].varint(j); // C's rank among the free points
+        subs[6].byte(0); // the midpoint offset t
+        subs[1].byte(u);
+        subs[2].byte(v);
+        subs[5].signed(r_z);
+        let split = LevelPayload {
+            round_splits: vec![1],
+            plane: PlanePolicy::Height,
+            wings: WingPolicy::Ranks,
+            deficits: DeficitContexts::Plain,
+            records: RecordOrder::PositionsFirst,
+            ties: Ties::Ring,
+            substreams: subs,
+            vertex_count: 5,
+            // One wing is the ghost: one triangle more.
+            triangle_count: 3,
+            geometric_error: 0.0,
+        };
+        write_stream(
+            &params,
+            &[handmade::base(&positions, &triangles, &[]), split],
+        )
+    };
+    // Name the split with decoder-core's own positions-first lists, on the
+    // seed's state.
+    let draft = build(0, 0, 0);
+    let mut workspace =
+        splitstream_decoder_core::owned::OwnedWorkspace::for_stream(&draft).expect("valid");
+    let mut decoder = workspace.decoder(&draft).expect("valid");
+    let k = decoder.next_level().expect("level 0");
+    let bytes = decoder.level_bytes(k, &draft).expect("level 0");
+    let level = decoder.begin_level(k, bytes).expect("level 0");
+    let state = level.state();
+    let mut ring = Ring::default();
+    state.ring(0, &mut ring).expect("R's ring");
+    let mut pf = PositionsFirst::default();
+    pf.free_points(state.positions(), state.positions()[0], &ring)
+        .expect("the fan has free points");
+    let j = pf.rank_of(n).expect("N is a free point") as u32;
+    let edge = NewEdge {
+        a: [-n[0], -n[1]],
+        b: n,
+        midpoint: true,
+    };
+    // The ghost (ring position 0) and q1 (1) are the wings: P owns the
+    // arc from the ghost to q1.
+    assert_eq!(
+        ring.vertices()[1],
+        1,
+        "the ring starts at the ghost, then q1"
+    );
+    let xs = pf.order_xs(&state.wing_candidates(&ring), &edge);
+    let u = pf.rank_of_choice(xs, 0).expect("the ghost pairs with q1");
+    let ys = pf.order_ys(&edge, 0);
+    let v = pf.rank_of_choice(ys, 1).expect("q1 pairs with the ghost");
+    let stream = build(j, u as u8, v as u8);
+    let mesh = decode_all(&stream, false).expect("the split decodes");
+    // P = R − (X >> 1) with X = (2, 2, r_z): h = 0 puts P at z 50 − 3.
+    assert_eq!(mesh.positions[0], [9, 9, 47]);
+    assert_eq!(mesh.positions[4], [11, 11, 53]);
+    stream
 }
