@@ -163,15 +163,24 @@ fn spec_sorted(
     list
 }
 
-/// A fan: 3 to 12 entries within `reach` of R, at most one the ghost.
+/// A fan: 3 to 12 entries within `reach` of R (per axis), at most one the
+/// ghost. The thin reach (100 in x, 3 in y) gives wedges more than 64
+/// lattice points wide under the point cap: rows that take more than one
+/// 64-bit word when listed.
 fn fans() -> impl Strategy<Value = Vec<Option<[i64; 2]>>> {
     (
-        prop_oneof![Just(3i64), Just(8), Just(20), Just(40)],
+        prop_oneof![
+            Just((3i64, 3i64)),
+            Just((8, 8)),
+            Just((20, 20)),
+            Just((40, 40)),
+            Just((100, 3)),
+        ],
         3usize..=12,
     )
-        .prop_flat_map(|(reach, k)| {
+        .prop_flat_map(|((rx, ry), k)| {
             (
-                prop::collection::vec([-reach..=reach, -reach..=reach], k),
+                prop::collection::vec([-rx..=rx, -ry..=ry], k),
                 prop::option::of(0..k),
             )
         })
