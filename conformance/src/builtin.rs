@@ -37,6 +37,12 @@ pub const BUILTINS: &[Builtin] = &[
         decode: decoder_core,
     },
     Builtin {
+        name: "fans-ahead",
+        summary: "decoder-core with the fans of each batch's flagged vertices walked ahead in lockstep at every size (the default starts at 65,536 vertices)",
+        hidden: false,
+        decode: fans_ahead,
+    },
+    Builtin {
         name: "two-threads",
         summary: "decoder-core's rounds with the split records read on a second thread (sdk-native threaded)",
         hidden: false,
@@ -88,10 +94,27 @@ fn finish(hashes: Vec<u64>, result: Result<(), Error>) -> Outcome {
 
 /// The reference decoder through its public API.
 pub fn decoder_core(stream: &[u8]) -> Outcome {
+    decoder_core_with(stream, None)
+}
+
+/// decoder-core walking ahead the fans of every batch's likely flagged
+/// vertices whatever the mesh's size: a speed setting that must not change
+/// any state (`Decoder::set_fans_ahead_from`), which the small vectors
+/// would otherwise never take.
+pub fn fans_ahead(stream: &[u8]) -> Outcome {
+    decoder_core_with(stream, Some(0))
+}
+
+/// [`decoder_core`], with the fans walked ahead from `fans_ahead_from`
+/// vertices when given.
+fn decoder_core_with(stream: &[u8], fans_ahead_from: Option<u32>) -> Outcome {
     let mut hashes = Vec::new();
     let result = (|| {
         let mut ws = OwnedWorkspace::for_stream(stream)?;
         let mut decoder = ws.decoder(stream)?;
+        if let Some(from) = fans_ahead_from {
+            decoder.set_fans_ahead_from(from);
+        }
         while let Some(k) = decoder.next_level() {
             let bytes = decoder.level_bytes(k, stream)?;
             let mut level = decoder.begin_level(k, bytes)?;
