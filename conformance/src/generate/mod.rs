@@ -8,6 +8,7 @@ mod meshes;
 mod mutate;
 mod positions_first;
 mod rans;
+mod reach;
 mod valid;
 
 use std::collections::BTreeMap;
@@ -130,6 +131,7 @@ pub fn generate(real_data: &Path) -> Result<Generated, String> {
     valid_vectors(&mut specs, real_data)?;
     invalid_vectors(&mut specs);
     malformed::malformed_vectors(&mut specs);
+    reach::reach_vectors(&mut specs);
     let mut files = BTreeMap::new();
     let mut vectors = Vec::new();
     for spec in specs.0 {

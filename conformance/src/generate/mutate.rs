@@ -6,6 +6,7 @@
 use std::ops::Range;
 
 use splitstream_decoder_core::limits::{CHUNK_ENTRY_LEN, HEADER_LEN, LEVEL_ENTRY_LEN, codec};
+use splitstream_decoder_core::owned::decode_all;
 use splitstream_decoder_core::writer::{
     ChunkCodec, LevelPayload, SeedPayload, StreamParams, SubstreamWriter, write_stream_seeded,
 };
@@ -401,4 +402,47 @@ fn append_level(out: &mut Vec<u8>, k: u16, level: &[u8]) {
     out[entry..entry + 8].copy_from_slice(&offset.to_le_bytes());
     out[entry + 8..entry + 12].copy_from_slice(&(level.len() as u32).to_le_bytes());
     out.extend_from_slice(level);
+}
+
+/// `stream`, after checking that decoder-core rejects it with `detail`
+/// (the error's `Debug` form).
+pub fn failing_with(detail: &str, stream: Vec<u8>) -> Vec<u8> {
+    match decode_all(&stream, false) {
+        Err(e) => assert_eq!(format!("{e:?}"), detail, "the vector meets another check"),
+        Ok(_) => panic!("the vector for {detail} decodes"),
+    }
+    stream
+}
+
+/// `stream` with `f` applied to its header, whose CRC is then recomputed.
+pub fn with_header(stream: &[u8], f: impl Fn(&mut [u8])) -> Vec<u8> {
+    let mut b = stream.to_vec();
+    f(&mut b[..96]);
+    fix_header_crc(&mut b);
+    b
+}
+
+/// `stream` with `f` applied to level-table entry `k`, whose CRC is then
+/// recomputed.
+pub fn with_table_entry(stream: &[u8], k: u16, f: impl Fn(&mut [u8])) -> Vec<u8> {
+    let mut b = stream.to_vec();
+    let at = table_entry(k);
+    f(&mut b[at..at + 32]);
+    fix_table_crc(&mut b);
+    b
+}
+
+pub fn put_u32(b: &mut [u8], at: usize, v: u32) {
+    b[at..at + 4].copy_from_slice(&v.to_le_bytes());
+}
+
+pub fn put_f64(b: &mut [u8], at: usize, v: f64) {
+    b[at..at + 8].copy_from_slice(&v.to_le_bytes());
+}
+
+/// The level count of a valid stream.
+pub fn level_count_of(stream: &[u8]) -> u16 {
+    splitstream_decoder_core::Header::parse(stream)
+        .expect("a valid stream")
+        .level_count
 }
