@@ -378,13 +378,11 @@ pub fn with_chunk_payload(stream: &[u8], k: u16, c: usize, payload: Vec<u8>) -> 
             level.splice(from..to, payload.iter().copied());
             let entry = chunk_entry_at(stream, k, c) - range.start;
             set_stored_payload(&mut level[entry..entry + CHUNK_ENTRY_LEN], &payload);
-            let crc_at = level_crc_at(stream, k) - range.start;
-            let crc = crc32(&level[..crc_at]);
-            level[crc_at..crc_at + 4].copy_from_slice(&crc.to_le_bytes());
         }
         append_level(&mut out, l, &level);
     }
     fix_table_crc(&mut out);
+    fix_level_header_crc(&mut out, k);
     out
 }
 
@@ -417,7 +415,7 @@ pub fn failing_with(detail: &str, stream: Vec<u8>) -> Vec<u8> {
 /// `stream` with `f` applied to its header, whose CRC is then recomputed.
 pub fn with_header(stream: &[u8], f: impl Fn(&mut [u8])) -> Vec<u8> {
     let mut b = stream.to_vec();
-    f(&mut b[..96]);
+    f(&mut b[..HEADER_LEN]);
     fix_header_crc(&mut b);
     b
 }
@@ -427,7 +425,7 @@ pub fn with_header(stream: &[u8], f: impl Fn(&mut [u8])) -> Vec<u8> {
 pub fn with_table_entry(stream: &[u8], k: u16, f: impl Fn(&mut [u8])) -> Vec<u8> {
     let mut b = stream.to_vec();
     let at = table_entry(k);
-    f(&mut b[at..at + 32]);
+    f(&mut b[at..at + LEVEL_ENTRY_LEN]);
     fix_table_crc(&mut b);
     b
 }
