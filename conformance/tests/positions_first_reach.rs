@@ -10,10 +10,14 @@
 //!   `P = 2R − C + t` is R itself. A SPEC note once said no pair could
 //!   exist then; these records are common (1,453 of the Jacksboro DEM's
 //!   120,549 records read positions first).
+//! * a kind-1 record whose P falls on a ring entry in x and y, with that
+//!   entry's wedges in C's arc: the reference encoder has never written
+//!   one, so a hand-made vector holds it (`positions-first-p-on-ring-entry`).
 //!
 //! A generator change that drops one of them fails this test.
 
 use splitstream_conformance::manifest::{Manifest, default_vector_dir};
+use splitstream_decoder_core::limits::NONE;
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::positions_first::{NewEdge, PositionsFirst};
 use splitstream_decoder_core::{MeshState, RecordOrder, Ring, SplitObserver, SplitRecord};
@@ -25,6 +29,7 @@ struct Reached {
     capped: usize,
     not_eligible: usize,
     kind1_p_on_r: usize,
+    kind1_p_on_entry: usize,
     pf: PositionsFirst,
 }
 
@@ -85,8 +90,17 @@ impl SplitObserver for Reached {
         let midpoint: [u32; 3] =
             core::array::from_fn(|a| (p[a] as i64 + ((c[a] as i64 - p[a] as i64) >> 1)) as u32);
         let on_r = p[..2] == parent[..2] && p != parent && c != parent && midpoint == parent;
-        if on_r && self.names_midpoint(state, parent, ring, rec) {
-            self.kind1_p_on_r += 1;
+        let on_entry = ring
+            .vertices()
+            .iter()
+            .any(|&e| e != NONE && positions[e as usize][..2] == p[..2]);
+        if (on_r || on_entry) && midpoint == parent && self.names_midpoint(state, parent, ring, rec)
+        {
+            if on_r {
+                self.kind1_p_on_r += 1;
+            } else {
+                self.kind1_p_on_entry += 1;
+            }
         }
     }
 }
@@ -127,4 +141,8 @@ fn positions_first_vectors_reach_the_rare_rules() {
         "no fan with an entry `pair` may not take"
     );
     assert!(reached.kind1_p_on_r > 0, "no kind-1 record with P on R");
+    assert!(
+        reached.kind1_p_on_entry > 0,
+        "no kind-1 record with P on a ring entry"
+    );
 }

@@ -143,6 +143,12 @@ pub(super) fn positions_first_valid(s: &mut Specs) {
         height_outside_fan(),
     );
     s.valid(
+        "positions-first-p-on-ring-entry",
+        "Hand-made: a boundary vertex R at (10, 10) whose fan turns three quarters, from R + (1, -2) through R + (3, 0) and R + (0, 2) to q4 = R + (-1, 0), splits read positions first, kind 1 with C at R + (1, 0) and t = 0: P lands on q4 in x and y (not in z). The wings are the ghost and the first entry, so P's arc has no wedge and q4's two wedges (one of them the ghost's) go to C, and the pair holds (SPEC §7.4 `pair`, and the note after `incircle`: P on a ring entry). No encoder-made vector holds such a record.",
+        &["handmade", "positions-first", "boundary", "ghost-wing"],
+        p_on_ring_entry(),
+    );
+    s.valid(
         "positions-first-all-escapes",
         "33x33 fractal terrain at 20 bits per axis, its x and y quantized over the bounding box instead of kept on the raster's lattice (whose cells would be about 2^15 steps wide): every fan's bounding box holds more than 1,024 lattice points, so every record of the positions-first levels is read wings first (an escape without a kind, SPEC §7.4).",
         &["encoded", "terrain", "rans", "positions-first", "escape"],
@@ -334,33 +340,99 @@ fn first_named_level(subject: &[u8]) -> u16 {
 
 /// The stream of the `positions-first-height-outside-fan` vector: a seed
 /// of two triangles, (R, q1, q2) and (R, q2, q3), and one split of R read
-/// positions first (stored chunks, constrained mode, `every-vertex`).
+/// positions first, kind 1: C = R + (1, 1), P = R − (1, 1), the ghost and
+/// q1 the wings.
 fn height_outside_fan() -> Vec<u8> {
+    let stream = one_split_kind_1(&OneSplit {
+        positions: &[[10, 10, 50], [14, 10, 60], [14, 14, 80], [10, 14, 70]],
+        triangles: &[[0, 1, 2], [0, 2, 3]],
+        n: [1, 1],
+        t: 0,
+        r_z: 6,
+        wings: (0, 1),
+    });
+    let mesh = decode_all(&stream, false).expect("the split decodes");
+    // P = R − (X >> 1) with X = (2, 2, r_z): h = 0 puts P at z 50 − 3.
+    assert_eq!(mesh.positions[0], [9, 9, 47]);
+    assert_eq!(mesh.positions[4], [11, 11, 53]);
+    stream
+}
+
+/// The stream of the `positions-first-p-on-ring-entry` vector: R at
+/// (10, 10) on a boundary, its fan (R, q1, q2), (R, q2, q3), (R, q3, q4)
+/// turning from q1 = R + (1, −2) through R + (3, 0) and R + (0, 2) to
+/// q4 = R + (−1, 0); kind 1 with C = R + (1, 0) and t = 0 puts P at
+/// R + (−1, 0), on q4 in x and y. The ghost and q1 are the wings, so P
+/// takes no wedge of the ring and C all three, q4's among them: the one
+/// way a pair can hold when A falls on a ring entry (SPEC §7.4, the note
+/// after `incircle`).
+fn p_on_ring_entry() -> Vec<u8> {
+    let q4 = [9, 10, 90];
+    let stream = one_split_kind_1(&OneSplit {
+        positions: &[[10, 10, 50], [11, 8, 55], [13, 10, 60], [10, 12, 65], q4],
+        triangles: &[[0, 1, 2], [0, 2, 3], [0, 3, 4]],
+        n: [1, 0],
+        t: 0,
+        r_z: -4,
+        wings: (0, 1),
+    });
+    let mesh = decode_all(&stream, false).expect("the split decodes");
+    let (p, c) = (mesh.positions[0], mesh.positions[5]);
+    assert_eq!(&p[..2], &q4[..2], "P on q4 in x and y");
+    assert_ne!(p[2], q4[2], "P and q4 apart in z");
+    assert_eq!(&c[..2], &[11, 10]);
+    // P keeps one triangle, the new one with C and q1; C takes R's three.
+    let with = |v: u32| mesh.triangles.iter().filter(|t| t.contains(&v)).count();
+    assert_eq!((with(0), with(5)), (1, 4));
+    assert!(mesh.triangles.iter().any(|t| {
+        let mut t = *t;
+        let at = t.iter().position(|&v| v == 5).unwrap_or(0);
+        t.rotate_left(at);
+        t == [5, 0, 1]
+    }));
+    stream
+}
+
+/// A seed and one split of its vertex 0 read positions first, kind 1
+/// (stored chunks, constrained mode, `every-vertex`): the new edge's
+/// rank, the midpoint offset `t` and the wing ranks are found with
+/// decoder-core's own positions-first lists on the seed's state.
+struct OneSplit<'a> {
+    positions: &'a [[u32; 3]],
+    triangles: &'a [[u32; 3]],
+    /// C − R in x and y; P = R − N + t.
+    n: [i64; 2],
+    /// The midpoint offset: bit 0 for x, bit 1 for y.
+    t: u8,
+    /// The z residual of the edge vector.
+    r_z: i32,
+    /// The wings' ring positions (x, y), x < y: P owns the arc from x to y.
+    wings: (usize, usize),
+}
+
+fn one_split_kind_1(split: &OneSplit) -> Vec<u8> {
     use splitstream_decoder_core::positions_first::{NewEdge, PositionsFirst};
     use splitstream_decoder_core::writer::{
         LevelPayload, StreamParams, SubstreamWriter, write_stream,
     };
     use splitstream_decoder_core::{PlanePolicy, Ring, WingPolicy, handmade};
 
-    let positions = [[10, 10, 50], [14, 10, 60], [14, 14, 80], [10, 14, 70]];
-    let triangles = [[0, 1, 2], [0, 2, 3]];
     let params = StreamParams {
         position_mode: PositionMode::Constrained,
         schedule: Schedule::EveryVertex,
         ..handmade::params(ChunkCodec::Stored)
     };
-    // C = R + N, P = R − N + t with t = (0, 0); the new edge's z residual.
-    let (n, r_z) = ([1i64, 1], 6);
+    let ghost_wing = split.wings.0 == 0;
     let build = |j: u32, u: u8, v: u8| {
         let mut subs = vec![SubstreamWriter::default(); 7];
         subs[0].bit(true); // R's flag; its neighbours' are inferred
         subs[6].byte(1); // kind 1: R sat on the floor midpoint
         subs[5].varint(j); // C's rank among the free points
-        subs[6].byte(0); // the midpoint offset t
+        subs[6].byte(split.t);
         subs[1].byte(u);
         subs[2].byte(v);
-        subs[5].signed(r_z);
-        let split = LevelPayload {
+        subs[5].signed(split.r_z);
+        let level = LevelPayload {
             round_splits: vec![1],
             plane: PlanePolicy::Height,
             wings: WingPolicy::Ranks,
@@ -368,18 +440,16 @@ fn height_outside_fan() -> Vec<u8> {
             records: RecordOrder::PositionsFirst,
             ties: Ties::Ring,
             substreams: subs,
-            vertex_count: 5,
-            // One wing is the ghost: one triangle more.
-            triangle_count: 3,
+            vertex_count: split.positions.len() as u32 + 1,
+            // Two new triangles, one when a wing is the ghost.
+            triangle_count: split.triangles.len() as u32 + if ghost_wing { 1 } else { 2 },
             geometric_error: 0.0,
         };
         write_stream(
             &params,
-            &[handmade::base(&positions, &triangles, &[]), split],
+            &[handmade::base(split.positions, split.triangles, &[]), level],
         )
     };
-    // Name the split with decoder-core's own positions-first lists, on the
-    // seed's state.
     let draft = build(0, 0, 0);
     let mut workspace =
         splitstream_decoder_core::owned::OwnedWorkspace::for_stream(&draft).expect("valid");
@@ -390,30 +460,28 @@ fn height_outside_fan() -> Vec<u8> {
     let state = level.state();
     let mut ring = Ring::default();
     state.ring(0, &mut ring).expect("R's ring");
-    let mut pf = PositionsFirst::default();
-    pf.free_points(state.positions(), state.positions()[0], &ring)
-        .expect("the fan has free points");
-    let j = pf.rank_of(n).expect("N is a free point") as u32;
-    let edge = NewEdge {
-        a: [-n[0], -n[1]],
-        b: n,
-        midpoint: true,
-    };
-    // The ghost (ring position 0) and q1 (1) are the wings: P owns the
-    // arc from the ghost to q1.
     assert_eq!(
         ring.vertices()[1],
         1,
-        "the ring starts at the ghost, then q1"
+        "the ring starts at the ghost, then vertex 1"
     );
+    let mut pf = PositionsFirst::default();
+    pf.free_points(state.positions(), state.positions()[0], &ring)
+        .expect("the fan has free points");
+    let n = split.n;
+    let j = pf.rank_of(n).expect("N is a free point") as u32;
+    let edge = NewEdge {
+        a: [
+            -n[0] + i64::from(split.t & 1),
+            -n[1] + i64::from(split.t >> 1),
+        ],
+        b: n,
+        midpoint: true,
+    };
+    let (x, y) = split.wings;
     let xs = pf.order_xs(&state.wing_candidates(&ring), &edge);
-    let u = pf.rank_of_choice(xs, 0).expect("the ghost pairs with q1");
-    let ys = pf.order_ys(&edge, 0);
-    let v = pf.rank_of_choice(ys, 1).expect("q1 pairs with the ghost");
-    let stream = build(j, u as u8, v as u8);
-    let mesh = decode_all(&stream, false).expect("the split decodes");
-    // P = R − (X >> 1) with X = (2, 2, r_z): h = 0 puts P at z 50 − 3.
-    assert_eq!(mesh.positions[0], [9, 9, 47]);
-    assert_eq!(mesh.positions[4], [11, 11, 53]);
-    stream
+    let u = pf.rank_of_choice(xs, x).expect("x pairs");
+    let ys = pf.order_ys(&edge, x);
+    let v = pf.rank_of_choice(ys, y).expect("y pairs with x");
+    build(j, u as u8, v as u8)
 }
