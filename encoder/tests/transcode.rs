@@ -347,3 +347,32 @@ fn conformance_vectors_transcode_or_are_refused() {
     }
     assert!(seen > 100, "{seen} vectors");
 }
+
+/// `EncodeOptions` and `TranscodeOptions` share one coding: the defaults
+/// are the same, and `with_coding` and `coding` carry every field across.
+#[test]
+fn encode_and_transcode_options_share_their_coding() {
+    let same = |a: &TranscodeOptions, b: &TranscodeOptions| format!("{a:?}") == format!("{b:?}");
+    assert!(same(
+        &EncodeOptions::default().coding(),
+        &TranscodeOptions::default()
+    ));
+    let coding = TranscodeOptions {
+        codec: ChunkCodec::Deflate(6),
+        chunk_limit: 4096,
+        rans_chunk_limit: 8192,
+        plane: Some(PlanePolicy::Height),
+        wings: Some(WingPolicy::Ranks),
+        deficits: Some(DeficitContexts::Valence),
+        records: Some(splitstream_decoder_core::RecordOrder::WingsFirst),
+        ties: Some(splitstream_decoder_core::Ties::Falling),
+        schedule: splitstream_decoder_core::Schedule::SplitValences,
+    };
+    let options = EncodeOptions {
+        bits: 11,
+        ..EncodeOptions::default()
+    }
+    .with_coding(coding);
+    assert!(same(&options.coding(), &coding));
+    assert_eq!(options.bits, 11, "with_coding keeps what is not coding");
+}

@@ -7,7 +7,7 @@ use splitstream_decoder_core::{
 };
 
 use super::{CliResult, Codec, DeficitsArg, PlaneArg, RecordsArg, ScheduleArg, TiesArg, WingsArg};
-use splitstream_encoder::emit::check_coding;
+use splitstream_encoder::emit::{TranscodeOptions, check_coding};
 
 #[derive(clap::Args)]
 pub struct CodingArgs {
@@ -72,6 +72,22 @@ impl CodingArgs {
     /// read, by the library's own rules.
     pub fn check(&self) -> CliResult {
         check_coding(self.chunk_codec(), self.chunk_size, self.rans_chunk)
+    }
+
+    /// The coding the flags ask for, as the library takes it (`encode`
+    /// sets it into its `EncodeOptions` with `with_coding`).
+    pub fn options(&self) -> TranscodeOptions {
+        TranscodeOptions {
+            codec: self.chunk_codec(),
+            chunk_limit: self.chunk_size,
+            rans_chunk_limit: self.rans_chunk,
+            plane: self.plane(),
+            wings: self.wings(),
+            deficits: self.deficits(),
+            records: self.records(),
+            ties: self.ties(),
+            schedule: self.schedule(),
+        }
     }
 
     pub fn chunk_codec(&self) -> ChunkCodec {

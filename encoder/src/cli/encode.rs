@@ -87,9 +87,6 @@ pub fn run(a: Args) -> CliResult {
             Position::Constrained => PositionMode::Constrained,
         },
         max_error: a.max_error,
-        codec: a.coding.chunk_codec(),
-        chunk_limit: a.coding.chunk_size,
-        rans_chunk_limit: a.coding.rans_chunk,
         lock_boundary: a.lock_boundary,
         admit_quantile: a.admit,
         units: if a.geographic {
@@ -100,13 +97,9 @@ pub fn run(a: Args) -> CliResult {
         quantization: a.quantization.into(),
         lattice: a.lattice.lattice(),
         backend: a.backend.into(),
-        plane: a.coding.plane(),
-        wings: a.coding.wings(),
-        records: a.coding.records(),
-        ties: a.coding.ties(),
-        deficits: a.coding.deficits(),
-        schedule: a.coding.schedule(),
-    };
+        ..EncodeOptions::default()
+    }
+    .with_coding(a.coding.options());
     options.check().map_err(|e| e.to_string())?;
     if options.levels == 1 && options.base_vertices.is_some() {
         eprintln!(

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use splitstream_decoder_core::Header;
-use splitstream_encoder::emit::{TranscodeOptions, transcode};
+use splitstream_encoder::emit::transcode;
 
 use super::CliResult;
 use super::coding::CodingArgs;
@@ -23,17 +23,7 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     a.coding.check()?;
     let stream = std::fs::read(&a.input).map_err(|e| format!("{}: {e}", a.input.display()))?;
-    let options = TranscodeOptions {
-        codec: a.coding.chunk_codec(),
-        chunk_limit: a.coding.chunk_size,
-        rans_chunk_limit: a.coding.rans_chunk,
-        plane: a.coding.plane(),
-        wings: a.coding.wings(),
-        records: a.coding.records(),
-        ties: a.coding.ties(),
-        deficits: a.coding.deficits(),
-        schedule: a.coding.schedule(),
-    };
+    let options = a.coding.options();
     let started = Instant::now();
     let done = transcode(&stream, &options).map_err(|e| format!("{}: {e}", a.input.display()))?;
     let seconds = started.elapsed().as_secs_f64();

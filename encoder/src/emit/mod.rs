@@ -125,6 +125,51 @@ impl Default for EncodeOptions {
     }
 }
 
+impl EncodeOptions {
+    /// The part of these options that says how the stream is coded, not
+    /// what is simplified: what [`transcode`] takes.
+    pub fn coding(&self) -> TranscodeOptions {
+        TranscodeOptions {
+            codec: self.codec,
+            chunk_limit: self.chunk_limit,
+            rans_chunk_limit: self.rans_chunk_limit,
+            plane: self.plane,
+            wings: self.wings,
+            deficits: self.deficits,
+            records: self.records,
+            ties: self.ties,
+            schedule: self.schedule,
+        }
+    }
+
+    /// These options with the coding of `coding` ([`EncodeOptions::coding`]).
+    pub fn with_coding(self, coding: TranscodeOptions) -> Self {
+        let TranscodeOptions {
+            codec,
+            chunk_limit,
+            rans_chunk_limit,
+            plane,
+            wings,
+            deficits,
+            records,
+            ties,
+            schedule,
+        } = coding;
+        EncodeOptions {
+            codec,
+            chunk_limit,
+            rans_chunk_limit,
+            plane,
+            wings,
+            deficits,
+            records,
+            ties,
+            schedule,
+            ..self
+        }
+    }
+}
+
 /// A written stream and what went into it.
 pub struct Encoded {
     pub stream: Vec<u8>,

@@ -22,7 +22,7 @@ use splitstream_decoder_core::{
 
 use super::levels::LevelPlan;
 use super::replay::{ReplayError, ReplayOptions, replay};
-use super::{check_coding, check_records};
+use super::{EncodeOptions, check_coding, check_records};
 use crate::corner_table::{CornerTable, Fan};
 use crate::quantize::QuantizedMesh;
 use crate::simplify::{Collapse, NO_SPLIT, Simplification};
@@ -57,19 +57,10 @@ pub struct TranscodeOptions {
 impl Default for TranscodeOptions {
     /// The reference encoder's defaults: rANS in 4 lanes, byte-codec chunks
     /// of 16 KiB, rANS chunks of up to 262,144 values
-    /// (`DEFAULT_RANS_CHUNK_LIMIT`), every policy chosen by size.
+    /// (`DEFAULT_RANS_CHUNK_LIMIT`), every policy chosen by size: those of
+    /// [`EncodeOptions::default`], which holds them.
     fn default() -> Self {
-        TranscodeOptions {
-            codec: ChunkCodec::Rans { lanes: 4 },
-            chunk_limit: 16 * 1024,
-            rans_chunk_limit: splitstream_decoder_core::writer::DEFAULT_RANS_CHUNK_LIMIT,
-            plane: None,
-            wings: None,
-            deficits: None,
-            records: None,
-            ties: None,
-            schedule: Schedule::EveryVertex,
-        }
+        EncodeOptions::default().coding()
     }
 }
 
