@@ -542,3 +542,39 @@ fn records_read_positions_first_decode_to_the_same_mesh() {
     ]));
     assert!(err.contains("--records positions-first"), "{err}");
 }
+
+/// Without `--lanes`, a small mesh gets one rANS lane (lanes only cost
+/// bytes there), and `transcode` chooses the same way; `--lanes` sets it.
+#[test]
+fn small_meshes_get_one_lane_unless_asked() {
+    let (_, stream) = encoded_raster("lanes-default.sps");
+    let lanes = |p: &PathBuf| {
+        splitstream_decoder_core::Header::parse(&std::fs::read(p).unwrap())
+            .unwrap()
+            .lane_count
+    };
+    assert_eq!(lanes(&stream), 1);
+    let input = raster();
+    let four = input.with_file_name("lanes-four.sps");
+    succeeded(&splitstream(&[
+        "encode",
+        input.to_str().unwrap(),
+        "-o",
+        four.to_str().unwrap(),
+        "--lanes",
+        "4",
+    ]));
+    assert_eq!(lanes(&four), 4);
+    let back = input.with_file_name("lanes-transcoded.sps");
+    succeeded(&splitstream(&[
+        "transcode",
+        four.to_str().unwrap(),
+        "-o",
+        back.to_str().unwrap(),
+    ]));
+    assert_eq!(lanes(&back), 1);
+    assert_eq!(
+        std::fs::read(&back).unwrap(),
+        std::fs::read(&stream).unwrap()
+    );
+}

@@ -29,6 +29,17 @@ fn refused(options: EncodeOptions, says: &str) {
     }
 }
 
+/// One lane below 65,536 vertices, four from there (`lanes_for`, what
+/// `splitstream encode` writes without `--lanes`).
+#[test]
+fn lanes_by_mesh_size() {
+    use splitstream_encoder::emit::{ONE_LANE_BELOW_VERTICES, lanes_for};
+    assert_eq!(lanes_for(0), 1);
+    assert_eq!(lanes_for(ONE_LANE_BELOW_VERTICES - 1), 1);
+    assert_eq!(lanes_for(ONE_LANE_BELOW_VERTICES), 4);
+    assert_eq!(lanes_for(usize::MAX), 4);
+}
+
 #[test]
 fn lane_counts_outside_the_format_are_refused() {
     // Before the check these wrote streams whose header every decoder

@@ -10,7 +10,7 @@ use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::baseline::{BaselineOptions, simplify_sequential};
-use splitstream_encoder::emit::{EncodeOptions, encode};
+use splitstream_encoder::emit::{EncodeOptions, encode, lanes_for};
 use splitstream_encoder::input::{ReadOptions, check_mesh, fractal_terrain, read_mesh};
 use splitstream_encoder::metrics::surface_distance;
 use splitstream_encoder::quantize::{Quantization, QuantizedMesh, Units, quantize};
@@ -116,7 +116,9 @@ pub fn run(settings: &Settings) -> CliResult {
         // is what Draco does at the same bit count (fair comparisons).
         for mode in [PositionMode::Optimal, PositionMode::Constrained] {
             for quantization in [Quantization::PerAxis, Quantization::Uniform] {
-                for codec in [ChunkCodec::Rans { lanes: 4 }, ChunkCodec::Deflate(9)] {
+                // The lanes `splitstream encode` writes for this mesh.
+                let lanes = lanes_for(mesh.positions.len());
+                for codec in [ChunkCodec::Rans { lanes }, ChunkCodec::Deflate(9)] {
                     size_row(
                         input.name,
                         &mesh,

@@ -7,16 +7,18 @@ use splitstream_decoder_core::{
 };
 
 use super::{CliResult, Codec, DeficitsArg, PlaneArg, RecordsArg, ScheduleArg, TiesArg, WingsArg};
-use splitstream_encoder::emit::{TranscodeOptions, check_coding};
+use splitstream_encoder::emit::{TranscodeOptions, check_coding, lanes_for};
 
 #[derive(clap::Args)]
 pub struct CodingArgs {
     #[arg(long, value_enum, default_value_t = Codec::Rans)]
     pub codec: Codec,
     /// rANS lanes per chunk (1..=32): independent streams a decoder may
-    /// decode in parallel.
-    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u8).range(1..=32))]
-    pub lanes: u8,
+    /// decode in parallel [default: 1 for a mesh of fewer than 65,536
+    /// vertices, 4 for a larger one: each lane costs a few bytes a chunk,
+    /// and only large levels gain from decoding them apart]
+    #[arg(long, value_parser = clap::value_parser!(u8).range(1..=32))]
+    pub lanes: Option<u8>,
     /// Largest stored or deflate chunk in bytes: bounds the decoder's
     /// buffers (7 chunks, or 1,856 bytes each at least, SPEC §9).
     #[arg(long, default_value_t = 16384)]
@@ -71,14 +73,17 @@ impl CodingArgs {
     /// Refuses what clap cannot (a chunk size of 0) before any input is
     /// read, by the library's own rules.
     pub fn check(&self) -> CliResult {
-        check_coding(self.chunk_codec(), self.chunk_size, self.rans_chunk)
+        // Any mesh size gives a valid lane count: check with the smallest.
+        check_coding(self.chunk_codec(0), self.chunk_size, self.rans_chunk)
     }
 
-    /// The coding the flags ask for, as the library takes it (`encode`
-    /// sets it into its `EncodeOptions` with `with_coding`).
-    pub fn options(&self) -> TranscodeOptions {
+    /// The coding the flags ask for, for a mesh of `vertices` vertices
+    /// (the lane count when `--lanes` is not given: [`lanes_for`]), as the
+    /// library takes it (`encode` sets it into its `EncodeOptions` with
+    /// `with_coding`).
+    pub fn options(&self, vertices: usize) -> TranscodeOptions {
         TranscodeOptions {
-            codec: self.chunk_codec(),
+            codec: self.chunk_codec(vertices),
             chunk_limit: self.chunk_size,
             rans_chunk_limit: self.rans_chunk,
             plane: self.plane(),
@@ -90,9 +95,11 @@ impl CodingArgs {
         }
     }
 
-    pub fn chunk_codec(&self) -> ChunkCodec {
+    /// The codec for a mesh of `vertices` vertices.
+    pub fn chunk_codec(&self, vertices: usize) -> ChunkCodec {
+        let lanes = self.lanes.unwrap_or_else(|| lanes_for(vertices));
         match self.codec {
-            Codec::Rans => ChunkCodec::Rans { lanes: self.lanes },
+            Codec::Rans => ChunkCodec::Rans { lanes },
             Codec::Deflate => ChunkCodec::Deflate(9),
             Codec::Stored => ChunkCodec::Stored,
         }

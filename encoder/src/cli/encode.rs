@@ -99,7 +99,9 @@ pub fn run(a: Args) -> CliResult {
         backend: a.backend.into(),
         ..EncodeOptions::default()
     }
-    .with_coding(a.coding.options());
+    // The lane count of a mesh whose size is not known yet; set again
+    // below, once it is.
+    .with_coding(a.coding.options(usize::MAX));
     options.check().map_err(|e| e.to_string())?;
     if options.levels == 1 && options.base_vertices.is_some() {
         eprintln!(
@@ -127,6 +129,7 @@ pub fn run(a: Args) -> CliResult {
         );
     }
     let n = mesh.positions.len();
+    let options = options.with_coding(a.coding.options(n));
     let bar = ProgressBar::new(n as u64);
     bar.set_style(
         ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} collapses")

@@ -23,7 +23,10 @@ pub struct Args {
 pub fn run(a: Args) -> CliResult {
     a.coding.check()?;
     let stream = std::fs::read(&a.input).map_err(|e| format!("{}: {e}", a.input.display()))?;
-    let options = a.coding.options();
+    // The lane count by the mesh's size (a stream that does not parse fails
+    // in `transcode` with its own error).
+    let vertices = Header::parse(&stream).map_or(usize::MAX, |h| h.vertex_capacity as usize);
+    let options = a.coding.options(vertices);
     let started = Instant::now();
     let done = transcode(&stream, &options).map_err(|e| format!("{}: {e}", a.input.display()))?;
     let seconds = started.elapsed().as_secs_f64();

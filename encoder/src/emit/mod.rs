@@ -299,6 +299,31 @@ pub fn check_records(
     Ok(())
 }
 
+/// Meshes with fewer vertices than this get one rANS lane from
+/// [`lanes_for`].
+pub const ONE_LANE_BELOW_VERTICES: usize = 1 << 16;
+
+/// The rANS lane count `splitstream encode` and `transcode` write when
+/// `--lanes` is not given: 1 for a mesh of fewer than
+/// [`ONE_LANE_BELOW_VERTICES`] vertices, 4 for a larger one.
+///
+/// Lanes let a decoder split a chunk's entropy decoding over cores or GPU
+/// lanes (SPEC §5.5.3); one thread reads 1 and 4 lanes alike (armadillo
+/// decodes in 12.0–12.2 ms either way). Each lane costs a 4-byte state, a
+/// length and a partly filled last byte in every chunk: 4 lanes instead of
+/// 1 add 0.09–0.12 bits per vertex to the 26k–44k-vertex scanned meshes
+/// (0.4 %) and 1.0 to the 1,839-vertex bunny (2.4 %), where nobody splits
+/// a level's decoding, and 0.03 % to the 1M-vertex terrain, whose large
+/// levels are what lanes are for (encoder/BENCHMARKS.md, "Lanes by mesh
+/// size").
+pub fn lanes_for(vertices: usize) -> u8 {
+    if vertices < ONE_LANE_BELOW_VERTICES {
+        1
+    } else {
+        4
+    }
+}
+
 /// The coding options' own rules, shared by [`EncodeOptions::check`] and
 /// [`transcode()`]: chunks of at least one byte or value, and 1 to 32 rANS
 /// lanes (SPEC §5.5.3; the writer would put any other count in a header
