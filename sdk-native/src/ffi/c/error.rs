@@ -118,3 +118,30 @@ pub extern "C" fn ss_last_error_message() -> *const c_char {
 pub extern "C" fn ss_last_error_class() -> *const c_char {
     LAST.with(|l| l.borrow().class.as_ptr())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::ffi::CStr;
+
+    fn last() -> (String, String) {
+        // SAFETY: NUL-terminated strings, valid until the next failure.
+        let text = |p| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned();
+        (text(ss_last_error_class()), text(ss_last_error_message()))
+    }
+
+    /// A panic (a bug) stops at the boundary as `SS_STATUS_PANIC`, its
+    /// message kept whatever its payload.
+    #[test]
+    fn a_panic_becomes_a_status_and_its_message() {
+        assert_eq!(guard(|| panic!("a static message")), SsStatus::Panic);
+        assert_eq!(last().0, "panic");
+        assert!(last().1.ends_with("a static message"), "{:?}", last().1);
+        let n = 7;
+        assert_eq!(guard(|| panic!("a formatted message {n}")), SsStatus::Panic);
+        assert!(last().1.ends_with("a formatted message 7"));
+        assert_eq!(guard(|| std::panic::panic_any(42u8)), SsStatus::Panic);
+        assert!(last().1.ends_with("unknown panic"));
+        assert_eq!(guard(|| SsStatus::Ok), SsStatus::Ok);
+    }
+}
