@@ -14,7 +14,7 @@ pub struct CodingArgs {
     #[arg(long, value_enum, default_value_t = Codec::Rans)]
     pub codec: Codec,
     /// rANS lanes per chunk (1..=32): independent streams a decoder may
-    /// decode in parallel [default: 1 for a mesh of fewer than 65,536
+    /// decode in parallel [default: 1 for a mesh of fewer than 262,144
     /// vertices, 4 for a larger one: each lane costs a few bytes a chunk,
     /// and only large levels gain from decoding them apart]
     #[arg(long, value_parser = clap::value_parser!(u8).range(1..=32))]

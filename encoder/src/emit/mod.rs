@@ -301,7 +301,7 @@ pub fn check_records(
 
 /// Meshes with fewer vertices than this get one rANS lane from
 /// [`lanes_for`].
-pub const ONE_LANE_BELOW_VERTICES: usize = 1 << 16;
+pub const ONE_LANE_BELOW_VERTICES: usize = 1 << 18;
 
 /// The rANS lane count `splitstream encode` and `transcode` write when
 /// `--lanes` is not given: 1 for a mesh of fewer than
@@ -311,11 +311,12 @@ pub const ONE_LANE_BELOW_VERTICES: usize = 1 << 16;
 /// lanes (SPEC §5.5.3); one thread reads 1 and 4 lanes alike (armadillo
 /// decodes in 12.0–12.2 ms either way). Each lane costs a 4-byte state, a
 /// length and a partly filled last byte in every chunk: 4 lanes instead of
-/// 1 add 0.09–0.12 bits per vertex to the 26k–44k-vertex scanned meshes
-/// (0.4 %) and 1.0 to the 1,839-vertex bunny (2.4 %), where nobody splits
-/// a level's decoding, and 0.03 % to the 1M-vertex terrain, whose large
-/// levels are what lanes are for (encoder/BENCHMARKS.md, "Lanes by mesh
-/// size").
+/// 1 add 0.4 % to the 26k–139k-vertex real meshes (0.04–0.12 bits per
+/// vertex) and 2.4 % to the 1,839-vertex bunny, whose levels nobody
+/// would decode on several cores, and 0.13 % to the 1M-vertex terrain,
+/// whose large levels are what lanes are for (encoder/BENCHMARKS.md,
+/// "Lanes by mesh size"). The threshold is the demo's default terrain,
+/// 512 × 512 vertices.
 pub fn lanes_for(vertices: usize) -> u8 {
     if vertices < ONE_LANE_BELOW_VERTICES {
         1
