@@ -12,13 +12,22 @@ pub const SUPPORTED_EXTENSIONS: &[&str] = &[
     "ply", "obj", "off", "gltf", "glb", "stl", "tif", "tiff", "asc", "npy", "npz",
 ];
 
+/// The extensions `read_grid` understands (elevation grids only).
+pub const GRID_EXTENSIONS: &[&str] = &["tif", "tiff", "asc", "npy", "npz"];
+
 /// Why a file could not be turned into a [`crate::Mesh`].
 #[derive(Debug)]
 pub enum InputError {
     /// The file could not be opened or read.
     Io { file: String, source: io::Error },
-    /// The file name has no extension we know how to read.
-    UnknownExtension { file: String, extension: String },
+    /// The file name has no extension the reader knows; `supported` lists
+    /// those it does ([`SUPPORTED_EXTENSIONS`] for meshes,
+    /// [`GRID_EXTENSIONS`] for grids).
+    UnknownExtension {
+        file: String,
+        extension: String,
+        supported: &'static [&'static str],
+    },
     /// A text format failed at a known line (1-based).
     Line {
         file: String,
@@ -118,11 +127,12 @@ impl fmt::Display for InputError {
                     one_line(&source.to_string())
                 )
             }
-            InputError::UnknownExtension { file, extension } => {
-                let list: Vec<String> = SUPPORTED_EXTENSIONS
-                    .iter()
-                    .map(|e| format!(".{e}"))
-                    .collect();
+            InputError::UnknownExtension {
+                file,
+                extension,
+                supported,
+            } => {
+                let list: Vec<String> = supported.iter().map(|e| format!(".{e}")).collect();
                 if extension.is_empty() {
                     write!(
                         f,
@@ -196,6 +206,7 @@ mod tests {
             InputError::UnknownExtension {
                 file: "a.stl".into(),
                 extension: "stl".into(),
+                supported: SUPPORTED_EXTENSIONS,
             },
             InputError::line("bunny.off", 12, "expected 3 coordinates, found 2"),
             InputError::element("a.ply", "face 3", "bad\n\tthing"),

@@ -28,7 +28,7 @@ use std::path::Path;
 use crate::Mesh;
 
 pub use check::{MeshError, MeshStats, check_mesh};
-pub use error::{InputError, SUPPORTED_EXTENSIONS};
+pub use error::{GRID_EXTENSIONS, InputError, SUPPORTED_EXTENSIONS};
 pub use grid::{Grid, grid_to_mesh};
 pub use read_grid::read_grid;
 pub use repair::{RepairReport, repair_mesh};
@@ -85,7 +85,13 @@ pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<Mesh, InputError>
             npy::read_npz(path, &file, options.npz_array.as_deref())?,
             options,
         )),
-        _ => return Err(InputError::UnknownExtension { file, extension }),
+        _ => {
+            return Err(InputError::UnknownExtension {
+                file,
+                extension,
+                supported: SUPPORTED_EXTENSIONS,
+            });
+        }
     };
     if options.z_scale != 1.0 {
         for p in &mut mesh.positions {
@@ -191,6 +197,20 @@ mod tests {
         assert!(msg.contains("'.fbx'") && msg.contains(".npz"), "{msg}");
         let err = read_mesh(Path::new("noext"), &ReadOptions::default()).unwrap_err();
         assert!(err.to_string().contains("no file extension"));
+    }
+
+    /// `read_grid` lists the grid formats only: a mesh file given where a
+    /// grid is wanted is told so, not offered its own extension.
+    #[test]
+    fn a_mesh_where_a_grid_is_wanted_lists_the_grid_formats() {
+        let f = TempFile::new("tri.off", b"OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n");
+        let err = read_grid(&f.0, &ReadOptions::default()).unwrap_err();
+        let msg = err.to_string();
+        assert!(msg.contains("unsupported extension '.off'"), "{msg}");
+        assert!(
+            msg.ends_with("supported: .tif, .tiff, .asc, .npy, .npz"),
+            "{msg}"
+        );
     }
 
     #[test]

@@ -3,7 +3,7 @@
 
 use std::path::Path;
 
-use super::{Grid, InputError, ReadOptions, esri, geotiff, npy};
+use super::{GRID_EXTENSIONS, Grid, InputError, ReadOptions, esri, geotiff, npy};
 
 /// Reads a `.tif`/`.tiff`, `.asc`, `.npy` or `.npz` elevation grid (chosen
 /// by extension, case-insensitive), applying `options.grid_spacing` and
@@ -20,7 +20,13 @@ pub fn read_grid(path: &Path, options: &ReadOptions) -> Result<Grid, InputError>
         "asc" => esri::read(path, &file)?,
         "npy" => npy::read_npy(path, &file)?,
         "npz" => npy::read_npz(path, &file, options.npz_array.as_deref())?,
-        _ => return Err(InputError::UnknownExtension { file, extension }),
+        _ => {
+            return Err(InputError::UnknownExtension {
+                file,
+                extension,
+                supported: GRID_EXTENSIONS,
+            });
+        }
     };
     if let Some((dx, dy)) = options.grid_spacing {
         grid.spacing = [dx, dy];
