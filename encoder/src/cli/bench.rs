@@ -68,7 +68,8 @@ pub struct Settings {
     /// Fraction of candidate collapses admitted per step (0..1].
     #[arg(long, default_value_t = 0.5)]
     pub admit: f64,
-    /// Only inputs whose name contains this.
+    /// Only inputs whose name contains this (one that matches none, such
+    /// as `none`, leaves the throughput run alone).
     #[arg(long)]
     pub only: Option<String>,
     /// Skip the synthetic-terrain throughput run.
@@ -89,6 +90,16 @@ pub fn run(settings: &Settings) -> CliResult {
         admit_quantile: admit,
         ..SimplifyOptions::default()
     };
+    if let Some(only) = &settings.only
+        && !INPUTS.iter().any(|i| i.name.contains(only.as_str()))
+    {
+        // Not an error: `--only none` is how the throughput runs alone.
+        let names: Vec<&str> = INPUTS.iter().map(|i| i.name).collect();
+        eprintln!(
+            "note: --only {only} matches no input ({}): no size or quality rows",
+            names.join(", ")
+        );
+    }
     println!("# splitstream encoder benchmark\n");
     println!("## Stream size (5 levels, 14-bit positions), bits per vertex\n");
     println!(
