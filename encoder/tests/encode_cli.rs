@@ -578,3 +578,45 @@ fn small_meshes_get_one_lane_unless_asked() {
         std::fs::read(&stream).unwrap()
     );
 }
+
+/// `--permutation` maps each decoded vertex to the input file's own vertex
+/// number, also for an OBJ whose faces use its vertices out of order
+/// (decoded vertex i sits where the file's vertex `permutation[i]` does).
+#[test]
+fn the_permutation_indexes_the_input_files_vertices() {
+    let input = temp(
+        "out-of-order.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 4 2 3\nf 4 3 1\nf 4 1 2\nf 1 3 2\n",
+    );
+    let file_positions = obj_positions(&input);
+    let stream = input.with_file_name("out-of-order.sps");
+    let permutation = input.with_file_name("out-of-order.perm");
+    let decoded = input.with_file_name("out-of-order-decoded.obj");
+    succeeded(&splitstream(&[
+        "encode",
+        input.to_str().unwrap(),
+        "-o",
+        stream.to_str().unwrap(),
+        "--permutation",
+        permutation.to_str().unwrap(),
+    ]));
+    succeeded(&splitstream(&[
+        "decode",
+        stream.to_str().unwrap(),
+        "-o",
+        decoded.to_str().unwrap(),
+    ]));
+    let ids: Vec<usize> = std::fs::read_to_string(&permutation)
+        .unwrap()
+        .lines()
+        .map(|l| l.parse().unwrap())
+        .collect();
+    let decoded_positions = obj_positions(&decoded);
+    assert_eq!(ids.len(), file_positions.len());
+    for (i, &id) in ids.iter().enumerate() {
+        assert_eq!(
+            decoded_positions[i], file_positions[id],
+            "decoded vertex {i}"
+        );
+    }
+}

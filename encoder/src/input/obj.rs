@@ -1,12 +1,18 @@
-//! Wavefront OBJ reader on top of `tobj` (positions and faces only).
+//! Wavefront OBJ reader: positions (`v`) and faces (`f`) only.
 //!
-//! tobj re-indexes vertices per object/group, which would disconnect groups
-//! that share vertices. We therefore hand it only the `v` and `f` statements
-//! (no `o`/`g`/`usemtl`/`mtllib`), so it builds one model whose indices keep
-//! every shared vertex shared. tobj resolves negative (relative) indices and
-//! fan-triangulates polygons; vertices no face uses are not returned.
+//! Vertex ids are the file's: the i-th `v` statement is vertex i, whether
+//! or not a face uses it (an unused one is then reported by the input
+//! check, as for the other formats), so `encode --permutation` maps decoded
+//! vertices to the file's own numbering and attributes can follow. The
+//! `tobj` crate, used before, renumbers vertices in the order faces first
+//! use them and drops unused ones; it offers no way back to the file's
+//! numbering, hence this reader. It takes what the OBJ format says of
+//! these two statements: 1-based indices, negative ones relative to the
+//! vertices read so far, `v/vt/vn` forms (only `v` is kept), polygons
+//! fanned into triangles from their first vertex, `\` line continuations;
+//! every other statement (`vt`, `vn`, `o`, `g`, `usemtl`, `l`, …) is
+//! skipped. Coordinates stay f64.
 
-use std::io::Cursor;
 use std::path::Path;
 
 use crate::Mesh;
@@ -19,50 +25,105 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     parse(&text, file)
 }
 
-/// Keeps `v` and `f` statements (and their `\` continuation lines).
-fn geometry_only(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut continuing = false;
-    for line in text.lines() {
-        let keep = continuing || matches!(line.split_whitespace().next(), Some("v" | "f"));
-        if keep {
-            out.push_str(line);
-            out.push('\n');
+/// The statements of `text`, each with the line it starts on (1-based),
+/// continuation lines (`\` at a line's end) joined.
+fn statements(text: &str) -> impl Iterator<Item = (usize, String)> + '_ {
+    let mut lines = text.lines().enumerate();
+    std::iter::from_fn(move || {
+        let (i, first) = lines.next()?;
+        let mut statement = first.to_string();
+        while statement.trim_end().ends_with('\\') {
+            let cut = statement.trim_end().len() - 1;
+            statement.truncate(cut);
+            match lines.next() {
+                Some((_, more)) => {
+                    statement.push(' ');
+                    statement.push_str(more);
+                }
+                None => break,
+            }
         }
-        continuing = keep && line.trim_end().ends_with('\\');
-    }
-    out
+        Some((i + 1, statement))
+    })
 }
 
 pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
-    let filtered = geometry_only(text);
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    let (models, _materials) =
-        tobj::load_obj_buf(&mut Cursor::new(filtered.as_bytes()), &options, |_| {
-            Err(tobj::LoadError::OpenFileFailed)
-        })
-        .map_err(|e| InputError::malformed(file, format!("invalid OBJ: {e}")))?;
-
     let mut mesh = Mesh::default();
-    for model in models {
-        let base = mesh.positions.len() as u64;
-        let positions = &model.mesh.positions;
-        check_vertex_count(file, base + positions.len() as u64 / 3)?;
-        mesh.positions
-            .extend(positions.chunks_exact(3).map(|p| [p[0], p[1], p[2]]));
-        mesh.triangles.extend(
-            model
-                .mesh
-                .indices
-                .chunks_exact(3)
-                .map(|t| [t[0] + base as u32, t[1] + base as u32, t[2] + base as u32]),
-        );
+    // Each face corner as the file wrote it: a positive index may name a
+    // vertex defined further down, so they are resolved at the end.
+    let mut corners: Vec<(i64, usize)> = Vec::new();
+    let mut polygon: Vec<(i64, usize)> = Vec::new();
+    for (line, statement) in statements(text) {
+        let mut words = statement.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let mut xyz = [0.0f64; 3];
+                for (axis, x) in xyz.iter_mut().enumerate() {
+                    let word = words.next().ok_or_else(|| {
+                        InputError::line(file, line, format!("vertex with {axis} coordinates"))
+                    })?;
+                    *x = word.parse().map_err(|_| {
+                        InputError::line(file, line, format!("'{word}' is not a coordinate"))
+                    })?;
+                }
+                // A w or vertex colours may follow: not positions.
+                mesh.positions.push(xyz);
+                check_vertex_count(file, mesh.positions.len() as u64)?;
+            }
+            Some("f") => {
+                polygon.clear();
+                for word in words {
+                    let v = word.split('/').next().unwrap_or("");
+                    let index: i64 = v.parse().map_err(|_| {
+                        InputError::line(file, line, format!("'{word}' is not a vertex index"))
+                    })?;
+                    // Negative: relative to the vertices read so far.
+                    let index = match index {
+                        0 => {
+                            return Err(InputError::line(file, line, "vertex index 0"));
+                        }
+                        i if i < 0 => mesh.positions.len() as i64 + i + 1,
+                        i => i,
+                    };
+                    if index < 1 {
+                        return Err(InputError::line(
+                            file,
+                            line,
+                            format!("'{word}' points before the first vertex"),
+                        ));
+                    }
+                    polygon.push((index, line));
+                }
+                if polygon.len() < 3 {
+                    return Err(InputError::line(
+                        file,
+                        line,
+                        format!("face with {} vertices", polygon.len()),
+                    ));
+                }
+                for i in 1..polygon.len() - 1 {
+                    corners.extend([polygon[0], polygon[i], polygon[i + 1]]);
+                }
+            }
+            _ => {}
+        }
     }
+    let n = mesh.positions.len() as i64;
+    let resolve = |(index, line): (i64, usize)| {
+        if index > n {
+            Err(InputError::line(
+                file,
+                line,
+                format!("vertex {index} of a file with {n} vertices"),
+            ))
+        } else {
+            Ok((index - 1) as u32)
+        }
+    };
+    mesh.triangles = corners
+        .chunks_exact(3)
+        .map(|t| Ok([resolve(t[0])?, resolve(t[1])?, resolve(t[2])?]))
+        .collect::<Result<_, InputError>>()?;
     Ok(mesh)
 }
 
@@ -93,13 +154,59 @@ vt 0 0\nvn 0 0 1\no first\ng a\nusemtl red\nf 1/1/1 2/1/1 3/1/1 4/1/1\ng b\nf -4
 
     #[test]
     fn bad_indices_fail() {
-        for text in [
-            "v 0 0 0\nf 1 2 3\n",
-            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n",
-            "v 0 0\n",
+        for (text, message) in [
+            (
+                "v 0 0 0\nf 1 2 3\n",
+                "bad.obj: line 2: vertex 2 of a file with 1 vertices",
+            ),
+            (
+                "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 x\n",
+                "bad.obj: line 4: 'x' is not a vertex index",
+            ),
+            ("v 0 0\n", "bad.obj: line 1: vertex with 2 coordinates"),
+            ("v 0 0 z\n", "bad.obj: line 1: 'z' is not a coordinate"),
+            (
+                "v 0 0 0\nv 1 0 0\nf 1 2\n",
+                "bad.obj: line 3: face with 2 vertices",
+            ),
+            ("v 0 0 0\nf 0 1 1\n", "bad.obj: line 2: vertex index 0"),
+            (
+                "v 0 0 0\nf -2 1 1\n",
+                "bad.obj: line 2: '-2' points before the first vertex",
+            ),
         ] {
             let msg = parse(text, "bad.obj").unwrap_err().to_string();
-            assert!(msg.starts_with("bad.obj: invalid OBJ: "), "{msg}");
+            assert_eq!(msg, message);
         }
+    }
+
+    /// Vertex ids are the file's `v` order, whatever order the faces use
+    /// them in, so a permutation written by `encode` indexes the file's
+    /// vertices; an unused vertex stays and the check names it.
+    #[test]
+    fn vertices_keep_the_files_order() {
+        let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 9 9 9\n\
+f 4 2 3\nf 4 3 1\nf 4 1 2\nf 1 3 2\n";
+        let m = parse(text, "t.obj").unwrap();
+        assert_eq!(m.positions[3], [0.0, 0.0, 1.0]);
+        assert_eq!(m.positions.len(), 5);
+        assert_eq!(m.triangles[0], [3, 1, 2]);
+        let err = check_mesh(&m).unwrap_err().to_string();
+        assert!(err.contains("vertex 4 (9, 9, 9) is not used"), "{err}");
+    }
+
+    /// Forward references, negative indices, `v/vt/vn` forms, polygons,
+    /// continuation lines, a w and vertex colours.
+    #[test]
+    fn the_formats_index_forms_all_read() {
+        let text = "f 1 2 3\nv 0 0 0 1\nv 1 0 0 0.5 0.5 0.5\nv 1 1 0\nv 0 1 \\\n  0\n\
+f -4/1/1 -2//1 -1/2\nf 1/1 2/2 3/3 4/4 \\\n\n";
+        let m = parse(text, "t.obj").unwrap();
+        assert_eq!(m.positions.len(), 4);
+        assert_eq!(m.positions[3], [0.0, 1.0, 0.0]);
+        assert_eq!(
+            m.triangles,
+            vec![[0, 1, 2], [0, 2, 3], [0, 1, 2], [0, 2, 3]]
+        );
     }
 }
