@@ -3,7 +3,8 @@
 use std::time::Instant;
 
 use splitstream_decoder_core::owned::OwnedWorkspace;
-use splitstream_encoder::emit::{EncodeOptions, encode};
+use splitstream_decoder_core::writer::ChunkCodec;
+use splitstream_encoder::emit::{EncodeOptions, encode, lanes_for};
 use splitstream_encoder::input::fractal_terrain;
 
 use super::CliResult;
@@ -29,9 +30,13 @@ pub fn run(
     // y kept exactly on the raster's lattice, the schedule `every-vertex`
     // (13.67 bits per vertex at side 1000, 14.84 under `split-valences`;
     // optimal mode, which this command used until 2026-12-02, took 32.3).
+    // The lanes `splitstream encode` would write for this terrain.
     let options = EncodeOptions {
         schedule,
         records,
+        codec: ChunkCodec::Rans {
+            lanes: lanes_for(mesh.positions.len()),
+        },
         ..EncodeOptions::default()
     };
     let started = Instant::now();
