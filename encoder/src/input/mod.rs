@@ -78,13 +78,16 @@ pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<Mesh, InputError>
         "off" => off::read(path, &file)?,
         "gltf" | "glb" => gltf::read(path, &file)?,
         "stl" => stl::read(path, &file)?,
-        "tif" | "tiff" => grid_to_mesh(&apply_spacing(geotiff::read(path, &file)?, options)),
-        "asc" => grid_to_mesh(&apply_spacing(esri::read(path, &file)?, options)),
-        "npy" => grid_to_mesh(&apply_spacing(npy::read_npy(path, &file)?, options)),
-        "npz" => grid_to_mesh(&apply_spacing(
-            npy::read_npz(path, &file, options.npz_array.as_deref())?,
-            options,
-        )),
+        "tif" | "tiff" => grid_mesh(&file, apply_spacing(geotiff::read(path, &file)?, options))?,
+        "asc" => grid_mesh(&file, apply_spacing(esri::read(path, &file)?, options))?,
+        "npy" => grid_mesh(&file, apply_spacing(npy::read_npy(path, &file)?, options))?,
+        "npz" => grid_mesh(
+            &file,
+            apply_spacing(
+                npy::read_npz(path, &file, options.npz_array.as_deref())?,
+                options,
+            ),
+        )?,
         _ => {
             return Err(InputError::UnknownExtension {
                 file,
@@ -99,6 +102,30 @@ pub fn read_mesh(path: &Path, options: &ReadOptions) -> Result<Mesh, InputError>
         }
     }
     Ok(mesh)
+}
+
+/// [`grid_to_mesh`], or an error that says why a grid gives no triangle
+/// (a single row or column, or missing samples in every cell), where the
+/// mesh check would only say that the mesh is empty.
+fn grid_mesh(file: &str, grid: Grid) -> Result<Mesh, InputError> {
+    let mesh = grid_to_mesh(&grid);
+    if !mesh.triangles.is_empty() {
+        return Ok(mesh);
+    }
+    let (rows, cols) = (grid.rows, grid.cols);
+    let message = if rows < 2 || cols < 2 {
+        format!("a grid of {rows} x {cols} samples has no cell to triangulate")
+    } else {
+        let missing = match (0..rows * cols).filter(|&i| !grid.is_valid(i)).count() {
+            1 => "1 sample is missing".to_string(),
+            n => format!("{n} samples are missing"),
+        };
+        format!(
+            "no cell of the {rows} x {cols} grid has heights at its four corners \
+             ({missing}: NaN, infinite or nodata)"
+        )
+    };
+    Err(InputError::malformed(file, message))
 }
 
 fn apply_spacing(mut grid: Grid, options: &ReadOptions) -> Grid {
@@ -210,6 +237,34 @@ mod tests {
         assert!(
             msg.ends_with("supported: .tif, .tiff, .asc, .npy, .npz"),
             "{msg}"
+        );
+    }
+
+    /// A grid that gives no triangle says why, not only that the mesh is
+    /// empty.
+    #[test]
+    fn grids_without_a_whole_cell_say_why() {
+        let f = TempFile::new(
+            "row.asc",
+            b"ncols 5\nnrows 1\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3 4 5\n",
+        );
+        let err = read_mesh(&f.0, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.ends_with("a grid of 1 x 5 samples has no cell to triangulate"),
+            "{err}"
+        );
+        let f = TempFile::new(
+            "holes.asc",
+            b"ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9\n1 -9\n2 3\n",
+        );
+        let err = read_mesh(&f.0, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.ends_with("no cell of the 2 x 2 grid has heights at its four corners (1 sample is missing: NaN, infinite or nodata)"),
+            "{err}"
         );
     }
 
