@@ -50,14 +50,7 @@ fn open(stream: &[u8]) -> *mut SsDecoder {
 
 /// The bytes of level `k` (offset and length from its table entry).
 fn level_bytes(d: *const SsDecoder, stream: &[u8], k: u16) -> Vec<u8> {
-    let mut info = SsLevelInfo {
-        offset: 0,
-        length: 0,
-        vertex_count: 0,
-        triangle_count: 0,
-        round_count: 0,
-        geometric_error: 0.0,
-    };
+    let mut info = SsLevelInfo::default();
     // SAFETY: a live handle and a writable struct.
     assert_eq!(
         unsafe { ss_decoder_level_info(d, k, &mut info) },
@@ -119,14 +112,7 @@ fn a_null_decoder_answers_nothing_and_fails_each_call() {
     let null: *mut SsDecoder = ptr::null_mut();
     let mut level = 0u16;
     let mut decoded = false;
-    let mut info = SsLevelInfo {
-        offset: 0,
-        length: 0,
-        vertex_count: 0,
-        triangle_count: 0,
-        round_count: 0,
-        geometric_error: 0.0,
-    };
+    let mut info = SsLevelInfo::default();
     let bytes = [0u8; 4];
     // SAFETY: every handle is null, every other pointer a writable local.
     unsafe {
@@ -181,14 +167,7 @@ fn a_live_decoder_checks_its_other_arguments() {
     unsafe {
         let levels = ss_decoder_level_count(d);
         assert!(levels >= 2);
-        let mut info = SsLevelInfo {
-            offset: 0,
-            length: 0,
-            vertex_count: 0,
-            triangle_count: 0,
-            round_count: 0,
-            geometric_error: 0.0,
-        };
+        let mut info = SsLevelInfo::default();
         invalid(
             ss_decoder_level_info(d, levels, &mut info),
             "level index beyond the level count",
@@ -412,14 +391,7 @@ fn every_invalid_vector_gets_the_status_of_its_class() {
                 let Ok(k) = u16::try_from(ss_decoder_next_level(d)) else {
                     break;
                 };
-                let mut info = SsLevelInfo {
-                    offset: 0,
-                    length: 0,
-                    vertex_count: 0,
-                    triangle_count: 0,
-                    round_count: 0,
-                    geometric_error: 0.0,
-                };
+                let mut info = SsLevelInfo::default();
                 assert_eq!(ss_decoder_level_info(d, k, &mut info), SsStatus::Ok);
                 // A range past the stream's end: the bytes there are.
                 let start = (info.offset as usize).min(bytes.len());
