@@ -43,7 +43,12 @@ pub struct Args {
     /// reorient, split non-manifold vertices.
     #[arg(long)]
     pub repair: bool,
-    /// Write the input vertex id of each decoded vertex, one per line.
+    /// Write the input vertex id of each decoded vertex, one per line: the
+    /// 0-based index of its vertex in the file (PLY, OBJ, OFF), of its
+    /// welded position (glTF, STL: the vertices at one position are one),
+    /// or of its grid sample, row by row from the southern row; after
+    /// --repair, or on a grid with missing samples, an index into the mesh
+    /// as repaired or as triangulated.
     #[arg(long)]
     pub permutation: Option<PathBuf>,
     /// .npz only: the array with the elevations.
