@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.8 decoder, in Python, written from
+"""A second splitstream 3.9 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
@@ -10,8 +10,9 @@ seed_triangles above its table entry's triangle_count failing
 count-mismatch before the seed is read; 3.6's schedule `every-vertex`,
 header flag bit 1, was added with the SPEC sections that define it, and
 3.7's record order `positions-first`, level header byte 11, with SPEC §7.4
-"Positions first", and 3.8's tie rules of record orders 2 and 3 with
-`off` of SPEC §7.4 `before`.) It speaks the conformance protocol (a stream
+"Positions first", 3.8's tie rules of record orders 2 and 3 with
+`off` of SPEC §7.4 `before`, and 3.9's adaptive rANS tables with SPEC
+§5.5.2 and §5.5.4.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -116,6 +117,18 @@ class Table:
         self.look = look
 
 
+class Adaptive:
+    """An adaptive table (SPEC §5.5.2, 3.9): m tokens, a rate, and per lane
+    m - 1 probabilities (16-bit fractions of "above"), all one half, each
+    with the count of its uses."""
+
+    def __init__(self, m, rate, lane_count):
+        self.m = m
+        self.rate = rate
+        self.q = [[1 << 15] * (m - 1) for _ in range(lane_count)]
+        self.k = [[0] * (m - 1) for _ in range(lane_count)]
+
+
 def leb128(next_byte):
     """SPEC §5.4 read_varint over the bytes `next_byte()` returns."""
     v = 0
@@ -152,6 +165,13 @@ def parse_rans(p, nctx, raw_len, lane_count):
             raise Fail("malformed")
         n = p[q]
         q += 1
+        if n & 0x80:
+            m = (n & 0x0F) + 1
+            rate = 4 + ((n >> 4) & 7)
+            if (m - 1) * lane_count > 48:
+                raise Fail("malformed")
+            tables.append(Adaptive(m, rate, lane_count))
+            continue
         if n > 44:
             raise Fail("malformed")
         if n == 0:
@@ -211,15 +231,39 @@ def renorm(L):
         L.cur += 1
 
 
-def decode_value(L, tab):
+def adaptive_token(L, tab, lane):
+    """SPEC §5.5.4: the token of an adaptive table, decision by decision."""
+    q = tab.q[lane]
+    k = tab.k[lane]
+    for i in range(tab.m - 1):
+        above = max(q[i] >> 4, 1)
+        below = 4096 - above
+        slot = L.x & 4095
+        shift = min(tab.rate, 1 + k[i].bit_length())
+        k[i] = min(k[i] + 1, 255)
+        if slot < below:
+            L.x = below * (L.x >> 12) + slot
+            renorm(L)
+            q[i] -= q[i] >> shift
+            return i
+        L.x = above * (L.x >> 12) + slot - below
+        renorm(L)
+        q[i] += (65536 - q[i]) >> shift
+    return tab.m - 1
+
+
+def decode_value(L, tab, lane):
     if tab is None:
         raise Fail("malformed")
-    x = L.x
-    slot = x & 4095
-    t = tab.look[slot]
-    c0 = tab.cum[t]
-    L.x = tab.f[t] * (x >> 12) + slot - c0
-    renorm(L)
+    if isinstance(tab, Adaptive):
+        t = adaptive_token(L, tab, lane)
+    else:
+        x = L.x
+        slot = x & 4095
+        t = tab.look[slot]
+        c0 = tab.cum[t]
+        L.x = tab.f[t] * (x >> 12) + slot - c0
+        renorm(L)
     if t < 16:
         return t
     e = t - 12
@@ -277,8 +321,8 @@ class Sub:
     def value(self, ctx):
         if self.pos == self.len:
             self.load()
-        L = self.lanes[self.pos % self.lane_count]
-        v = decode_value(L, self.tables[ctx])
+        lane = self.pos % self.lane_count
+        v = decode_value(self.lanes[lane], self.tables[ctx], lane)
         self.pos += 1
         if self.pos == self.len:
             for L in self.lanes:

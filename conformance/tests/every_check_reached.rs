@@ -23,7 +23,7 @@ const DETAILED: [&str; 5] = [
 ];
 
 /// Checks no stream can reach, kept as guards, each with its reason.
-const GUARDS: [(&str, &str); 3] = [
+const GUARDS: [(&str, &str); 4] = [
     (
         "InvalidLevelTable(\"empty\")",
         "the header already rejects level_count 0 (SPEC §3.3)",
@@ -31,6 +31,10 @@ const GUARDS: [(&str, &str); 3] = [
     (
         "InvalidRansChunk(\"counts cannot be normalised\")",
         "with the last count nonzero, f[j] >= 92 - 43 (SPEC §5.5.2)",
+    ),
+    (
+        "InvalidRansChunk(\"adaptive table without room\")",
+        "an adaptive table's (m - 1) x lane_count <= 48 is checked when the table is read (SPEC §5.5.2)",
     ),
     (
         "InvalidRansChunk(\"slot beyond the table\")",

@@ -36,6 +36,7 @@ pub fn params(codec: ChunkCodec) -> StreamParams {
         chunk_limit: 4,
         rans_chunk_limit: 4,
         schedule: Schedule::SplitValences,
+        adaptive_tables: false,
     }
 }
 
@@ -243,9 +244,15 @@ pub fn tetra_split_level(rec: Rec) -> LevelPayload {
 /// plane policy `dominant` (the predicted axis is x), P = (0,0,0),
 /// C = (2,2,2).
 pub fn tetra_stream(codec: ChunkCodec) -> Vec<u8> {
+    tetra_stream_under(&params(codec))
+}
+
+/// [`tetra_stream`] framed under `params` (for rANS with adaptive tables,
+/// `params(..)` with `adaptive_tables` set).
+pub fn tetra_stream_under(params: &StreamParams) -> Vec<u8> {
     let build = |rec: Rec| {
         write_stream(
-            &params(codec),
+            params,
             &[
                 tetrahedron(),
                 level_with(PlanePolicy::Dominant, &[true], vec![1], &[rec], 5, 6),

@@ -8,7 +8,10 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 /// stream; 3.5 added a check and no feature, so no stream is written with
 /// minor version 5 (the writer uses the constants below).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 8;
+pub const VERSION_MINOR: u8 = 9;
+/// The minor version written when a rANS chunk has an adaptive table (SPEC
+/// §5.5.2): 3.8 decoders reject its table byte.
+pub const VERSION_MINOR_ADAPTIVE: u8 = 9;
 /// The minor version written when a positions-first level breaks the wing
 /// choices' ties by a lattice diagonal (SPEC §5.1, §7.4): 3.7 decoders
 /// reject its record order byte.
@@ -144,4 +147,21 @@ pub mod rans {
     /// u32 words of one substream's rANS tables: per context the token
     /// count and the cumulative frequencies (`TOKENS + 1` entries).
     pub const TABLE_WORDS: usize = MAX_CONTEXTS * (TOKENS + 2);
+    /// An adaptive table (3.9) sets this bit of its table byte; bits 4–6
+    /// hold its rate less `ADAPTIVE_RATE_MIN`, bits 0–3 its token count
+    /// less 1 (SPEC §5.5.2).
+    pub const ADAPTIVE_FLAG: u8 = 0x80;
+    /// The slowest adaptation rate is `ADAPTIVE_RATE_MIN + 7`.
+    pub const ADAPTIVE_RATE_MIN: u8 = 4;
+    /// Most tokens of an adaptive table.
+    pub const ADAPTIVE_TOKENS: usize = 16;
+    /// Most probabilities an adaptive table keeps: `(m − 1) × lane_count`
+    /// for `m` tokens (SPEC §5.5.2), each with its decision count. They fit
+    /// where a static table keeps its cumulative frequencies and bucket
+    /// index, so the working memory is unchanged.
+    pub const ADAPTIVE_STATES: usize = 48;
+    /// An adaptive probability's bits (a 16-bit fraction), and its value
+    /// at the start of every chunk (one half).
+    pub const ADAPTIVE_BITS: u32 = 16;
+    pub const ADAPTIVE_START: u16 = 1 << 15;
 }

@@ -1,16 +1,19 @@
 //! The rANS codec of a chunk (SPEC §5.5): context-modelled, lane-interleaved
 //! range asymmetric numeral systems, integer-only.
 //!
-//! A chunk holds one frequency table per context of its substream, then
+//! A chunk holds one table per context of its substream (a frequency table,
+//! or from 3.9 an adaptive one whose probabilities follow the values), then
 //! `lane_count` independent byte streams ("lanes"). Value `i` of the chunk is
 //! coded in lane `i mod lane_count`: a token of the hybrid integer code
 //! (§5.5.1) drawn from its context's table, then the token's raw bits. Lanes
-//! share nothing, so a decoder may run them on several cores or, as here,
-//! keep them in one loop where their loads overlap.
+//! share nothing (an adaptive table keeps a set of probabilities per lane),
+//! so a decoder may run them on several cores or, as here, keep them in one
+//! loop where their loads overlap.
 
 use crate::Error;
 use crate::bytes::u32_at;
 use crate::limits::rans::{
+    ADAPTIVE_BITS, ADAPTIVE_FLAG, ADAPTIVE_RATE_MIN, ADAPTIVE_START, ADAPTIVE_STATES,
     DIRECT_TOKENS, MAX_CONTEXTS, MAX_LANES, PROB_BITS, PROB_SCALE, RAW_BITS_STEP, STATE_LOW,
     TABLE_WORDS, TOKENS,
 };
@@ -20,6 +23,9 @@ use crate::limits::rans::{
 /// so that a scan for a slot's token always stops inside the table.
 const CUM_LEN: usize = 48;
 const _: () = assert!(CUM_LEN > TOKENS + 1);
+// An adaptive table keeps its probabilities where a static one keeps its
+// cumulative frequencies, and their decision counts in its bucket index.
+const _: () = assert!(CUM_LEN >= ADAPTIVE_STATES && BUCKETS >= ADAPTIVE_STATES);
 
 /// A slot's token is looked up in one of this many equal buckets of the
 /// `PROB_SCALE` slots, then found by a short forward scan.
@@ -116,9 +122,13 @@ pub fn normalise(counts: &mut [u32]) -> Result<(), Error> {
 pub struct ChunkDecoder<'b> {
     /// Tokens of each context's table; 0 for an unused table.
     tokens: [u8; MAX_CONTEXTS],
-    /// `CUM_LEN` cumulative frequencies per context.
+    /// Each context's adaptation rate: 0 for a static table.
+    rates: [u8; MAX_CONTEXTS],
+    /// `CUM_LEN` cumulative frequencies per context, or for an adaptive
+    /// table its probabilities, `m − 1` per lane, lane 0's first.
     cums: &'b mut [[u16; CUM_LEN]; MAX_CONTEXTS],
-    /// Per context, the token of the first slot of each bucket.
+    /// Per context, the token of the first slot of each bucket, or for an
+    /// adaptive table how often each probability has been used.
     buckets: &'b mut [[u8; BUCKETS]; MAX_CONTEXTS],
     /// State, cursor, end of each lane (room for the most lanes a stream
     /// may have, SPEC §9; the first `lane_count` are used).
@@ -148,6 +158,7 @@ impl<'b> ChunkDecoder<'b> {
             bytemuck::try_cast_slice_mut(&mut lanes[..LANE_WORDS * MAX_LANES as usize]).ok()?;
         Some(ChunkDecoder {
             tokens: [0; MAX_CONTEXTS],
+            rates: [0; MAX_CONTEXTS],
             cums: cums.try_into().ok()?,
             buckets: buckets.try_into().ok()?,
             lanes: lanes.try_into().ok()?,
@@ -173,7 +184,8 @@ impl<'b> ChunkDecoder<'b> {
 
     /// Parses the tables of `contexts` contexts at `bytes[*at..end]`
     /// (§5.5.2): per context a token count `n` (0: unused), then `n`
-    /// counts, normalised here to frequencies summing to `PROB_SCALE`.
+    /// counts, normalised here to frequencies summing to `PROB_SCALE`; or
+    /// an adaptive table (3.9): `ADAPTIVE_FLAG | m` and a rate.
     fn read_tables(
         &mut self,
         bytes: &[u8],
@@ -182,12 +194,17 @@ impl<'b> ChunkDecoder<'b> {
         contexts: usize,
     ) -> Result<(), Error> {
         self.tokens = [0; MAX_CONTEXTS];
+        self.rates = [0; MAX_CONTEXTS];
         for c in 0..contexts.min(MAX_CONTEXTS) {
             if *at >= end {
                 return Err(Error::InvalidRansChunk("tables run past the chunk"));
             }
             let n = bytes[*at] as usize;
             *at += 1;
+            if n & ADAPTIVE_FLAG as usize != 0 {
+                self.open_adaptive(c, n as u8)?;
+                continue;
+            }
             if n > TOKENS {
                 return Err(Error::InvalidRansChunk("more tokens than the code has"));
             }
@@ -217,6 +234,25 @@ impl<'b> ChunkDecoder<'b> {
             cum[n..].fill(PROB_SCALE as u16);
             self.tokens[c] = n as u8;
         }
+        Ok(())
+    }
+
+    /// An adaptive table for context `c` from its table byte (§5.5.2,
+    /// 3.9): `m` tokens and a rate, every lane's `m − 1` probabilities one
+    /// half and never used.
+    fn open_adaptive(&mut self, c: usize, byte: u8) -> Result<(), Error> {
+        let m = (byte & 0x0F) as usize + 1;
+        let rate = ADAPTIVE_RATE_MIN + ((byte >> 4) & 0x07);
+        let states = (m - 1) * self.lane_count;
+        if states > ADAPTIVE_STATES {
+            return Err(Error::InvalidRansChunk(
+                "adaptive table needs more probabilities than a table holds",
+            ));
+        }
+        self.cums[c][..states].fill(ADAPTIVE_START);
+        self.buckets[c][..states].fill(0);
+        self.tokens[c] = m as u8;
+        self.rates[c] = rate;
         Ok(())
     }
 
@@ -276,7 +312,8 @@ impl<'b> ChunkDecoder<'b> {
     #[inline(always)]
     pub fn decode(&mut self, bytes: &[u8], context: usize) -> Result<u32, Error> {
         // lane < lane_count <= MAX_LANES, a power of two.
-        let lane = &mut self.lanes[self.lane & (MAX_LANES as usize - 1)];
+        let index = self.lane & (MAX_LANES as usize - 1);
+        let lane = &mut self.lanes[index];
         self.lane = if self.lane + 1 >= self.lane_count {
             0
         } else {
@@ -285,10 +322,12 @@ impl<'b> ChunkDecoder<'b> {
         decode_in(
             Tables {
                 tokens: &self.tokens,
+                rates: &self.rates,
                 cums: self.cums,
                 buckets: self.buckets,
             },
             lane,
+            index,
             bytes,
             context,
         )
@@ -298,28 +337,32 @@ impl<'b> ChunkDecoder<'b> {
     /// `contexts`, one context per value, without consuming anything: `(bits,
     /// count)`, bit i the i-th next value, `count` at most 128 and at most
     /// `remaining` (the values left in the chunk), and nothing from a value
-    /// that is not a bit or fails. Works on copies of the lanes.
+    /// that is not a bit or fails. Works on copies of the lanes (and of the
+    /// adaptive tables' probabilities).
     pub fn peek_bits(&self, bytes: &[u8], contexts: &[u8], remaining: usize) -> (u128, u32) {
         let mut lanes = [[0u32; LANE_WORDS]; MAX_LANES as usize];
         let count = self.lane_count.min(MAX_LANES as usize);
         lanes[..count].copy_from_slice(&self.lanes[..count]);
-        let tables = Tables {
+        let (mut cums, mut buckets) = (*self.cums, *self.buckets);
+        let mut tables = Tables {
             tokens: &self.tokens,
-            cums: self.cums,
-            buckets: self.buckets,
+            rates: &self.rates,
+            cums: &mut cums,
+            buckets: &mut buckets,
         };
         let mut lane = self.lane;
         // By 64-bit halves: a variable 128-bit shift is a library call on
         // 32-bit targets.
         let (mut halves, mut known) = ([0u64; 2], 0u32);
         for &context in contexts.iter().take(remaining.min(128)) {
-            let l = &mut lanes[lane & (MAX_LANES as usize - 1)];
+            let index = lane & (MAX_LANES as usize - 1);
+            let l = &mut lanes[index];
             lane = if lane + 1 >= self.lane_count {
                 0
             } else {
                 lane + 1
             };
-            match decode_in(tables, l, bytes, context as usize) {
+            match decode_in(tables.reborrow(), l, index, bytes, context as usize) {
                 Ok(v @ (0 | 1)) => halves[known as usize / 64] |= (v as u64) << (known % 64),
                 _ => break,
             }
@@ -329,19 +372,32 @@ impl<'b> ChunkDecoder<'b> {
     }
 }
 
-/// A chunk's tables, as [`decode_in`] reads them.
-#[derive(Clone, Copy)]
+/// A chunk's tables, as [`decode_in`] reads them (and adapts them).
 struct Tables<'a> {
     tokens: &'a [u8; MAX_CONTEXTS],
-    cums: &'a [[u16; CUM_LEN]; MAX_CONTEXTS],
-    buckets: &'a [[u8; BUCKETS]; MAX_CONTEXTS],
+    rates: &'a [u8; MAX_CONTEXTS],
+    cums: &'a mut [[u16; CUM_LEN]; MAX_CONTEXTS],
+    buckets: &'a mut [[u8; BUCKETS]; MAX_CONTEXTS],
 }
 
-/// Decodes one value in `context` from `lane` (§5.5.1, §5.5.4).
+impl Tables<'_> {
+    fn reborrow(&mut self) -> Tables<'_> {
+        Tables {
+            tokens: self.tokens,
+            rates: self.rates,
+            cums: self.cums,
+            buckets: self.buckets,
+        }
+    }
+}
+
+/// Decodes one value in `context` from `lane`, lane number `index`
+/// (§5.5.1, §5.5.4).
 #[inline(always)]
 fn decode_in(
     tables: Tables<'_>,
     lane: &mut [u32; LANE_WORDS],
+    index: usize,
     bytes: &[u8],
     context: usize,
 ) -> Result<u32, Error> {
@@ -352,6 +408,23 @@ fn decode_in(
         return Err(Error::InvalidRansChunk(
             "value in a context without a table",
         ));
+    }
+    let rate = tables.rates[context];
+    if rate != 0 {
+        let mut x = lane[0];
+        let token = adaptive_token(
+            Adaptive {
+                probs: &mut tables.cums[context],
+                counts: &mut tables.buckets[context],
+                rate,
+                tokens: n,
+            },
+            index,
+            lane,
+            bytes,
+            &mut x,
+        )?;
+        return raw_bits(token, x, lane, bytes);
     }
     let cum = &tables.cums[context];
     let mut x = lane[0];
@@ -371,7 +444,96 @@ fn decode_in(
     let freq = cum[t + 1] as u32 - start;
     x = freq * (x >> PROB_BITS) + slot - start;
     renormalise(bytes, lane, &mut x)?;
-    let token = t as u32;
+    raw_bits(t as u32, x, lane, bytes)
+}
+
+/// One context's adaptive table (§5.5.2, 3.9), as [`adaptive_token`]
+/// reads and adapts it.
+struct Adaptive<'a> {
+    probs: &'a mut [u16; CUM_LEN],
+    counts: &'a mut [u8; BUCKETS],
+    rate: u8,
+    tokens: usize,
+}
+
+/// The token of an adaptive table (§5.5.4, 3.9), read from lane number
+/// `index` with state `x`: decision i asks whether the token is above i,
+/// with the lane's probability i of "above" (a 16-bit fraction), which then
+/// moves towards the answer: by half the way the first time, a quarter the
+/// second, and so on down to `2^-rate`.
+#[inline(always)]
+fn adaptive_token(
+    table: Adaptive<'_>,
+    index: usize,
+    lane: &mut [u32; LANE_WORDS],
+    bytes: &[u8],
+    x: &mut u32,
+) -> Result<u32, Error> {
+    let decisions = table.tokens - 1;
+    // `open_adaptive` checked decisions × lane_count <= ADAPTIVE_STATES.
+    let states = index * decisions..(index + 1) * decisions;
+    let (Some(probs), Some(counts)) = (
+        table.probs.get_mut(states.clone()),
+        table.counts.get_mut(states),
+    ) else {
+        return Err(Error::InvalidRansChunk("adaptive table without room"));
+    };
+    for (i, (q, count)) in probs.iter_mut().zip(counts.iter_mut()).enumerate() {
+        if !decide(q, count, table.rate, lane, bytes, x)? {
+            return Ok(i as u32);
+        }
+    }
+    Ok(decisions as u32)
+}
+
+/// One decision of an adaptive table (§5.5.4, 3.9): whether the token is
+/// above the decision's index, read with probability `q` of "above", which
+/// then moves towards the answer. Without a branch on the answer (half the
+/// flags of a level are set, so one would be mispredicted often).
+#[inline(always)]
+fn decide(
+    q: &mut u16,
+    count: &mut u8,
+    rate: u8,
+    lane: &mut [u32; LANE_WORDS],
+    bytes: &[u8],
+    x: &mut u32,
+) -> Result<bool, Error> {
+    let p = *q as u32;
+    let above = (p >> (ADAPTIVE_BITS - PROB_BITS)).max(1);
+    let below = PROB_SCALE - above;
+    let slot = *x & (PROB_SCALE - 1);
+    let is_above = slot >= below;
+    // All ones when the answer is "above".
+    let mask = 0u32.wrapping_sub(is_above as u32);
+    let start = below & mask;
+    let freq = below ^ ((below ^ above) & mask);
+    *x = freq * (*x >> PROB_BITS) + slot - start;
+    renormalise(bytes, lane, x)?;
+    let shift = adaptive_shift(*count, rate);
+    *count = count.saturating_add(1);
+    let up = ((1u32 << ADAPTIVE_BITS) - p) >> shift;
+    let down = p >> shift;
+    *q = (p + (up & mask) - (down & !mask)) as u16;
+    Ok(is_above)
+}
+
+/// How far a probability used `count` times before moves (§5.5.4, 3.9):
+/// `2^-shift` of the way, `shift = min(rate, 1 + bit length of count)`.
+#[inline(always)]
+pub fn adaptive_shift(count: u8, rate: u8) -> u32 {
+    (1 + (8 - count.leading_zeros())).min(rate as u32)
+}
+
+/// Finishes a value whose token has been read, leaving the lane's state
+/// `x`: the token's raw bits (§5.5.1, §5.5.4).
+#[inline(always)]
+fn raw_bits(
+    token: u32,
+    mut x: u32,
+    lane: &mut [u32; LANE_WORDS],
+    bytes: &[u8],
+) -> Result<u32, Error> {
     let extra = token_bits(token);
     if extra == 0 {
         lane[0] = x;
@@ -483,6 +645,108 @@ mod tests {
         // Table: n = 4, counts 0 0 0 c; two lane lengths; two 4-byte states.
         assert!(payload.len() <= 1 + 4 + 2 + 2 + 8, "{}", payload.len());
         assert_eq!(decode(&payload, &[0; 100], 1, 2).unwrap(), vec![3; 100]);
+    }
+
+    /// Skewed bits in two contexts (in the first, one in eight differs
+    /// from the rest, which turn from 0 to 1 halfway), then small values in
+    /// a third: contexts an encoder codes with adaptive tables.
+    fn skewed(n: usize) -> Vec<Symbol> {
+        (0..n)
+            .map(|i| match i % 3 {
+                0 => (0, ((i % 8 == 0) ^ (2 * i > n)) as u32),
+                1 => (1, (i % 5 == 0) as u32),
+                _ => (2, ((i * 7) % 11 % 4) as u32),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn adaptive_tables_round_trip_in_any_lane_count() {
+        let symbols = skewed(3000);
+        let contexts: Vec<u8> = symbols.iter().map(|s| s.0).collect();
+        let expected: Vec<u32> = symbols.iter().map(|s| s.1).collect();
+        for lanes in [1, 2, 3, 4, 16, 32] {
+            let (payload, adaptive) =
+                crate::rans_writer::encode_chunk_with(&symbols, 3, lanes, true);
+            // With many lanes each lane's probabilities learn from few
+            // values, and static tables may be smaller.
+            if lanes <= 4 {
+                assert!(adaptive, "{lanes} lanes: skewed bits pay no table");
+                // The first context's table is its one adaptive byte.
+                assert_ne!(payload[0] & ADAPTIVE_FLAG, 0);
+            }
+            assert_eq!(decode(&payload, &contexts, 3, lanes).unwrap(), expected);
+            let (static_only, adaptive) =
+                crate::rans_writer::encode_chunk_with(&symbols, 3, lanes, false);
+            assert!(!adaptive);
+            assert!(payload.len() <= static_only.len(), "{lanes} lanes");
+            assert_eq!(decode(&static_only, &contexts, 3, lanes).unwrap(), expected);
+        }
+    }
+
+    #[test]
+    fn adaptive_tables_over_their_room_are_malformed() {
+        // 16 tokens in 4 lanes: 60 probabilities, over ADAPTIVE_STATES.
+        let mut words = vec![0u32; TABLE_WORDS + LANE_WORDS * MAX_LANES as usize];
+        let mut chunk = ChunkDecoder::new(&mut words, 4).expect("room");
+        let payload = [0x8F, 0, 0, 0, 0];
+        assert_eq!(
+            chunk.open(&payload, 0, payload.len(), 1, 0),
+            Err(Error::InvalidRansChunk(
+                "adaptive table needs more probabilities than a table holds"
+            ))
+        );
+        // 13 tokens in 4 lanes fit (48), and a table byte alone with no
+        // lane directory after it runs past the chunk.
+        let payload = [0x8C];
+        assert_eq!(
+            chunk.open(&payload, 0, payload.len(), 1, 1),
+            Err(Error::InvalidRansChunk("tables run past the chunk"))
+        );
+    }
+
+    #[test]
+    fn a_one_token_adaptive_table_reads_zeros_from_no_bytes() {
+        // Table byte 0x80: m = 1, rate 4. One lane of 4 bytes, state 2^23.
+        let mut payload = vec![0x80, 4];
+        payload.extend_from_slice(&STATE_LOW.to_le_bytes());
+        assert_eq!(decode(&payload, &[0; 5], 1, 1).unwrap(), vec![0; 5]);
+    }
+
+    #[test]
+    fn adaptive_shift_halves_then_settles_at_the_rate() {
+        let shifts: Vec<u32> = [0u8, 1, 2, 3, 4, 7, 8, 63, 64, 255]
+            .iter()
+            .map(|&k| adaptive_shift(k, 7))
+            .collect();
+        assert_eq!(shifts, [1, 2, 3, 3, 4, 4, 5, 7, 7, 7]);
+        assert_eq!(adaptive_shift(255, 11), 9);
+        assert_eq!(adaptive_shift(0, 4), 1);
+    }
+
+    #[test]
+    fn peeking_adaptive_bits_consumes_nothing() {
+        let symbols: Vec<Symbol> = skewed(900).into_iter().filter(|s| s.0 < 2).collect();
+        let contexts: Vec<u8> = symbols.iter().map(|s| s.0).collect();
+        let (payload, adaptive) = crate::rans_writer::encode_chunk_with(&symbols, 2, 2, true);
+        assert!(adaptive);
+        let mut words = vec![0u32; TABLE_WORDS + LANE_WORDS * MAX_LANES as usize];
+        let mut chunk = ChunkDecoder::new(&mut words, 2).expect("room");
+        chunk
+            .open(&payload, 0, payload.len(), 2, symbols.len() as u32)
+            .unwrap();
+        let mut at = 0;
+        while at < symbols.len() {
+            let (bits, known) = chunk.peek_bits(&payload, &contexts[at..], symbols.len() - at);
+            assert!(known > 0);
+            for i in 0..known as usize {
+                let v = chunk.decode(&payload, contexts[at + i] as usize).unwrap();
+                assert_eq!(v, symbols[at + i].1);
+                assert_eq!(v as u128, (bits >> i) & 1, "value {}", at + i);
+            }
+            at += known as usize;
+        }
+        assert!(chunk.exhausted());
     }
 
     proptest! {

@@ -6,12 +6,11 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use crate::limits::CHUNK_ENTRY_LEN;
-use crate::limits::rans::{PROB_BITS, RAW_BITS_STEP, STATE_LOW, TOKENS};
-use crate::rans::{normalise, token_of};
-
-/// The most raw-bit steps of one value: 31 extra bits in steps of
-/// `RAW_BITS_STEP`.
-const RAW_STEPS_MAX: usize = 31usize.div_ceil(RAW_BITS_STEP as usize);
+use crate::limits::rans::{
+    ADAPTIVE_BITS, ADAPTIVE_FLAG, ADAPTIVE_RATE_MIN, ADAPTIVE_START, ADAPTIVE_STATES,
+    ADAPTIVE_TOKENS, PROB_BITS, PROB_SCALE, RAW_BITS_STEP, STATE_LOW, TOKENS,
+};
+use crate::rans::{adaptive_shift, normalise, token_of};
 
 /// A value and the context it is coded in.
 pub type Symbol = (u8, u32);
@@ -30,12 +29,6 @@ fn push_varint(out: &mut Vec<u8>, mut v: u32) {
 
 fn varint_len(v: u32) -> usize {
     (32 - v.leading_zeros()).div_ceil(7).max(1) as usize
-}
-
-/// Counts sent for one context, scaled down so the table stays small.
-/// Tries a few scales and keeps the cheapest (table bytes + estimated code).
-fn choose_counts(histogram: &[u32]) -> Vec<u32> {
-    scaled_counts(histogram).1
 }
 
 /// [`choose_counts`] and the bits it was chosen for: the table's count
@@ -98,7 +91,7 @@ pub fn chunk_cost_bits(histograms: &[[u32; TOKENS]], values: usize, lanes: usize
 }
 
 /// log2 without std: exact enough for choosing a table scale.
-fn libm_log2(x: f64) -> f64 {
+const fn libm_log2(x: f64) -> f64 {
     // x is a frequency in 1..=4096: integer part from the exponent, then a
     // short series for the mantissa.
     let bits = x.to_bits();
@@ -112,79 +105,302 @@ fn libm_log2(x: f64) -> f64 {
     exponent as f64 + ln / core::f64::consts::LN_2
 }
 
-/// Encodes `symbols` as one rANS chunk payload with `contexts` tables and
-/// `lanes` lanes (SPEC §5.5.2, §5.5.3).
-pub fn encode_chunk(symbols: &[Symbol], contexts: usize, lanes: usize) -> Vec<u8> {
+/// How a chunk codes one context's tokens (SPEC §5.5.2).
+#[allow(
+    clippy::large_enum_variant,
+    reason = "at most 8 per chunk, built once per chunk"
+)]
+enum Model {
+    /// A static table: each token's cumulative start and frequency.
+    Static {
+        start: [u32; TOKENS],
+        freq: [u32; TOKENS],
+    },
+    /// An adaptive table (3.9) of `tokens` tokens and rate `rate`.
+    Adaptive { tokens: usize, rate: u8 },
+}
+
+/// Bits an adaptive table must save per value of its context over the
+/// best static table: an adaptive decision costs a decoder about ten more
+/// instructions than a static table's lookup. Measured on armadillo, 0.005
+/// keeps 375 of the 394 bytes that every adaptive table smaller than its
+/// static one saves, on 71 % of the values instead of 94 % (decoding 7.6 %
+/// more instructions than static tables instead of 9.7 %); on the 1M
+/// terrain, 2,061 of 2,492 bytes on 18 % of the values instead of 42 %
+/// (encoder/BENCHMARKS.md, "Adaptive tables").
+const ADAPTIVE_MIN_GAIN: f64 = 0.005;
+
+/// The rate an encoder tries first for an adaptive table: after its first
+/// values a probability follows about the last 2^rate answers. Measured on
+/// the scanned meshes, 7 suits most contexts, 5 or 6 some, 8 a few
+/// (encoder/BENCHMARKS.md).
+const FIRST_RATE: u8 = 7;
+
+/// The rates tried, from [`FIRST_RATE`] one step at a time towards the
+/// cheaper side while the cost falls (about three trials a context instead
+/// of one per rate: each is a pass over the context's values).
+fn best_rate(cost: impl Fn(u8) -> f64) -> (f64, u8) {
+    let rates = ADAPTIVE_RATE_MIN..=ADAPTIVE_RATE_MIN + 7;
+    let mut best = (cost(FIRST_RATE), FIRST_RATE);
+    let slower = (cost(FIRST_RATE + 1), FIRST_RATE + 1);
+    let step: i8 = if slower.0 < best.0 {
+        best = slower;
+        1
+    } else {
+        -1
+    };
+    loop {
+        let next = best.1.wrapping_add_signed(step);
+        if !rates.contains(&next) {
+            return best;
+        }
+        let tried = (cost(next), next);
+        if tried.0 >= best.0 {
+            return best;
+        }
+        best = tried;
+    }
+}
+
+/// Bits of a binary decision whose chosen side has frequency `f` out of
+/// `PROB_SCALE`, for `f` in `0..=PROB_SCALE` (entry 0 unused).
+static DECISION_BITS: [f32; PROB_SCALE as usize + 1] = decision_bits();
+
+const fn decision_bits() -> [f32; PROB_SCALE as usize + 1] {
+    let mut table = [0f32; PROB_SCALE as usize + 1];
+    let mut f = 1;
+    while f <= PROB_SCALE as usize {
+        table[f] = (PROB_BITS as f64 - libm_log2(f as f64)) as f32;
+        f += 1;
+    }
+    table
+}
+
+/// One adaptive decision (SPEC §5.5.4, 3.9): the frequencies of "above"
+/// and "not above" under probability `q`.
+#[inline]
+fn decision_frequencies(q: u16) -> (u32, u32) {
+    let above = ((q as u32) >> (ADAPTIVE_BITS - PROB_BITS)).max(1);
+    (above, PROB_SCALE - above)
+}
+
+/// Moves an adaptive probability used `count` times before towards the
+/// answer `above` (SPEC §5.5.4, 3.9), and counts the use.
+#[inline]
+fn adapt(q: &mut u16, count: &mut u8, above: bool, rate: u8) {
+    let shift = adaptive_shift(*count, rate);
+    *count = count.saturating_add(1);
+    if above {
+        *q += (((1u32 << ADAPTIVE_BITS) - *q as u32) >> shift) as u16;
+    } else {
+        *q -= *q >> shift;
+    }
+}
+
+/// The table byte of an adaptive table of `tokens` tokens (at most
+/// `ADAPTIVE_TOKENS`) and rate `rate` (SPEC §5.5.2, 3.9).
+fn adaptive_byte(tokens: usize, rate: u8) -> u8 {
+    ADAPTIVE_FLAG | (rate - ADAPTIVE_RATE_MIN) << 4 | (tokens - 1) as u8
+}
+
+/// Bits the tokens `lanes_tokens` (each lane's tokens of one context, in
+/// order) cost under an adaptive table of `tokens` tokens and `rate`.
+fn adaptive_bits(lanes_tokens: &[Vec<u8>], tokens: usize, rate: u8) -> f64 {
+    let mut bits = 0f64;
+    let mut probs = [ADAPTIVE_START; ADAPTIVE_TOKENS];
+    let mut counts = [0u8; ADAPTIVE_TOKENS];
+    for lane in lanes_tokens {
+        probs.fill(ADAPTIVE_START);
+        counts.fill(0);
+        let mut lane_bits = 0f32;
+        for &t in lane {
+            let decisions = probs[..tokens - 1].iter_mut().zip(&mut counts);
+            for (i, (q, count)) in decisions.enumerate() {
+                let (above, below) = decision_frequencies(*q);
+                let is_above = (t as usize) > i;
+                lane_bits += DECISION_BITS[if is_above { above } else { below } as usize];
+                adapt(q, count, is_above, rate);
+                if !is_above {
+                    break;
+                }
+            }
+        }
+        bits += lane_bits as f64;
+    }
+    bits
+}
+
+/// The model of each context for `symbols` coded in `lanes` lanes, and the
+/// table bytes that announce them: an adaptive table where it is estimated
+/// smaller than the best static one (at most `ADAPTIVE_TOKENS` tokens,
+/// every lane's probabilities within `ADAPTIVE_STATES`), a static table
+/// otherwise.
+fn choose_models(
+    symbols: &[Symbol],
+    contexts: usize,
+    lanes: usize,
+    adaptive_tables: bool,
+    out: &mut Vec<u8>,
+) -> Vec<Model> {
     let mut histograms = vec![[0u32; TOKENS]; contexts];
     for &(ctx, value) in symbols {
         histograms[ctx as usize][token_of(value).0 as usize] += 1;
     }
-    let mut out = Vec::new();
-    // Cumulative starts and frequencies per context and token.
-    let mut start = vec![[0u32; TOKENS]; contexts];
-    let mut freq = vec![[0u32; TOKENS]; contexts];
-    for c in 0..contexts {
-        let counts = choose_counts(&histograms[c]);
-        out.push(counts.len() as u8);
+    let mut models = Vec::with_capacity(contexts);
+    for (c, histogram) in histograms.iter().enumerate() {
+        let (static_bits, counts) = scaled_counts(histogram);
+        let tokens = counts.len();
+        if adaptive_tables
+            && tokens > 1
+            && tokens <= ADAPTIVE_TOKENS
+            && (tokens - 1) * lanes <= ADAPTIVE_STATES
+        {
+            let mut lanes_tokens = vec![Vec::new(); lanes];
+            for (i, &(ctx, value)) in symbols.iter().enumerate() {
+                if ctx as usize == c {
+                    lanes_tokens[i % lanes].push(token_of(value).0 as u8);
+                }
+            }
+            let (bits, rate) = best_rate(|rate| adaptive_bits(&lanes_tokens, tokens, rate));
+            let values: usize = lanes_tokens.iter().map(Vec::len).sum();
+            if bits + ADAPTIVE_MIN_GAIN * values as f64 <= static_bits {
+                out.push(adaptive_byte(tokens, rate));
+                models.push(Model::Adaptive { tokens, rate });
+                continue;
+            }
+        }
+        out.push(tokens as u8);
         for &count in &counts {
-            push_varint(&mut out, count);
+            push_varint(out, count);
         }
-        let mut f = counts.clone();
-        if f.is_empty() {
-            continue;
+        let (mut start, mut freq) = ([0u32; TOKENS], [0u32; TOKENS]);
+        if !counts.is_empty() {
+            let mut f = counts.clone();
+            normalise(&mut f).expect("nonzero counts normalise");
+            let mut cum = 0;
+            for (t, &ft) in f.iter().enumerate() {
+                start[t] = cum;
+                freq[t] = ft;
+                cum += ft;
+            }
         }
-        normalise(&mut f).expect("nonzero counts normalise");
-        let mut cum = 0;
-        for (t, &ft) in f.iter().enumerate() {
-            start[c][t] = cum;
-            freq[c][t] = ft;
-            cum += ft;
+        models.push(Model::Static { start, freq });
+    }
+    models
+}
+
+/// One step of a lane as the decoder takes it: a symbol of `freq` slots
+/// from `start`, or `count` raw bits.
+#[derive(Clone, Copy)]
+enum Step {
+    Symbol { start: u32, freq: u32 },
+    Raw { count: u32, bits: u32 },
+}
+
+/// The steps of one lane's values, in the decoder's order: each value's
+/// token (one symbol, or an adaptive table's decisions), then its raw bits
+/// low steps first.
+fn lane_steps(values: &[&Symbol], models: &[Model], lane: usize, lanes: usize) -> Vec<Step> {
+    let mut steps = Vec::with_capacity(values.len() * 2);
+    let mut probs: Vec<Vec<(u16, u8)>> = models
+        .iter()
+        .map(|m| match m {
+            Model::Adaptive { tokens, .. } => vec![(ADAPTIVE_START, 0); tokens - 1],
+            Model::Static { .. } => Vec::new(),
+        })
+        .collect();
+    debug_assert!(lane < lanes);
+    for &&(ctx, value) in values {
+        let (token, extra, low) = token_of(value);
+        match &models[ctx as usize] {
+            Model::Static { start, freq } => {
+                let (start, freq) = (start[token as usize], freq[token as usize]);
+                debug_assert!(freq > 0);
+                steps.push(Step::Symbol { start, freq });
+            }
+            Model::Adaptive { rate, .. } => {
+                for (i, (q, count)) in probs[ctx as usize].iter_mut().enumerate() {
+                    let (above, below) = decision_frequencies(*q);
+                    let is_above = token as usize > i;
+                    steps.push(if is_above {
+                        Step::Symbol {
+                            start: below,
+                            freq: above,
+                        }
+                    } else {
+                        Step::Symbol {
+                            start: 0,
+                            freq: below,
+                        }
+                    });
+                    adapt(q, count, is_above, *rate);
+                    if !is_above {
+                        break;
+                    }
+                }
+            }
+        }
+        let mut done = 0;
+        while done < extra {
+            let count = (extra - done).min(RAW_BITS_STEP);
+            steps.push(Step::Raw {
+                count,
+                bits: (low >> done) & ((1 << count) - 1),
+            });
+            done += count;
         }
     }
+    steps
+}
+
+/// Encodes `symbols` as one rANS chunk payload with `contexts` tables and
+/// `lanes` lanes (SPEC §5.5.2, §5.5.3), adaptive tables where they are
+/// smaller.
+#[cfg(test)]
+pub fn encode_chunk(symbols: &[Symbol], contexts: usize, lanes: usize) -> Vec<u8> {
+    encode_chunk_with(symbols, contexts, lanes, true).0
+}
+
+/// [`encode_chunk`], with adaptive tables only where `adaptive_tables`
+/// allows them, and whether the chunk has one (format 3.9).
+pub fn encode_chunk_with(
+    symbols: &[Symbol],
+    contexts: usize,
+    lanes: usize,
+    adaptive_tables: bool,
+) -> (Vec<u8>, bool) {
+    let mut out = Vec::new();
+    let models = choose_models(symbols, contexts, lanes, adaptive_tables, &mut out);
+    let adaptive = models.iter().any(|m| matches!(m, Model::Adaptive { .. }));
     let mut lane_bytes: Vec<Vec<u8>> = Vec::with_capacity(lanes);
     for lane in 0..lanes {
-        let mut x = STATE_LOW;
-        let mut bytes = Vec::new(); // reversed
-        let mine = symbols.iter().skip(lane).step_by(lanes);
-        let mine: Vec<&Symbol> = mine.collect();
+        let mine: Vec<&Symbol> = symbols.iter().skip(lane).step_by(lanes).collect();
         if mine.is_empty() {
             lane_bytes.push(Vec::new());
             continue;
         }
-        for &&(ctx, value) in mine.iter().rev() {
-            let (token, extra, low) = token_of(value);
-            // Raw bits: the decoder reads the low step first, so the
-            // encoder pushes the high steps first. At most 31 extra bits:
-            // two steps (a fixed array; a Vec here allocated once per value
-            // with raw bits).
-            let mut steps = [(0u32, 0u32); RAW_STEPS_MAX];
-            let mut count = 0;
-            let mut done = 0;
-            while done < extra {
-                let step = (extra - done).min(RAW_BITS_STEP);
-                steps[count] = (step, (low >> done) & ((1 << step) - 1));
-                count += 1;
-                done += step;
-            }
-            for &(step, bits) in steps[..count].iter().rev() {
-                let x_max = (STATE_LOW >> step) << 8;
-                while x >= x_max {
-                    bytes.push(x as u8);
-                    x >>= 8;
+        // rANS codes backwards: the decoder's last step first.
+        let mut x = STATE_LOW;
+        let mut bytes = Vec::new(); // reversed
+        for step in lane_steps(&mine, &models, lane, lanes).into_iter().rev() {
+            match step {
+                Step::Raw { count, bits } => {
+                    let x_max = (STATE_LOW >> count) << 8;
+                    while x >= x_max {
+                        bytes.push(x as u8);
+                        x >>= 8;
+                    }
+                    x = (x << count) | bits;
                 }
-                x = (x << step) | bits;
+                Step::Symbol { start, freq } => {
+                    let x_max = ((STATE_LOW >> PROB_BITS) << 8) * freq;
+                    while x >= x_max {
+                        bytes.push(x as u8);
+                        x >>= 8;
+                    }
+                    x = ((x / freq) << PROB_BITS) + (x % freq) + start;
+                }
             }
-            let (s, f) = (
-                start[ctx as usize][token as usize],
-                freq[ctx as usize][token as usize],
-            );
-            debug_assert!(f > 0);
-            let x_max = ((STATE_LOW >> PROB_BITS) << 8) * f;
-            while x >= x_max {
-                bytes.push(x as u8);
-                x >>= 8;
-            }
-            x = ((x / f) << PROB_BITS) + (x % f) + s;
         }
         bytes.extend_from_slice(&x.to_be_bytes());
         bytes.reverse();
@@ -197,5 +413,5 @@ pub fn encode_chunk(symbols: &[Symbol], contexts: usize, lanes: usize) -> Vec<u8
     for b in lane_bytes {
         out.extend_from_slice(&b);
     }
-    out
+    (out, adaptive)
 }

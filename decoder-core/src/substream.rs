@@ -497,6 +497,7 @@ mod tests {
             chunk_limit: chunk,
             rans_chunk_limit: chunk,
             schedule: crate::Schedule::SplitValences,
+            adaptive_tables: true,
         };
         frame_level(&payload, None, &params).bytes
     }

@@ -10,14 +10,14 @@ use crate::header::{Header, PositionMode, Schedule};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
-    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_BASELINE, VERSION_MINOR_DEFICITS,
-    VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_RECORDS, VERSION_MINOR_SCHEDULE,
-    VERSION_MINOR_TIES, VERSION_MINOR_WINGS, codec, substream,
+    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_ADAPTIVE, VERSION_MINOR_BASELINE,
+    VERSION_MINOR_DEFICITS, VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_RECORDS,
+    VERSION_MINOR_SCHEDULE, VERSION_MINOR_TIES, VERSION_MINOR_WINGS, codec, substream,
 };
 use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
 use crate::rans_segments::rans_segments;
-use crate::rans_writer::{Symbol, encode_chunk};
+use crate::rans_writer::{Symbol, encode_chunk_with};
 use crate::wing_order::WingPolicy;
 
 /// A growing substream: bytes, bits (least significant first) or varints
@@ -201,6 +201,10 @@ pub struct StreamParams {
     /// Which vertices split in which round (SPEC §3.2 header flag bit 1,
     /// format 3.6).
     pub schedule: Schedule,
+    /// Whether rANS chunks may code a context with an adaptive table where
+    /// that is smaller (SPEC §5.5.2, format 3.9). Without, the stream stays
+    /// readable by 3.8 decoders.
+    pub adaptive_tables: bool,
 }
 
 impl Default for StreamParams {
@@ -217,6 +221,7 @@ impl Default for StreamParams {
             chunk_limit: 16 * 1024,
             rans_chunk_limit: DEFAULT_RANS_CHUNK_LIMIT,
             schedule: Schedule::default(),
+            adaptive_tables: true,
         }
     }
 }
@@ -281,6 +286,8 @@ pub struct FramedLevel {
     pub largest_byte_chunk: u32,
     /// Values of its largest rANS chunk (0 if none).
     pub largest_rans_chunk: u32,
+    /// Whether a rANS chunk codes a context with an adaptive table (3.9).
+    pub adaptive: bool,
 }
 
 /// Frames a base level (seed mesh only) and refinement levels.
@@ -329,6 +336,7 @@ pub fn assemble_stream(
     let largest_byte = largest_byte.unwrap_or(0);
     let largest_rans = framed.iter().map(|f| f.largest_rans_chunk).max();
     let largest_rans = largest_rans.unwrap_or(0);
+    let adaptive = framed.iter().any(|f| f.adaptive);
     let free = largest_byte.max(RANS_SLOT_BYTES as u32);
     let rans_above = largest_rans > free;
     let max_chunk = if rans_above {
@@ -360,13 +368,15 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.8 where a positions-first level breaks ties by a
+    // SPEC §1: 3.9 where a rANS chunk has an adaptive table, 3.8 where a positions-first level breaks ties by a
     // diagonal, 3.7 where a level reads its records positions first, 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
     // `max_chunk_len`) is used, 3.3 where a 3.3 feature (the deficit
     // contexts `valence`) is, 3.2 where a 3.2 feature (a wing policy other
     // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
     // is; every other stream stays readable by 3.0 decoders.
-    let version_minor = if levels
+    let version_minor = if adaptive {
+        VERSION_MINOR_ADAPTIVE
+    } else if levels
         .iter()
         .any(|l| l.records == RecordOrder::PositionsFirst && l.ties != Ties::Ring)
     {
@@ -445,6 +455,7 @@ pub fn frame_level_with(
     let mut directory = Vec::new();
     let mut payload = Vec::new();
     let (mut largest_byte_chunk, mut largest_rans_chunk) = (0u32, 0u32);
+    let mut adaptive = false;
     let rounds = level
         .substreams
         .iter()
@@ -471,6 +482,7 @@ pub fn frame_level_with(
                 &mut largest_byte_chunk
             };
             *largest = (*largest).max(chunk.raw_len);
+            adaptive |= chunk.adaptive;
             payload.extend_from_slice(&chunk.stored);
         }
     }
@@ -500,6 +512,7 @@ pub fn frame_level_with(
         bytes: out,
         largest_byte_chunk,
         largest_rans_chunk,
+        adaptive,
     }
 }
 
@@ -533,7 +546,14 @@ fn substream_chunks(
         ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None, map),
         ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l), map),
         ChunkCodec::Rans { lanes } => {
-            let rans = rans_chunks(sub.symbols(), rans_limit, contexts, lanes as usize, map);
+            let rans = rans_chunks(
+                sub.symbols(),
+                rans_limit,
+                contexts,
+                lanes as usize,
+                params.adaptive_tables,
+                map,
+            );
             let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
             // Level 10 is slow (up to 1,500 match probes per byte); a quick
             // level-1 pass first rules it out where it cannot win.
@@ -548,9 +568,14 @@ fn substream_chunks(
                 deflate
             }
         }
-        ChunkCodec::RansAlways { lanes } => {
-            rans_chunks(sub.symbols(), rans_limit, contexts, lanes as usize, map)
-        }
+        ChunkCodec::RansAlways { lanes } => rans_chunks(
+            sub.symbols(),
+            rans_limit,
+            contexts,
+            lanes as usize,
+            params.adaptive_tables,
+            map,
+        ),
     }
 }
 
@@ -669,6 +694,8 @@ pub struct Chunk {
     codec: u8,
     raw_len: u32,
     stored: Vec<u8>,
+    /// A rANS chunk with an adaptive table (3.9).
+    adaptive: bool,
 }
 
 /// Byte-codec chunks of at most `limit` raw bytes; deflated at `level` where
@@ -688,11 +715,13 @@ fn byte_chunk(bytes: &[u8], limit: usize, level: Option<u8>, i: usize) -> Chunk 
             codec: codec::DEFLATE,
             raw_len: raw.len() as u32,
             stored: p,
+            adaptive: false,
         },
         _ => Chunk {
             codec: codec::STORED,
             raw_len: raw.len() as u32,
             stored: raw.to_vec(),
+            adaptive: false,
         },
     }
 }
@@ -705,15 +734,18 @@ fn rans_chunks(
     limit: usize,
     contexts: usize,
     lanes: usize,
+    adaptive_tables: bool,
     map: ChunkMap<'_>,
 ) -> Vec<Chunk> {
     let segments = rans_segments(symbols, contexts, lanes, limit);
     map(segments.len(), &|i| {
         let values = &symbols[segments[i].clone()];
+        let (stored, adaptive) = encode_chunk_with(values, contexts, lanes, adaptive_tables);
         Chunk {
             codec: codec::RANS,
             raw_len: values.len() as u32,
-            stored: encode_chunk(values, contexts, lanes),
+            stored,
+            adaptive,
         }
     })
 }

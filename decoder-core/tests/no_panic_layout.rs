@@ -40,6 +40,7 @@ fn huge_stream() -> Vec<u8> {
         chunk_limit: 4,
         rans_chunk_limit: 4,
         schedule: splitstream_decoder_core::Schedule::SplitValences,
+        adaptive_tables: true,
     };
     let mut base = vec![SubstreamWriter::default(); 3];
     let mut prev = [0i32; 3];

@@ -94,6 +94,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
         chunk_limit: 1 << 16,
         rans_chunk_limit: 1 << 16,
         schedule: splitstream_decoder_core::Schedule::SplitValences,
+        adaptive_tables: true,
     };
     write_stream(&params, &[base, level])
 }

@@ -115,6 +115,7 @@ proptest! {
             chunk_limit: 5,
             rans_chunk_limit: 5,
             schedule: splitstream_decoder_core::Schedule::SplitValences,
+            adaptive_tables: true,
         };
         let stream = write_stream(&params, &[base_level, level]);
         let d = streams::decode_full(&stream);

@@ -105,6 +105,8 @@ fn height_policy_roundtrips_and_sets_the_minor_version() {
         for bits in [14, 31] {
             for (plane, minor) in [(PlanePolicy::Height, 1), (PlanePolicy::Axis(2), 0)] {
                 let options = EncodeOptions {
+                    // Static tables: the minor version is the feature's (3.9 adds none here).
+                    adaptive_tables: false,
                     bits,
                     plane: Some(plane),
                     wings: Some(WingPolicy::Ranks),
@@ -140,6 +142,8 @@ fn every_wing_policy_roundtrips_and_sets_the_minor_version() {
                     (WingPolicy::NearXy, 2),
                 ] {
                     let options = EncodeOptions {
+                        // Static tables: the minor version is the feature's (3.9 adds none here).
+                        adaptive_tables: false,
                         bits,
                         plane: Some(PlanePolicy::Dominant),
                         wings: Some(wings),
@@ -188,6 +192,8 @@ fn both_deficit_contexts_roundtrip_and_set_the_minor_version() {
                     [(DeficitContexts::Plain, 0), (DeficitContexts::Valence, 3)]
                 {
                     let options = EncodeOptions {
+                        // Static tables: the minor version is the feature's (3.9 adds none here).
+                        adaptive_tables: false,
                         bits,
                         plane: Some(PlanePolicy::Dominant),
                         wings: Some(WingPolicy::Ranks),
@@ -305,6 +311,8 @@ fn rans_chunks_beyond_max_chunk_len_set_minor_version_4() {
         (ChunkCodec::Rans { lanes: 2 }, 16 * 1024),
     ] {
         let options = EncodeOptions {
+            // Static tables: the minor version is the feature's (3.9 adds none here).
+            adaptive_tables: false,
             codec,
             chunk_limit,
             position_mode: PositionMode::Constrained,
@@ -330,6 +338,8 @@ fn rans_chunks_beyond_max_chunk_len_set_minor_version_4() {
     // Short rANS chunks: the largest chunk of any codec, 3.3 at most.
     let small = common::icosphere(2);
     let options = EncodeOptions {
+        // Static tables: the minor version is the feature's (3.9 adds none here).
+        adaptive_tables: false,
         codec: ChunkCodec::RansAlways { lanes: 4 },
         schedule: Schedule::SplitValences,
         ..EncodeOptions::default()
@@ -361,6 +371,8 @@ fn every_vertex_roundtrips_and_sets_the_minor_version() {
                 (12, ChunkCodec::Stored),
             ] {
                 let options = EncodeOptions {
+                    // Static tables: the minor version is the feature's (3.9 adds none here).
+                    adaptive_tables: false,
                     bits,
                     codec,
                     position_mode: mode,
@@ -374,6 +386,8 @@ fn every_vertex_roundtrips_and_sets_the_minor_version() {
                 let every = encode(mesh, &options, |_| {}).expect("encode").stream;
                 assert_eq!(every[9], 6, "{mode:?} {bits} {codec:?}");
                 let split = EncodeOptions {
+                    // Static tables: the minor version is the feature's (3.9 adds none here).
+                    adaptive_tables: false,
                     schedule: Schedule::SplitValences,
                     ..options
                 };
@@ -487,6 +501,8 @@ fn positions_first_roundtrips_and_sets_the_minor_version() {
         for schedule in [Schedule::EveryVertex, Schedule::SplitValences] {
             for codec in [ChunkCodec::Rans { lanes: 4 }, ChunkCodec::Deflate(6)] {
                 let options = EncodeOptions {
+                    // Static tables: the minor version is the feature's (3.9 adds none here).
+                    adaptive_tables: false,
                     records: Some(RecordOrder::PositionsFirst),
                     schedule,
                     codec,
@@ -526,6 +542,8 @@ fn every_tie_rule_roundtrips_and_the_default_is_the_smallest() {
     let mut sizes = Vec::new();
     for ties in Ties::ALL {
         let options = EncodeOptions {
+            // Static tables: the minor version is the feature's (3.9 adds none here).
+            adaptive_tables: false,
             records: Some(RecordOrder::PositionsFirst),
             ties: Some(ties),
             ..EncodeOptions::default()
@@ -545,6 +563,8 @@ fn every_tie_rule_roundtrips_and_the_default_is_the_smallest() {
         sizes.push(stream.len());
     }
     let options = EncodeOptions {
+        // Static tables: the minor version is the feature's (3.9 adds none here).
+        adaptive_tables: false,
         records: Some(RecordOrder::PositionsFirst),
         ..EncodeOptions::default()
     };
@@ -594,4 +614,42 @@ fn the_chosen_record_order_is_never_larger_than_wings_first() {
     };
     let (auto, wings_first) = (size(None), size(Some(RecordOrder::WingsFirst)));
     assert!(auto * 20 < wings_first * 19, "{auto} against {wings_first}");
+}
+
+/// Adaptive rANS tables (format 3.9, the default): streams round-trip
+/// with and without them in 1 and 4 lanes, under both schedules; a stream
+/// with one marks minor version 9, one without keeps its feature's, and
+/// both decode to the same mesh, the adaptive one no larger.
+#[test]
+fn adaptive_tables_roundtrip_and_set_the_minor_version() {
+    use splitstream_decoder_core::owned::decode_all;
+    for mesh in [common::icosphere(3), common::bumpy_grid(31, 23, 2)] {
+        for (lanes, schedule) in [(1, Schedule::EveryVertex), (4, Schedule::SplitValences)] {
+            let adaptive = EncodeOptions {
+                codec: ChunkCodec::Rans { lanes },
+                schedule,
+                ..EncodeOptions::default()
+            };
+            assert!(adaptive.adaptive_tables, "the default");
+            let fixed = EncodeOptions {
+                adaptive_tables: false,
+                ..adaptive.clone()
+            };
+            assert_roundtrip(&mesh, &adaptive);
+            assert_roundtrip(&mesh, &fixed);
+            let a = encode(&mesh, &adaptive, |_| {}).expect("encode").stream;
+            let f = encode(&mesh, &fixed, |_| {}).expect("encode").stream;
+            assert_eq!(
+                a[9], 9,
+                "{lanes} lanes {schedule:?}: small substreams pay no tables"
+            );
+            assert!(f[9] < 9);
+            assert!(a.len() <= f.len(), "{} against {}", a.len(), f.len());
+            let (da, df) = (
+                decode_all(&a, false).unwrap(),
+                decode_all(&f, false).unwrap(),
+            );
+            assert_eq!((da.positions, da.triangles), (df.positions, df.triangles));
+        }
+    }
 }

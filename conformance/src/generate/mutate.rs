@@ -110,6 +110,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
             chunk_limit: header.max_chunk_len,
             rans_chunk_limit: header.max_chunk_len,
             schedule: header.schedule,
+            adaptive_tables: false,
         },
         levels,
     }
@@ -344,8 +345,11 @@ pub fn rans_layout(s: &[u8], payload: Range<usize>, contexts: usize, lanes: usiz
         token_counts.push(at);
         let n = s[at] as usize;
         at += 1;
-        for _ in 0..n {
-            varint(s, &mut at);
+        // An adaptive table (3.9) is its table byte alone.
+        if n & 0x80 == 0 {
+            for _ in 0..n {
+                varint(s, &mut at);
+            }
         }
     }
     let lengths: Vec<u32> = (0..lanes).map(|_| varint(s, &mut at)).collect();

@@ -17,7 +17,7 @@ pub(super) fn rans_vectors(s: &mut Specs) {
     // Level 1's first chunk is its flags: one context, one lane.
     let flags = chunk_payload(&subject, 1, 0);
     assert_eq!(chunk_codec(&subject, 1, 0), codec::RANS);
-    let layout = rans_layout(&subject, flags, 1, 1);
+    let layout = rans_layout(&subject, flags.clone(), 1, 1);
     let patched = |f: &dyn Fn(&mut Vec<u8>)| {
         let mut b = subject.clone();
         f(&mut b);
@@ -46,6 +46,44 @@ pub(super) fn rans_vectors(s: &mut Specs) {
         "The flags table announces 45 tokens; the code has 44 (SPEC §5.5.2).",
         &["rans", "handmade"],
         patched(&|b| b[layout.token_counts[0]] = 45),
+    );
+    s.invalid(
+        "rans-lane-shorter-than-its-state",
+        "malformed",
+        "The flags lane is 3 bytes long: its 4-byte initial state does not fit (SPEC §5.5.3; chunk payload replaced, its length and every CRC fixed).",
+        &["rans", "handmade"],
+        {
+            let lane = layout.lanes[0];
+            // One lane: its length is the one-byte varint just before it.
+            let mut payload = subject[flags.start..lane - 1].to_vec();
+            payload.push(3);
+            payload.extend_from_slice(&subject[lane..lane + 3]);
+            with_chunk_payload(&subject, 1, 0, payload)
+        },
+    );
+    s.invalid(
+        "rans-adaptive-too-many-states",
+        "malformed",
+        "In a stream of 4 lanes, the flags table is adaptive with 16 tokens (table byte 0x8F): 15 probabilities per lane, 60 in all, above the 48 a table holds (SPEC §5.5.2, 3.9; chunk payload replaced, its length and every CRC fixed).",
+        &["rans", "rans-adaptive", "handmade"],
+        {
+            let subject = handmade::tetra_stream(ChunkCodec::RansAlways { lanes: 4 });
+            let flags = chunk_payload(&subject, 1, 0);
+            let layout = rans_layout(&subject, flags.clone(), 1, 4);
+            // The static table (its byte and counts) becomes one byte.
+            let mut payload = vec![0x8F];
+            let after_table = layout.token_counts[0] + 1 + 2;
+            assert_eq!(subject[layout.token_counts[0]], 2, "a two-token table, counts of one byte");
+            payload.extend_from_slice(&subject[after_table..flags.end]);
+            with_chunk_payload(&subject, 1, 0, payload)
+        },
+    );
+    s.invalid(
+        "rans-adaptive-table-too-short",
+        "malformed",
+        "The flags table of the one-lane stream is the adaptive table byte 0x81 of handmade-tetra-split-rans-adaptive followed by nothing: the lane directory is missing (SPEC §5.5.2, §5.5.3; chunk payload replaced, its length and every CRC fixed).",
+        &["rans", "rans-adaptive", "handmade"],
+        with_chunk_payload(&subject, 1, 0, vec![0x81]),
     );
     // The tetrahedron's split in rANS with one substream holding a single
     // value out of its field's range (slots from substream id 1).

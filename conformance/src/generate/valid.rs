@@ -2,7 +2,7 @@
 //! options, and a real mesh.
 
 use splitstream_decoder_core::handmade;
-use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
+use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, write_stream};
 use splitstream_decoder_core::{DeficitContexts, Header, PlanePolicy, PositionMode, WingPolicy};
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::EncodeOptions;
@@ -246,6 +246,8 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
                 EncodeOptions {
                     codec: ChunkCodec::RansAlways { lanes: 4 },
                     chunk_limit: 1,
+                    // Static tables: no 3.9 feature, so the stream is 3.4's.
+                    adaptive_tables: false,
                     ..opts()
                 },
             );
@@ -271,6 +273,15 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
         "SPEC Appendix A's split with every substream rANS-coded (1 lane).",
         &["minimal", "handmade", "one-split", "rans"],
         handmade::tetra_stream(ChunkCodec::RansAlways { lanes: 1 }),
+    );
+    s.valid(
+        "handmade-tetra-split-rans-adaptive",
+        "SPEC Appendix A's split rANS-coded (1 lane) with adaptive tables where the writer finds them smaller (3.9): the flag, the wing ranks and the split valences, each value a token of a two-token table whose one decision starts at one half.",
+        &["minimal", "handmade", "one-split", "rans", "rans-adaptive"],
+        handmade::tetra_stream_under(&StreamParams {
+            adaptive_tables: true,
+            ..handmade::params(ChunkCodec::RansAlways { lanes: 1 })
+        }),
     );
     // Every plane policy byte (SPEC §5.1, §7.4), forced for every level.
     for (i, policy) in PlanePolicy::ALL.into_iter().enumerate() {

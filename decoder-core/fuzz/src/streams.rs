@@ -619,6 +619,8 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
             1 << 14
         },
         schedule,
+        // Adaptive tables where the writer finds them smaller (format 3.9).
+        adaptive_tables: true,
     };
     let refinement_levels = 4 - choices.below(4);
     // With 31 bits, the base mesh is scaled towards the top of the grid.

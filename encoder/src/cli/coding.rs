@@ -9,6 +9,15 @@ use splitstream_decoder_core::{
 use super::{CliResult, Codec, DeficitsArg, PlaneArg, RecordsArg, ScheduleArg, TiesArg, WingsArg};
 use splitstream_encoder::emit::{TranscodeOptions, check_coding, lanes_for};
 
+/// `--tables`: how rANS chunks code their contexts (SPEC §5.5.2).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TablesArg {
+    /// Adaptive tables where smaller (format 3.9).
+    Adaptive,
+    /// A frequency table for every context (3.8 decoders read the stream).
+    Static,
+}
+
 #[derive(clap::Args)]
 pub struct CodingArgs {
     #[arg(long, value_enum, default_value_t = Codec::Rans)]
@@ -30,6 +39,13 @@ pub struct CodingArgs {
     /// decoder's memory (format 3.4).
     #[arg(long, default_value_t = splitstream_decoder_core::writer::DEFAULT_RANS_CHUNK_LIMIT)]
     pub rans_chunk: u32,
+    /// How rANS chunks code each context: `adaptive` lets a context whose
+    /// values take few tokens be coded by probabilities that follow them,
+    /// with no table sent, where that is smaller (format 3.9); `static`
+    /// sends a frequency table for every context (read by 3.8 decoders)
+    /// (SPEC §5.5.2).
+    #[arg(long, value_enum, default_value_t = TablesArg::Adaptive)]
+    pub tables: TablesArg,
     /// Which axis of each position residual the split's plane predicts, or
     /// `height`: z from the surface of the split vertex's fan (terrain,
     /// format 3.1) (SPEC §7.4); `auto` picks the cheapest per level.
@@ -86,6 +102,7 @@ impl CodingArgs {
             codec: self.chunk_codec(vertices),
             chunk_limit: self.chunk_size,
             rans_chunk_limit: self.rans_chunk,
+            adaptive_tables: self.tables == TablesArg::Adaptive,
             plane: self.plane(),
             wings: self.wings(),
             deficits: self.deficits(),

@@ -61,6 +61,10 @@ pub struct EncodeOptions {
     /// Largest rANS chunk (values); no effect on the decoder's memory
     /// (SPEC §5.2, format 3.4).
     pub rans_chunk_limit: u32,
+    /// Whether rANS chunks may code a context with an adaptive table where
+    /// that is smaller (SPEC §5.5.2, format 3.9); without, 3.8 decoders
+    /// read the stream.
+    pub adaptive_tables: bool,
     pub lock_boundary: bool,
     pub admit_quantile: f64,
     /// Units of the input coordinates, for the error metric.
@@ -109,6 +113,7 @@ impl Default for EncodeOptions {
             codec: ChunkCodec::Rans { lanes: 4 },
             chunk_limit: 16 * 1024,
             rans_chunk_limit: splitstream_decoder_core::writer::DEFAULT_RANS_CHUNK_LIMIT,
+            adaptive_tables: true,
             lock_boundary: false,
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,
@@ -133,6 +138,7 @@ impl EncodeOptions {
             codec: self.codec,
             chunk_limit: self.chunk_limit,
             rans_chunk_limit: self.rans_chunk_limit,
+            adaptive_tables: self.adaptive_tables,
             plane: self.plane,
             wings: self.wings,
             deficits: self.deficits,
@@ -148,6 +154,7 @@ impl EncodeOptions {
             codec,
             chunk_limit,
             rans_chunk_limit,
+            adaptive_tables,
             plane,
             wings,
             deficits,
@@ -159,6 +166,7 @@ impl EncodeOptions {
             codec,
             chunk_limit,
             rans_chunk_limit,
+            adaptive_tables,
             plane,
             wings,
             deficits,
@@ -433,6 +441,7 @@ fn encode_checked(
         chunk_limit: options.chunk_limit,
         rans_chunk_limit: options.rans_chunk_limit,
         schedule: options.schedule,
+        adaptive_tables: options.adaptive_tables,
     };
     let replayed = replay(
         mesh,

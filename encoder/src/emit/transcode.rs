@@ -37,6 +37,9 @@ pub struct TranscodeOptions {
     /// Largest rANS chunk (values); no effect on the decoder's memory
     /// (SPEC §5.2, format 3.4).
     pub rans_chunk_limit: u32,
+    /// Whether rANS chunks may code a context with an adaptive table where
+    /// that is smaller (SPEC §5.5.2, format 3.9).
+    pub adaptive_tables: bool,
     /// The plane policy of every level; `None`: chosen per level by size.
     pub plane: Option<PlanePolicy>,
     /// The wing policy of every level; `None`: chosen per level by size.
@@ -124,6 +127,7 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
         chunk_limit: options.chunk_limit,
         rans_chunk_limit: options.rans_chunk_limit,
         schedule: options.schedule,
+        adaptive_tables: options.adaptive_tables,
     };
     let simplification = refinement.simplification();
     let replayed = replay(
