@@ -74,7 +74,7 @@ pub use predict::{
     ArcMeans, Plane, PlanePolicy, SplitFan, Target, add_residual, arc_means, constrained_positions,
     height_prediction, predict, residual, surface_height,
 };
-pub use rans::token_of;
+pub use rans::{table_kinds, token_of};
 pub use ring::Ring;
 pub use round::{FANS_AHEAD_FROM_VERTICES, RecordSource, RoundStats};
 pub use split::{SplitOutcome, SplitRecord};

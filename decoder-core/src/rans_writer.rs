@@ -125,7 +125,8 @@ enum Model {
 /// instructions than a static table's lookup. Measured on armadillo, 0.005
 /// keeps 375 of the 394 bytes that every adaptive table smaller than its
 /// static one saves, on 71 % of the values instead of 94 % (decoding 7.6 %
-/// more instructions than static tables instead of 9.7 %); on the 1M
+/// more instructions than static tables instead of 9.7 %, measured with the
+/// decisions inlined); on the 1M
 /// terrain, 2,061 of 2,492 bytes on 18 % of the values instead of 42 %
 /// (encoder/BENCHMARKS.md, "Adaptive tables").
 const ADAPTIVE_MIN_GAIN: f64 = 0.005;

@@ -627,3 +627,43 @@ fn the_permutation_indexes_the_input_files_vertices() {
         );
     }
 }
+
+/// `--tables static` writes no adaptive table (format 3.9), the default
+/// writes some on a small raster, `info` counts them, and both streams
+/// decode to the same mesh.
+#[test]
+fn tables_adaptive_and_static_decode_alike_and_info_counts_them() {
+    let (input, adaptive) = encoded_raster("tables-adaptive.sps");
+    let fixed = input.with_file_name("tables-static.sps");
+    let (i, a, f) = (
+        input.to_str().unwrap(),
+        adaptive.to_str().unwrap(),
+        fixed.to_str().unwrap(),
+    );
+    succeeded(&splitstream(&["encode", i, "-o", f, "--tables", "static"]));
+    let tables = |p: &str| {
+        let doc: serde_json::Value =
+            serde_json::from_str(&succeeded(&splitstream(&["info", p, "--json"]))).unwrap();
+        (
+            doc["rans_tables_adaptive"].as_u64().unwrap(),
+            doc["rans_tables"].as_u64().unwrap(),
+        )
+    };
+    let (some, all) = tables(a);
+    assert!(some > 0 && some <= all, "{some} of {all}");
+    assert_eq!(tables(f).0, 0);
+    assert!(
+        succeeded(&splitstream(&["info", a]))
+            .contains(&format!("rANS tables: {some} of {all} adaptive"))
+    );
+    let (a, f) = (
+        std::fs::read(&adaptive).unwrap(),
+        std::fs::read(&fixed).unwrap(),
+    );
+    assert!(a.len() <= f.len());
+    let (da, df) = (
+        splitstream_decoder_core::owned::decode_all(&a, false).unwrap(),
+        splitstream_decoder_core::owned::decode_all(&f, false).unwrap(),
+    );
+    assert_eq!((da.positions, da.triangles), (df.positions, df.triangles));
+}

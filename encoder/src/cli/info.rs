@@ -5,6 +5,7 @@ use std::path::Path;
 use splitstream_decoder_core::limits::VERSION_MAJOR;
 use splitstream_decoder_core::limits::codec;
 use splitstream_decoder_core::limits::substream::{self, NAMES};
+use splitstream_decoder_core::table_kinds;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{
     Header, LevelHeader, LevelTable, PositionMode, Schedule, layout_for,
@@ -30,6 +31,10 @@ pub struct FieldSizes {
     pub framing: u64,
     /// Values of the longest rANS chunk (0 if none).
     pub largest_rans_chunk: u32,
+    /// rANS tables per id, over every chunk: how many are adaptive (format
+    /// 3.9) and how many are in use (SPEC §5.5.2).
+    pub adaptive_tables: [u32; FIELDS],
+    pub tables: [u32; FIELDS],
     /// Stored bytes per substream id in each level counted (`stored` is
     /// their sum).
     pub per_level: Vec<[u64; FIELDS]>,
@@ -97,8 +102,25 @@ fn field_sizes_of(
             .map_err(|e| format!("level {k}: {e}"))?;
         sizes.framing += lh.payload_start as u64;
         let mut level = [0u64; FIELDS];
+        let mut payload_at = lh.payload_start;
         for c in 0..lh.chunk_count {
             let chunk = lh.chunk(c).map_err(|e| e.to_string())?;
+            let payload = bytes
+                .get(payload_at..payload_at + chunk.stored_len as usize)
+                .ok_or_else(|| format!("level {k}: chunk {c} runs past the level"))?;
+            payload_at += chunk.stored_len as usize;
+            if chunk.codec == codec::RANS {
+                let contexts = splitstream_decoder_core::context::count(
+                    chunk.substream,
+                    lh.deficit_contexts,
+                    lh.record_order,
+                    header.schedule,
+                );
+                let (adaptive, in_use) = table_kinds(payload, contexts)
+                    .map_err(|e| format!("level {k}: chunk {c}: {e}"))?;
+                sizes.adaptive_tables[chunk.substream as usize] += adaptive;
+                sizes.tables[chunk.substream as usize] += in_use;
+            }
             level[chunk.substream as usize] += chunk.stored_len as u64;
             sizes.stored[chunk.substream as usize] += chunk.stored_len as u64;
             sizes.raw[chunk.substream as usize] += chunk.raw_len as u64;
@@ -324,6 +346,8 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
             "connectivity_bits_per_vertex": bpv(connectivity),
             "geometry_bits_per_vertex": bpv(geometry),
             "framing_bytes": sizes.framing,
+            "rans_tables": sizes.tables.iter().sum::<u32>(),
+            "rans_tables_adaptive": sizes.adaptive_tables.iter().sum::<u32>(),
             "workspace_bytes": header.workspace_bytes,
             "workspace_bytes_per_vertex": header.workspace_bytes as f64 / header.vertex_capacity as f64,
             "max_chunk_len": header.max_chunk_len,
@@ -457,6 +481,14 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
         println!(
             "  (as rans, as deflate: the same refinement coded again with that codec by `splitstream transcode`, \
              each level's coding chosen again)"
+        );
+    }
+    let tables: u32 = sizes.tables.iter().sum();
+    if tables > 0 {
+        let adaptive: u32 = sizes.adaptive_tables.iter().sum();
+        println!(
+            "  rANS tables: {adaptive} of {tables} adaptive (format 3.9, SPEC §5.5.2: no counts sent, \
+             probabilities that follow the values)"
         );
     }
     if by_level {
