@@ -542,18 +542,21 @@ fn substream_chunks(
 ) -> Vec<Chunk> {
     let limit = params.chunk_limit.max(1) as usize;
     let rans_limit = params.rans_chunk_limit.max(1) as usize;
+    let rans_in = |lanes: u8| {
+        rans_chunks(
+            sub.symbols(),
+            rans_limit,
+            contexts,
+            lanes as usize,
+            params.adaptive_tables,
+            map,
+        )
+    };
     match params.codec {
         ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None, map),
         ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l), map),
         ChunkCodec::Rans { lanes } => {
-            let rans = rans_chunks(
-                sub.symbols(),
-                rans_limit,
-                contexts,
-                lanes as usize,
-                params.adaptive_tables,
-                map,
-            );
+            let rans = rans_in(lanes);
             let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
             // Level 10 is slow (up to 1,500 match probes per byte); a quick
             // level-1 pass first rules it out where it cannot win.
@@ -568,14 +571,7 @@ fn substream_chunks(
                 deflate
             }
         }
-        ChunkCodec::RansAlways { lanes } => rans_chunks(
-            sub.symbols(),
-            rans_limit,
-            contexts,
-            lanes as usize,
-            params.adaptive_tables,
-            map,
-        ),
+        ChunkCodec::RansAlways { lanes } => rans_in(lanes),
     }
 }
 
