@@ -143,6 +143,22 @@ fn bad_streams_and_arguments_get_one_line_naming_the_file() {
         err.contains("cut.sps: ") && err.contains("truncated"),
         "{err}"
     );
+    // A negative error is a value refused for its reason, not an unknown
+    // flag.
+    let raster = input.to_str().unwrap();
+    let negative = input.with_file_name("negative-error.sps");
+    let err = one_line_error(&splitstream(&[
+        "encode",
+        raster,
+        "-o",
+        negative.to_str().unwrap(),
+        "--max-error",
+        "-1",
+    ]));
+    assert!(
+        err.contains("--max-error -1 is not a finite error"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -31,8 +31,10 @@ pub struct Args {
     pub base_vertices: Option<usize>,
     #[arg(long, value_enum, default_value_t = Position::Constrained)]
     pub position: Position,
-    /// Largest quadric error a collapse may have.
-    #[arg(long)]
+    /// Largest quadric error a collapse may have (0 or more).
+    // A negative value is read as one (and refused with its reason), not
+    // as an unknown flag.
+    #[arg(long, allow_negative_numbers = true)]
     pub max_error: Option<f64>,
     #[command(flatten)]
     pub coding: CodingArgs,
