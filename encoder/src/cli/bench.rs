@@ -66,7 +66,7 @@ pub struct Settings {
     #[arg(long)]
     pub skip_quality: bool,
     /// Fraction of candidate collapses admitted per step (0..1].
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     pub admit: f64,
     /// Only inputs whose name contains this (one that matches none, such
     /// as `none`, leaves the throughput run alone).

@@ -57,10 +57,10 @@ pub struct Args {
     #[arg(long)]
     pub npz_array: Option<String>,
     /// Multiply z by this (e.g. to match x/y units).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub z_scale: f64,
     /// Fraction of candidate collapses admitted per step (0..1].
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     pub admit: f64,
     /// x and y are longitude and latitude in degrees (z in metres):
     /// errors are measured in metres.

@@ -42,7 +42,7 @@ pub struct Settings {
     #[arg(long, value_enum, value_delimiter = ',', default_values_t = [Contender::Cpu, Contender::Sequential, Contender::Wgpu, Contender::Opencl])]
     pub backends: Vec<Contender>,
     /// Fraction of candidate collapses admitted per step (0..1].
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true)]
     pub admit: f64,
     /// Fail (instead of reporting the row as unavailable) when a GPU
     /// backend has no adapter.

@@ -39,7 +39,7 @@ pub struct Args {
     #[arg(long)]
     pub npz_array: Option<String>,
     /// Multiply z by this.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     pub z_scale: f64,
     /// How many tiles share each side, N,E,S,W (default 1,1,1,1): 2 when
     /// two tiles of half this tile's extent line that side.
