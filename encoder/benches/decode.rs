@@ -1,7 +1,8 @@
 //! Criterion benchmark of decoder-core on the 1M-vertex synthetic terrain:
 //! decoding of every level on one thread and on two (sdk-native
 //! `threaded`), in vertex splits per second (the goal of decoder-core's
-//! README), for both entropy codecs in one run.
+//! README), for both entropy codecs in one run, and for rANS with and
+//! without adaptive tables (format 3.9).
 //! Each stream is encoded once and kept in target/bench-data/ (encoding
 //! takes a while); the file name carries the format version and the codec.
 
@@ -16,13 +17,14 @@ const SIDE: usize = 1000;
 
 mod common;
 
-fn terrain_stream(name: &str, codec: ChunkCodec) -> Vec<u8> {
+fn terrain_stream(name: &str, codec: ChunkCodec, adaptive_tables: bool) -> Vec<u8> {
     // Optimal mode, as in every figure recorded with this benchmark (the
     // encoder's default until 2026-12-03; `splitstream demo` writes the
     // terrain in constrained mode).
     let options = EncodeOptions {
         codec,
         position_mode: PositionMode::Optimal,
+        adaptive_tables,
         ..EncodeOptions::default()
     };
     common::terrain_stream(SIDE, name, &options)
@@ -42,11 +44,12 @@ fn splits(stream: &[u8]) -> u64 {
 fn decode(c: &mut Criterion) {
     let mut group = c.benchmark_group("decode");
     group.sample_size(10);
-    for (name, codec) in [
-        ("rans", ChunkCodec::Rans { lanes: 4 }),
-        ("deflate", ChunkCodec::Deflate(9)),
+    for (name, codec, adaptive) in [
+        ("rans", ChunkCodec::Rans { lanes: 4 }, true),
+        ("rans-static-tables", ChunkCodec::Rans { lanes: 4 }, false),
+        ("deflate", ChunkCodec::Deflate(9), false),
     ] {
-        let stream = terrain_stream(name, codec);
+        let stream = terrain_stream(name, codec, adaptive);
         let mut ws = OwnedWorkspace::for_stream(&stream).expect("valid stream");
         group.throughput(Throughput::Elements(splits(&stream)));
         group.bench_function(
