@@ -247,22 +247,34 @@ fn choose_models(
     for &(ctx, value) in symbols {
         histograms[ctx as usize][token_of(value).0 as usize] += 1;
     }
-    let mut models = Vec::with_capacity(contexts);
-    for (c, histogram) in histograms.iter().enumerate() {
-        let (static_bits, counts) = scaled_counts(histogram);
-        let tokens = counts.len();
-        if adaptive_tables
+    let priced: Vec<(f64, Vec<u32>)> = histograms.iter().map(|h| scaled_counts(h)).collect();
+    let may_adapt = |tokens: usize| {
+        adaptive_tables
             && tokens > 1
             && tokens <= ADAPTIVE_TOKENS
             && (tokens - 1) * lanes <= ADAPTIVE_STATES
-        {
-            let mut lanes_tokens = vec![Vec::new(); lanes];
-            for (i, &(ctx, value)) in symbols.iter().enumerate() {
-                if ctx as usize == c {
-                    lanes_tokens[i % lanes].push(token_of(value).0 as u8);
-                }
+    };
+    // Each such context's tokens, lane by lane, gathered in one pass.
+    let mut lanes_tokens: Vec<Vec<Vec<u8>>> = priced
+        .iter()
+        .map(|(_, counts)| {
+            if may_adapt(counts.len()) {
+                vec![Vec::new(); lanes]
+            } else {
+                Vec::new()
             }
-            let (bits, rate) = best_rate(|rate| adaptive_bits(&lanes_tokens, tokens, rate));
+        })
+        .collect();
+    for (i, &(ctx, value)) in symbols.iter().enumerate() {
+        if let Some(lane) = lanes_tokens[ctx as usize].get_mut(i % lanes) {
+            lane.push(token_of(value).0 as u8);
+        }
+    }
+    let mut models = Vec::with_capacity(contexts);
+    for ((static_bits, counts), lanes_tokens) in priced.into_iter().zip(&lanes_tokens) {
+        let tokens = counts.len();
+        if may_adapt(tokens) {
+            let (bits, rate) = best_rate(|rate| adaptive_bits(lanes_tokens, tokens, rate));
             let values: usize = lanes_tokens.iter().map(Vec::len).sum();
             if bits + ADAPTIVE_MIN_GAIN * values as f64 <= static_bits {
                 out.push(adaptive_byte(tokens, rate));
