@@ -78,10 +78,12 @@ fn scaled_counts(histogram: &[u32]) -> (f64, Vec<u32>) {
 
 /// Estimated bits of one rANS chunk coding `values` values whose tokens
 /// fall into `histograms` (one per context), beside their raw bits: its
-/// directory entry, every context's table, the tokens under those tables
-/// (as [`encode_chunk`] chooses them) and the lanes' lengths and final
-/// states. What [`crate::writer`] weighs when it decides where to cut a
-/// substream into chunks.
+/// directory entry, every context's static table, the tokens under those
+/// tables (at the scale [`encode_chunk_with`] chooses) and the lanes'
+/// lengths and final states. What [`crate::writer`] weighs when it decides
+/// where to cut a substream into chunks. Adaptive tables (3.9) are left
+/// out: pricing them needs the values in order, not their counts, and
+/// they only make a chunk smaller.
 pub fn chunk_cost_bits(histograms: &[[u32; TOKENS]], values: usize, lanes: usize) -> f64 {
     // Directory entry, then per lane a length varint (about 2 bytes) and
     // its 4-byte state.
