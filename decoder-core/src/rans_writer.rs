@@ -368,16 +368,17 @@ fn lane_steps(values: &[&Symbol], models: &[Model], lane: usize, lanes: usize) -
     steps
 }
 
-/// Encodes `symbols` as one rANS chunk payload with `contexts` tables and
-/// `lanes` lanes (SPEC §5.5.2, §5.5.3), adaptive tables where they are
-/// smaller.
+/// [`encode_chunk_with`] allowing adaptive tables, the payload alone (the
+/// tests' shorthand).
 #[cfg(test)]
 pub fn encode_chunk(symbols: &[Symbol], contexts: usize, lanes: usize) -> Vec<u8> {
     encode_chunk_with(symbols, contexts, lanes, true).0
 }
 
-/// [`encode_chunk`], with adaptive tables only where `adaptive_tables`
-/// allows them, and whether the chunk has one (format 3.9).
+/// Encodes `symbols` as one rANS chunk payload with `contexts` tables and
+/// `lanes` lanes (SPEC §5.5.2, §5.5.3), with an adaptive table (3.9) for a
+/// context where `adaptive_tables` allows it and it is smaller; and
+/// whether the chunk has one.
 pub fn encode_chunk_with(
     symbols: &[Symbol],
     contexts: usize,
