@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.9 decoder, in Python, written from
+"""A second splitstream 3.10 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
@@ -11,8 +11,9 @@ count-mismatch before the seed is read; 3.6's schedule `every-vertex`,
 header flag bit 1, was added with the SPEC sections that define it, and
 3.7's record order `positions-first`, level header byte 11, with SPEC §7.4
 "Positions first", 3.8's tie rules of record orders 2 and 3 with
-`off` of SPEC §7.4 `before`, and 3.9's adaptive rANS tables with SPEC
-§5.5.2 and §5.5.4.) It speaks the conformance protocol (a stream
+`off` of SPEC §7.4 `before`, 3.9's adaptive rANS tables with SPEC
+§5.5.2 and §5.5.4, and 3.10's flag contexts `split-history` with SPEC
+§5.1, §5.5.5, §6.1 and §7.5.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -669,9 +670,11 @@ class Decoder:
             raise Fail("malformed")
         if lvl[9] > 2:  # wing policy (3.2)
             raise Fail("malformed")
-        if lvl[10] > 1:  # deficit contexts (3.3)
+        if lvl[10] > 2:  # contexts (3.3; 2 since 3.10)
             raise Fail("malformed")
-        if lvl[10] != 0 and self.every:  # no split-valence symbols (3.6)
+        if lvl[10] == 1 and self.every:  # no split-valence symbols (3.6)
+            raise Fail("malformed")
+        if lvl[10] == 2 and not self.every:  # split-history: every-vertex only (3.10)
             raise Fail("malformed")
         if lvl[11] > 3:  # record order (3.7; 2 and 3 since 3.8)
             raise Fail("malformed")
@@ -733,6 +736,8 @@ class Decoder:
         for sid in range(1, 11):
             lst = [(c, rl, crc, bytes(lvl[off:off + sl])) for (c, rl, crc, off, sl) in chunks.get(sid, [])]
             nctx = (NCTX_EVERY if self.every else NCTX_VALENCE if lvl[10] == 1 else NCTX)[sid]
+            if self.every and lvl[10] == 2 and sid == 1:  # split-history flags (3.10)
+                nctx = 8
             if lvl[11] >= 1:  # positions first (3.7, 3.8)
                 nctx = NCTX_PF.get(sid, nctx)
             subs[sid] = Sub(sid, lst, self.lane_count, nctx)
@@ -740,6 +745,8 @@ class Decoder:
         self.policy = lvl[8]
         self.wing_policy = lvl[9]
         self.deficit_contexts = lvl[10]
+        # SPEC §6.1 (3.10): the split-history bits, all 0 when a level starts.
+        self.split = set()
         # 0 wings-first, 1 positions-first (3.7), 2 positions-first-rising,
         # 3 positions-first-falling (3.8)
         self.record_order = lvl[11]
@@ -900,7 +907,12 @@ class Decoder:
                 continue
             # context 0; every-vertex (3.6): by the valence byte, as at
             # round start (all flags are read before any split), §5.5.5
-            fctx = min(max(deficit[v], 4), 8) - 4 if self.every else 0
+            if not self.every:
+                fctx = 0
+            elif self.deficit_contexts == 2:  # split-history (3.10)
+                fctx = min(max(deficit[v], 5), 8) - 5 + 4 * (v in self.split)
+            else:
+                fctx = min(max(deficit[v], 4), 8) - 4
             if flags.bit(fctx) == 1:
                 flagged.append(v)
                 rg = self.ring(v)
@@ -1294,6 +1306,8 @@ class Decoder:
         self.pos.append(Cp)
         deficit[R] = dP
         deficit.append(dC)
+        if self.every:  # R's split-history bit (3.10)
+            self.split.add(R)
         self.V += 1
 
 

@@ -211,8 +211,9 @@ fn pieces(stream: &[u8], broken: bool, hashes: &mut Vec<u64>) -> Result<(), Erro
         // SPEC §5.1: the level header against the table entry.
         let is_base = k == 0;
         let level_header = table.level_header(k, bytes, header.level_rules())?;
-        // SPEC §7.6: no split may take the level past its triangle count.
-        state.set_triangle_limit(info.triangle_count);
+        // SPEC §7.6: no split may take the level past its triangle count;
+        // §6.1 (3.10): the split-history bits start the level at 0.
+        state.start_level(info.triangle_count);
         let rounds = level_header.round_count;
         if is_base {
             // SPEC §6.3: the seed mesh (substreams 8..=10) comes first.

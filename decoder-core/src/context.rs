@@ -7,8 +7,11 @@ use crate::limits::{LEAF, substream};
 use crate::positions_first::RecordOrder;
 use crate::predict::{ArcMeans, PlanePolicy, placement_context};
 
-/// How a level's split-valence symbols are coded (SPEC §5.1, level header
-/// byte 10, format 3.3): which contexts deficit-p and deficit-c use.
+/// A level's contexts (SPEC §5.1, level header byte 10, `contexts`):
+/// under the schedule `split-valences` which contexts deficit-p and
+/// deficit-c use (format 3.3); under `every-vertex`, which code no
+/// split-valence symbols, which contexts the flags use (`Plain`, byte 0:
+/// by valence; `SplitHistory`, byte 2, format 3.10).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum DeficitContexts {
     /// Formats 3.0 to 3.2: deficit-p in one context, deficit-c by whether P
@@ -20,11 +23,21 @@ pub enum DeficitContexts {
     /// valence is at least the valence, and it mostly settles near the
     /// larger of the valence and 7, so the valence shapes its distribution.
     Valence,
+    /// 3.10, `every-vertex` only (named `split-history`): the flags in 8
+    /// contexts, by the vertex's valence (5 or less … 8 or more) and its
+    /// split-history bit (whether it has split in this level, SPEC §6.1).
+    /// A vertex that has split in a level splits again in it with other
+    /// odds than one of the same valence that has not.
+    SplitHistory,
 }
 
 impl DeficitContexts {
     /// Every choice, in byte order.
-    pub const ALL: [DeficitContexts; 2] = [DeficitContexts::Plain, DeficitContexts::Valence];
+    pub const ALL: [DeficitContexts; 3] = [
+        DeficitContexts::Plain,
+        DeficitContexts::Valence,
+        DeficitContexts::SplitHistory,
+    ];
 
     pub fn from_byte(b: u8) -> Option<DeficitContexts> {
         DeficitContexts::ALL.get(b as usize).copied()
@@ -39,6 +52,18 @@ impl DeficitContexts {
         match self {
             DeficitContexts::Plain => "plain",
             DeficitContexts::Valence => "valence",
+            DeficitContexts::SplitHistory => "split-history",
+        }
+    }
+
+    /// Whether a level of a stream with schedule `schedule` may declare
+    /// these contexts (SPEC §5.1): `valence` under `split-valences` only,
+    /// `split-history` under `every-vertex` only.
+    pub fn allowed_under(self, schedule: Schedule) -> bool {
+        match self {
+            DeficitContexts::Plain => true,
+            DeficitContexts::Valence => schedule == Schedule::SplitValences,
+            DeficitContexts::SplitHistory => schedule == Schedule::EveryVertex,
         }
     }
 }
@@ -57,6 +82,9 @@ pub fn count(id: u8, deficits: DeficitContexts, records: RecordOrder, schedule: 
         }
     }
     match (id, deficits, schedule) {
+        (substream::FLAGS, DeficitContexts::SplitHistory, Schedule::EveryVertex) => {
+            SPLIT_HISTORY_FLAG_CONTEXTS
+        }
         (substream::FLAGS, _, Schedule::EveryVertex) => FLAG_CONTEXTS,
         (substream::DEFICIT_P, DeficitContexts::Valence, _) => 5,
         (substream::DEFICIT_C, DeficitContexts::Valence, _) => 6,
@@ -67,15 +95,24 @@ pub fn count(id: u8, deficits: DeficitContexts, records: RecordOrder, schedule: 
 /// Contexts of the flags under the schedule `every-vertex` (SPEC §5.5.5).
 pub const FLAG_CONTEXTS: usize = 5;
 
-/// The flag of a vertex whose state byte is `byte` (SPEC §5.5.5, §7.3):
+/// Contexts of the flags under `every-vertex` with the contexts
+/// `split-history` (SPEC §5.5.5, 3.10).
+pub const SPLIT_HISTORY_FLAG_CONTEXTS: usize = 8;
+
+/// The flag of a vertex whose state byte is `byte` and whose split-history
+/// bit is `split` (SPEC §5.5.5, §7.3), in a level with contexts `contexts`:
 /// under `every-vertex` the byte is the vertex's valence (capped at 255),
-/// and the context its valence 4 (or less) … 8 (or more) as 0..=4; under
-/// `split-valences`, 0.
+/// and the context its valence 4 (or less) … 8 (or more) as 0..=4, or
+/// under `split-history` its valence 5 (or less) … 8 (or more) as 0..=3,
+/// plus 4 when it has split in this level; under `split-valences`, 0.
 #[inline]
-pub fn flag(schedule: Schedule, byte: u8) -> u8 {
-    match schedule {
-        Schedule::SplitValences => SINGLE,
-        Schedule::EveryVertex => byte.clamp(4, 8) - 4,
+pub fn flag(schedule: Schedule, contexts: DeficitContexts, byte: u8, split: bool) -> u8 {
+    match (schedule, contexts) {
+        (Schedule::SplitValences, _) => SINGLE,
+        (Schedule::EveryVertex, DeficitContexts::SplitHistory) => {
+            byte.clamp(5, 8) - 5 + 4 * u8::from(split)
+        }
+        (Schedule::EveryVertex, _) => byte.clamp(4, 8) - 4,
     }
 }
 
@@ -84,8 +121,8 @@ pub fn flag(schedule: Schedule, byte: u8) -> u8 {
 #[inline]
 pub fn deficit_p(deficits: DeficitContexts, valence_p: usize) -> u8 {
     match deficits {
-        DeficitContexts::Plain => SINGLE,
         DeficitContexts::Valence => (valence_p.clamp(4, 8) - 4) as u8,
+        _ => SINGLE,
     }
 }
 
@@ -103,10 +140,12 @@ pub fn wing(eligible: usize) -> u8 {
 #[inline]
 pub fn deficit_c(deficits: DeficitContexts, deficit_p: u8, valence_c: usize) -> u8 {
     match (deficits, deficit_p == LEAF) {
-        (DeficitContexts::Plain, true) => 4,
-        (DeficitContexts::Plain, false) => (valence_c.clamp(3, 6) - 3) as u8,
         (DeficitContexts::Valence, true) => 0,
         (DeficitContexts::Valence, false) => (valence_c.clamp(4, 8) - 3) as u8,
+        // `split-history` is `every-vertex`'s, which codes no split
+        // valences: `plain`'s contexts, never used.
+        (_, true) => 4,
+        (_, false) => (valence_c.clamp(3, 6) - 3) as u8,
     }
 }
 
@@ -146,7 +185,10 @@ mod tests {
     /// (SPEC §5.5.5), for every valence a ring allows and both leafnesses.
     #[test]
     fn deficit_contexts_stay_below_the_table_count() {
-        for set in DeficitContexts::ALL {
+        let split_valences = DeficitContexts::ALL
+            .into_iter()
+            .filter(|set| set.allowed_under(Schedule::SplitValences));
+        for set in split_valences {
             let (p_tables, c_tables) = (
                 count(
                     substream::DEFICIT_P,
@@ -185,7 +227,36 @@ mod tests {
         for set in DeficitContexts::ALL {
             assert_eq!(DeficitContexts::from_byte(set.to_byte()), Some(set));
         }
-        assert_eq!(DeficitContexts::from_byte(2), None);
+        assert_eq!(
+            DeficitContexts::from_byte(2),
+            Some(DeficitContexts::SplitHistory)
+        );
+        assert_eq!(DeficitContexts::from_byte(3), None);
         assert_eq!(DeficitContexts::from_byte(255), None);
+    }
+
+    /// Every context a flag can get is one of the flags' tables, and
+    /// every table is used (SPEC §5.5.5), under every schedule and every
+    /// contexts byte it allows.
+    #[test]
+    fn flag_contexts_stay_below_the_table_count_and_use_every_table() {
+        for schedule in [Schedule::SplitValences, Schedule::EveryVertex] {
+            for set in DeficitContexts::ALL {
+                if !set.allowed_under(schedule) {
+                    continue;
+                }
+                let tables = count(substream::FLAGS, set, RecordOrder::WingsFirst, schedule);
+                assert!(tables <= MAX_CONTEXTS);
+                let mut seen = [false; MAX_CONTEXTS];
+                for byte in 0..=255u8 {
+                    for split in [false, true] {
+                        let c = flag(schedule, set, byte, split) as usize;
+                        assert!(c < tables, "{schedule:?} {set:?} {byte} {split}");
+                        seen[c] = true;
+                    }
+                }
+                assert!(seen[..tables].iter().all(|&s| s), "{schedule:?} {set:?}");
+            }
+        }
     }
 }

@@ -232,7 +232,7 @@ impl<'h, 'ws> Decoder<'h, 'ws> {
                 return Err(e);
             }
         };
-        self.state.set_triangle_limit(info.triangle_count);
+        self.state.start_level(info.triangle_count);
         if level == 0 {
             // The seed mesh first (ids 8..=10), then the level's rounds.
             let buffers = self.buffers.each_mut().map(|b| &mut **b);

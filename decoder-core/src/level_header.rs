@@ -167,13 +167,19 @@ impl<'l> LevelHeader<'l> {
         if WingPolicy::from_byte(self.wing_byte).is_none() {
             return Err(Error::InvalidLevelHeader("unknown wing policy"));
         }
-        if DeficitContexts::from_byte(self.deficit_byte).is_none() {
-            return Err(Error::InvalidLevelHeader("unknown deficit contexts"));
-        }
-        if self.schedule == Schedule::EveryVertex && self.deficit_byte != 0 {
-            return Err(Error::InvalidLevelHeader(
-                "deficit contexts other than plain under the schedule every-vertex",
-            ));
+        match DeficitContexts::from_byte(self.deficit_byte) {
+            None => return Err(Error::InvalidLevelHeader("unknown contexts")),
+            Some(DeficitContexts::Valence) if self.schedule == Schedule::EveryVertex => {
+                return Err(Error::InvalidLevelHeader(
+                    "deficit contexts valence under the schedule every-vertex",
+                ));
+            }
+            Some(DeficitContexts::SplitHistory) if self.schedule == Schedule::SplitValences => {
+                return Err(Error::InvalidLevelHeader(
+                    "flag contexts split-history under the schedule split-valences",
+                ));
+            }
+            Some(_) => {}
         }
         match RecordOrder::from_byte(self.record_byte) {
             None => return Err(Error::InvalidLevelHeader("unknown record order")),

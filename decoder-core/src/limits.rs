@@ -8,7 +8,11 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 /// stream; 3.5 added a check and no feature, so no stream is written with
 /// minor version 5 (the writer uses the constants below).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 9;
+pub const VERSION_MINOR: u8 = 10;
+/// The minor version written when a level uses the contexts
+/// `split-history` (SPEC §5.1, §5.5.5): 3.9 decoders reject its contexts
+/// byte.
+pub const VERSION_MINOR_SPLIT_HISTORY: u8 = 10;
 /// The minor version written when a rANS chunk has an adaptive table (SPEC
 /// §5.5.2): 3.8 decoders reject its table byte.
 pub const VERSION_MINOR_ADAPTIVE: u8 = 9;

@@ -124,17 +124,29 @@ impl StreamSource<'_, '_, '_> {
     }
 }
 
+/// The context of `v`'s flag under `every-vertex` (SPEC §5.5.5): its
+/// valence byte and, under the contexts `split-history`, its split-history
+/// bit, as the state holds them (at the start of the round for every
+/// vertex whose flag is still to be read, §7.3).
+#[inline]
+pub(crate) fn flag_context(state: &MeshState<'_>, contexts: DeficitContexts, v: u32) -> u8 {
+    let byte = state.deficits().get(v as usize).copied().unwrap_or(0);
+    match contexts {
+        // `context::flag`'s rule, with the bit as a number: no branch on it.
+        DeficitContexts::SplitHistory => byte.clamp(5, 8) - 5 + 4 * state.split_bit(v),
+        _ => context::flag(Schedule::EveryVertex, contexts, byte, false),
+    }
+}
+
 impl RecordSource for StreamSource<'_, '_, '_> {
     /// SPEC §7.3: one context, or under `every-vertex` the vertex's
-    /// valence at the start of the round (§5.5.5).
+    /// valence at the start of the round, and under the contexts
+    /// `split-history` its split-history bit (§5.5.5, 3.10).
     #[inline]
     fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
         let context = match self.schedule {
             Schedule::SplitValences => SINGLE,
-            Schedule::EveryVertex => context::flag(
-                self.schedule,
-                state.deficits().get(v as usize).copied().unwrap_or(0),
-            ),
+            Schedule::EveryVertex => flag_context(state, self.deficits, v),
         };
         self.subs.bit(slot(substream::FLAGS), context)
     }
@@ -154,8 +166,7 @@ impl RecordSource for StreamSource<'_, '_, '_> {
                 let mut contexts = [0u8; 128];
                 let n = upcoming.len().min(128);
                 for (c, &v) in contexts.iter_mut().zip(&upcoming[..n]) {
-                    let byte = state.deficits().get(v as usize).copied().unwrap_or(0);
-                    *c = context::flag(self.schedule, byte);
+                    *c = flag_context(state, self.deficits, v);
                 }
                 self.subs
                     .peek_bits_in(slot(substream::FLAGS), &contexts[..n])

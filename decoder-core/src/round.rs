@@ -8,6 +8,7 @@
 //! in a [`RecordSource`].
 
 use crate::Error;
+use crate::header::Schedule;
 use crate::limits::NONE;
 use crate::pipe::{PendingSplits, RecordPipe};
 use crate::ring::{FAN_LEN, FANS, FansAhead, Ring};
@@ -126,16 +127,23 @@ impl MeshState<'_> {
         // bitmap is kept up to date by every split (SPEC §7.3). A copy
         // of it as it is now says which ring entries may be wings during
         // the round (SPEC §7.4, symbols.rs): splits change the live bitmap.
+        let every_vertex = self.schedule == Schedule::EveryVertex;
         let (candidates, round_start, _) = self.bitmaps();
         let words = words.min(candidates.len()).min(round_start.len());
-        round_start[..words].copy_from_slice(&candidates[..words]);
+        // Under `every-vertex` every entry may be a wing, and the round-start
+        // bitmap holds the split-history bits instead (SPEC §6.1, §9, 3.10).
+        if !every_vertex {
+            round_start[..words].copy_from_slice(&candidates[..words]);
+        }
         let mut stats = RoundStats {
             candidates: candidates[..words].iter().map(|w| w.count_ones()).sum(),
             ..RoundStats::default()
         };
         let result = self.flag_and_split(n, words, source, ring, splits, &mut stats);
         let (_, round_start, blocked) = self.bitmaps();
-        round_start[..words].fill(0);
+        if !every_vertex {
+            round_start[..words].fill(0);
+        }
         blocked[..words].fill(0);
         match result {
             Err(e) => Err(e),

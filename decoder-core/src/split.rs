@@ -191,6 +191,14 @@ impl MeshState<'_> {
         self.deficit[c as usize] = byte_c;
         self.set_candidate(r, byte_p);
         self.set_candidate(c, byte_c);
+        if every_vertex {
+            // R's split-history bit (SPEC §6.1, §7.5, 3.10); C's stays 0,
+            // as every bit above the level's first vertex count is.
+            let third = self.candidates.len() / 3;
+            if let Some(word) = self.candidates[third..2 * third].get_mut((r / 64) as usize) {
+                *word |= 1u64 << (r % 64);
+            }
+        }
         self.vertex_count += 1;
         self.triangle_count = next_t;
         Ok(SplitOutcome {

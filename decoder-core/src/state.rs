@@ -85,8 +85,9 @@ pub struct StateMemory<'ws> {
     pub deficit: &'ws mut [u8],
     /// Three bitmaps of one bit per vertex, one after the other: the current
     /// candidates (deficit 0), the candidates at the start of the current
-    /// round, and the candidates whose flag is inferred because a neighbour
-    /// was flagged.
+    /// round (under `every-vertex`, where every vertex is a candidate: the
+    /// split-history bits, SPEC §6.1, 3.10), and the candidates whose flag
+    /// is inferred because a neighbour was flagged.
     pub candidates: &'ws mut [u64],
 }
 
@@ -160,6 +161,42 @@ impl<'ws> MeshState<'ws> {
     /// (SPEC §7.5), whatever the workspace could hold.
     pub fn set_triangle_limit(&mut self, limit: u32) {
         self.triangle_limit = limit;
+    }
+
+    /// Starts a level whose table entry allows `triangle_limit` triangles
+    /// ([`MeshState::set_triangle_limit`]): under `every-vertex` every
+    /// vertex's split-history bit is cleared (SPEC §6.1, 3.10). Whoever
+    /// drives the rounds calls it before each level, level 0's seed
+    /// included.
+    pub fn start_level(&mut self, triangle_limit: u32) {
+        self.triangle_limit = triangle_limit;
+        if self.schedule == Schedule::EveryVertex {
+            let third = self.candidates.len() / 3;
+            self.candidates[third..2 * third].fill(0);
+        }
+    }
+
+    /// Whether `v` has split (as R) since the current level started: its
+    /// split-history bit (SPEC §6.1, 3.10; `every-vertex` only, `false`
+    /// otherwise).
+    #[inline]
+    pub fn split_in_level(&self, v: u32) -> bool {
+        self.schedule == Schedule::EveryVertex && v < self.vertex_count && self.split_bit(v) != 0
+    }
+
+    /// [`MeshState::split_in_level`] as 0 or 1, without the checks, for
+    /// a vertex below `vertex_count()` under `every-vertex`: one load, no
+    /// branch (the flags of a `split-history` level read it about five
+    /// times per vertex, twice each with the fans walked ahead).
+    #[inline]
+    pub(crate) fn split_bit(&self, v: u32) -> u8 {
+        let third = self.candidates.len() / 3;
+        let word = self
+            .candidates
+            .get(third + (v / 64) as usize)
+            .copied()
+            .unwrap_or(0);
+        (word >> (v % 64) & 1) as u8
     }
 
     /// Makes rounds that start with at least `vertices` vertices walk the

@@ -12,7 +12,8 @@ use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
     CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_ADAPTIVE, VERSION_MINOR_BASELINE,
     VERSION_MINOR_DEFICITS, VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_RECORDS,
-    VERSION_MINOR_SCHEDULE, VERSION_MINOR_TIES, VERSION_MINOR_WINGS, codec, substream,
+    VERSION_MINOR_SCHEDULE, VERSION_MINOR_SPLIT_HISTORY, VERSION_MINOR_TIES, VERSION_MINOR_WINGS,
+    codec, substream,
 };
 use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
@@ -368,13 +369,19 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.9 where a rANS chunk has an adaptive table, 3.8 where a positions-first level breaks ties by a
+    // SPEC §1: 3.10 where a level's flags use the contexts
+    // `split-history`, 3.9 where a rANS chunk has an adaptive table, 3.8 where a positions-first level breaks ties by a
     // diagonal, 3.7 where a level reads its records positions first, 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
     // `max_chunk_len`) is used, 3.3 where a 3.3 feature (the deficit
     // contexts `valence`) is, 3.2 where a 3.2 feature (a wing policy other
     // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
     // is; every other stream stays readable by 3.0 decoders.
-    let version_minor = if adaptive {
+    let version_minor = if levels
+        .iter()
+        .any(|l| l.deficits == DeficitContexts::SplitHistory)
+    {
+        VERSION_MINOR_SPLIT_HISTORY
+    } else if adaptive {
         VERSION_MINOR_ADAPTIVE
     } else if levels
         .iter()

@@ -227,6 +227,71 @@ fn the_chosen_deficit_contexts_are_never_larger_than_plain() {
     }
 }
 
+/// Format 3.10's flag contexts under `every-vertex`, forced in every
+/// level, on a closed mesh and on terrain with a boundary, in both position
+/// modes, at 14 and 31 bits: both round-trip, `split-history` sets minor
+/// version 10 and says byte 2 in every level header, `valence` leaves the
+/// stream at 6 (with static tables and wings-first records) (SPEC §1, §5.1,
+/// §5.5.5). The split-history bits are cleared at each level's start and
+/// set by every split (SPEC §6.1, §7.5): the decoder's state hash after
+/// every round is the encoder's, which is what `assert_roundtrip` checks.
+#[test]
+fn both_flag_contexts_roundtrip_and_set_the_minor_version() {
+    let meshes = [common::icosphere(2), common::bumpy_grid(21, 17, 3)];
+    for mesh in &meshes {
+        for mode in [PositionMode::Constrained, PositionMode::Optimal] {
+            for bits in [14, 31] {
+                for (flags, minor, byte) in [
+                    (DeficitContexts::Plain, 6, 0),
+                    (DeficitContexts::SplitHistory, 10, 2),
+                ] {
+                    let options = EncodeOptions {
+                        adaptive_tables: false,
+                        bits,
+                        deficits: Some(flags),
+                        records: Some(RecordOrder::WingsFirst),
+                        position_mode: mode,
+                        schedule: Schedule::EveryVertex,
+                        ..EncodeOptions::default()
+                    };
+                    assert_roundtrip(mesh, &options);
+                    let stream = encode(mesh, &options, |_| {}).expect("encode").stream;
+                    assert_eq!(stream[9], minor, "{mode:?} {bits} {flags:?}");
+                    let header = Header::parse(&stream).unwrap();
+                    let table = LevelTable::parse(&stream, &header).unwrap();
+                    for k in 0..table.len() {
+                        let e = table.get(k);
+                        let level =
+                            &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
+                        let lh = LevelHeader::parse(level, k == 0, header.level_rules()).unwrap();
+                        assert_eq!(
+                            lh.deficit_contexts.to_byte(),
+                            byte,
+                            "{mode:?} {bits} level {k}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// By default a small level keeps whichever flag contexts code smaller:
+/// never larger than `valence` (a few bytes of slack), and a large enough
+/// refinement takes `split-history` somewhere.
+#[test]
+fn the_chosen_flag_contexts_are_never_larger_than_valence() {
+    for mesh in [common::icosphere(3), common::bumpy_grid(61, 53, 2)] {
+        let auto = encode(&mesh, &EncodeOptions::default(), |_| {}).expect("encode");
+        let valence = EncodeOptions {
+            deficits: Some(DeficitContexts::Plain),
+            ..EncodeOptions::default()
+        };
+        let valence = encode(&mesh, &valence, |_| {}).expect("encode");
+        assert!(auto.stream.len() <= valence.stream.len() + 16);
+    }
+}
+
 #[test]
 fn rasters_keep_their_lattice_exactly() {
     // Heights in whole units (as the Jacksboro DEM's metres): all three

@@ -132,10 +132,13 @@ fn smaller_chunks_lower_the_workspace_and_keep_every_round() {
         // feature than 3.4's long rANS chunks; 7 where a level of the
         // grid reads its records positions first (3.7, chosen by size), 8
         // where one also breaks its ties by a diagonal (3.8), 9 where a
-        // chunk has an adaptive table (3.9, chosen by size).
+        // chunk has an adaptive table (3.9, chosen by size), 10 where a
+        // level's flags use the contexts split-history (3.10, chosen by
+        // size).
         let positions_first = matches!(long_header.version_minor, 7 | 8);
         assert!(
-            matches!(long_header.version_minor, 6 | 9) || (positions_first && name == "bumpy grid"),
+            matches!(long_header.version_minor, 6 | 9 | 10)
+                || (positions_first && name == "bumpy grid"),
             "{name}: minor {}",
             long_header.version_minor
         );

@@ -289,7 +289,7 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "deficit-contexts-reserved",
         "malformed",
-        "Level 1's deficit contexts byte (level header byte 10) set to 2, the first value 3.3 reserves (level header CRC recomputed).",
+        "Level 1's contexts byte (level header byte 10) set to 2 in a stream of the schedule split-valences: reserved from 3.3, and since 3.10 `split-history`, which only the schedule every-vertex allows (level header CRC recomputed).",
         &["reserved", "deficit-contexts"],
         with_level_header_byte(&subject, 1, plane_policy_at(&subject, 1) + 2, 2),
     );
@@ -807,9 +807,39 @@ fn every_vertex_invalid(s: &mut Specs) {
     s.invalid(
         "every-vertex-deficit-contexts-valence",
         "malformed",
-        "A stream of the schedule every-vertex whose level 1 says deficit contexts `valence` (level header byte 10 = 1, CRC recomputed): under every-vertex, which codes no split valences, it MUST be 0 (SPEC §5.1).",
+        "A stream of the schedule every-vertex whose level 1 says deficit contexts `valence` (level header byte 10 = 1, CRC recomputed): under every-vertex, which codes no split valences, it MUST be 0 or (3.10) 2 (SPEC §5.1).",
         &["deficit-contexts", tag],
         with_level_header_byte(&every, 1, plane_policy_at(&every, 1) + 2, 1),
+    );
+    s.invalid(
+        "every-vertex-contexts-reserved",
+        "malformed",
+        "A stream of the schedule every-vertex whose level 1's contexts byte (level header byte 10) is 3, the first value 3.10 reserves (level header CRC recomputed).",
+        &["reserved", "flag-contexts", tag],
+        with_level_header_byte(&every, 1, plane_policy_at(&every, 1) + 2, 3),
+    );
+    // A level whose flags were written in the 8 contexts of `split-history`
+    // read as `valence` (5): the flags' first chunk then ends its tables
+    // early and reads a table byte as its lane directory (SPEC §5.5.2).
+    s.invalid(
+        "every-vertex-flag-contexts-switched",
+        "malformed",
+        "A stream of the schedule every-vertex whose level 1, written with the flag contexts `split-history` (byte 10 = 2, 8 tables), is relabelled `valence` (byte 0, 5 tables; level header CRC recomputed).",
+        &["flag-contexts", "rans", tag],
+        {
+            let history = encoded(
+                &meshes::icosphere(2),
+                every_vertex(EncodeOptions {
+                    deficits: Some(DeficitContexts::SplitHistory),
+                    codec: ChunkCodec::RansAlways { lanes: 4 },
+                    adaptive_tables: false,
+                    ..opts()
+                }),
+            );
+            let at = plane_policy_at(&history, 1) + 2;
+            assert_eq!(history[at], 2);
+            with_level_header_byte(&history, 1, at, 0)
+        },
     );
     s.invalid(
         "every-vertex-deficit-p-value",

@@ -3,7 +3,9 @@
 
 use splitstream_decoder_core::handmade;
 use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, write_stream};
-use splitstream_decoder_core::{DeficitContexts, Header, PlanePolicy, PositionMode, WingPolicy};
+use splitstream_decoder_core::{
+    DeficitContexts, Header, PlanePolicy, PositionMode, Schedule, WingPolicy,
+};
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::EncodeOptions;
 use splitstream_encoder::quantize::Lattice;
@@ -331,7 +333,10 @@ pub(super) fn valid_vectors(s: &mut Specs, real_data: &Path) -> Result<(), Strin
     // Both deficit contexts (SPEC §5.1, §5.5.5; valence is 3.3), forced for
     // every level, in both position modes, with the rANS codec (the
     // contexts, and the number of tables, only matter to it).
-    for contexts in DeficitContexts::ALL {
+    let split_valences = DeficitContexts::ALL
+        .into_iter()
+        .filter(|c| c.allowed_under(Schedule::SplitValences));
+    for contexts in split_valences {
         let choice = Forced {
             id: "deficits",
             field: "deficit contexts",
@@ -520,7 +525,7 @@ fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh, shapes: &Shapes) {
     let tag = "schedule-every-vertex";
     s.valid(
         "every-vertex-bunny-npm",
-        "The npm `bunny` package's Stanford bunny with the encoder's defaults: constrained positions, rANS, the schedule every-vertex (a flag for every vertex in contexts by its valence, no split valences; format 3.6).",
+        "The npm `bunny` package's Stanford bunny with the encoder's defaults: constrained positions, rANS, the schedule every-vertex (a flag for every vertex in contexts by its valence, and from format 3.10 by whether it has split in the level; no split valences; format 3.6).",
         &["encoded", "real-mesh", tag],
         encoded(bunny, EncodeOptions::default()),
     );
@@ -591,6 +596,33 @@ fn every_vertex_vectors(s: &mut Specs, bunny: &Mesh, shapes: &Shapes) {
             }),
         ),
     );
+    // Both flag contexts (SPEC §5.1, §5.5.5; split-history is 3.10),
+    // forced in every level, in both position modes: the flags by valence,
+    // or by valence and the split-history bit (SPEC §6.1).
+    for (contexts, name) in [
+        (DeficitContexts::Plain, "valence"),
+        (DeficitContexts::SplitHistory, "split-history"),
+    ] {
+        let choice = Forced {
+            id: "every-vertex-flags",
+            field: "the flag contexts",
+            name,
+            byte: contexts.to_byte(),
+            feature: "flag-contexts",
+        };
+        forced_in_every_level(
+            s,
+            &[(sphere3, "icosphere"), (small_holed, "grid-hole")],
+            choice,
+            |mode| {
+                every_vertex(EncodeOptions {
+                    position_mode: mode,
+                    deficits: Some(contexts),
+                    ..opts()
+                })
+            },
+        );
+    }
     // Every wing policy under every-vertex, where every ring entry may be
     // a wing (SPEC §7.4): the ranks count the whole ring.
     for policy in WingPolicy::ALL {

@@ -674,11 +674,21 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         let level_start_v = state.vertex_count();
         let plane = PlanePolicy::ALL[choices.below(PlanePolicy::ALL.len())];
         let wings = WingPolicy::ALL[choices.below(WingPolicy::ALL.len())];
-        let mut deficits = DeficitContexts::ALL[choices.below(DeficitContexts::ALL.len())];
+        // `plain` or `valence` (the two choices of `split-valences`: the
+        // corpora's bytes keep their meaning).
+        let mut deficits = DeficitContexts::ALL[choices.below(2)];
         if schedule == Schedule::EveryVertex {
-            // No split valences: the level header says `plain` (SPEC §5.1).
-            deficits = DeficitContexts::Plain;
+            // No split valences: byte 10 names the flags' contexts (SPEC
+            // §5.1), `split-history` (3.10) on every other level, without a
+            // choice of its own.
+            deficits = if (levels.len() + base_index).is_multiple_of(2) {
+                DeficitContexts::SplitHistory
+            } else {
+                DeficitContexts::Plain
+            };
         }
+        // SPEC §6.1 (3.10): the split-history bits start the level at 0.
+        state.start_level(u32::MAX);
         // Positions first (3.7) on every other constrained level under
         // `height` (no choice of its own, so that existing corpora keep
         // their meaning); its escapes use the level's wing policy.
@@ -738,7 +748,8 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
                         flagged.push(v);
                     }
                     let byte = state.deficits()[v as usize];
-                    flags.push((f, context::flag(schedule, byte)));
+                    let split = state.split_in_level(v);
+                    flags.push((f, context::flag(schedule, deficits, byte, split)));
                 }
                 (flags, flagged, first_eligible)
             };

@@ -31,7 +31,10 @@ fn options(choices: &mut Choices<'_>, input: Schedule, mode: PositionMode) -> Tr
     let pick = |b: u8, n: usize| (b as usize % (n + 1)).checked_sub(1);
     let plane = pick(choices.byte(), PlanePolicy::ALL.len()).map(|i| PlanePolicy::ALL[i]);
     let wings = pick(choices.byte(), WingPolicy::ALL.len()).map(|i| WingPolicy::ALL[i]);
-    let deficits = pick(choices.byte(), DeficitContexts::ALL.len()).map(|i| DeficitContexts::ALL[i]);
+    // `plain` or `valence` forced, or per level (`split-history`, 3.10,
+    // comes with the default under `every-vertex`; two choices keep the
+    // corpora's bytes meaning what they did).
+    let deficits = pick(choices.byte(), 2).map(|i| DeficitContexts::ALL[i]);
     let schedule = match (choices.byte() & 1, input) {
         (0, s) => s,
         (_, Schedule::SplitValences) => Schedule::EveryVertex,

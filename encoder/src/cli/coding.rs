@@ -6,7 +6,9 @@ use splitstream_decoder_core::{
     DeficitContexts, PlanePolicy, RecordOrder, Schedule, Ties, WingPolicy,
 };
 
-use super::{CliResult, Codec, DeficitsArg, PlaneArg, RecordsArg, ScheduleArg, TiesArg, WingsArg};
+use super::{
+    CliResult, Codec, DeficitsArg, FlagsArg, PlaneArg, RecordsArg, ScheduleArg, TiesArg, WingsArg,
+};
 use splitstream_encoder::emit::{TranscodeOptions, check_coding, lanes_for};
 
 /// `--tables`: how rANS chunks code their contexts (SPEC §5.5.2).
@@ -61,6 +63,13 @@ pub struct CodingArgs {
     /// 3.3) (SPEC §5.5.5); `auto` picks the cheaper per level.
     #[arg(long, value_enum, default_value_t = DeficitsArg::Auto)]
     pub deficits: DeficitsArg,
+    /// Which contexts code each level's flags under the schedule
+    /// `every-vertex`: `valence`, by the vertex's valence (format 3.6), or
+    /// `split-history`, also by whether the vertex has split in the level
+    /// (format 3.10) (SPEC §5.5.5); `auto` takes `split-history`, and on a
+    /// level of fewer than 65,536 splits the smaller of the two.
+    #[arg(long, value_enum, default_value_t = FlagsArg::Auto)]
+    pub flags: FlagsArg,
     /// How each level reads its split records: `wings-first` (every 3.x
     /// decoder, the fastest to decode), or `positions-first`, the new
     /// vertex as a rank among its fan's free lattice points, then the
@@ -80,7 +89,7 @@ pub struct CodingArgs {
     /// `every-vertex`, a flag for every vertex (format 3.6, smaller), or
     /// `split-valences`, the paper's split valences (read by every 3.x
     /// decoder) (SPEC §3.2, §7.3). `--deficits` applies to
-    /// `split-valences` only.
+    /// `split-valences` only, `--flags` to `every-vertex` only.
     #[arg(long, value_enum, default_value_t = ScheduleArg::EveryVertex)]
     pub schedule: ScheduleArg,
 }
@@ -130,8 +139,13 @@ impl CodingArgs {
         self.wings.policy()
     }
 
+    /// Level header byte 10 (SPEC §5.1): the deficit contexts under
+    /// `split-valences`, the flags' under `every-vertex`.
     pub fn deficits(&self) -> Option<DeficitContexts> {
-        self.deficits.contexts()
+        match self.schedule() {
+            Schedule::SplitValences => self.deficits.contexts(),
+            Schedule::EveryVertex => self.flags.contexts(),
+        }
     }
 
     pub fn records(&self) -> Option<RecordOrder> {

@@ -8,7 +8,7 @@ use splitstream_decoder_core::limits::substream::{self, NAMES};
 use splitstream_decoder_core::table_kinds;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{
-    Header, LevelHeader, LevelTable, PositionMode, Schedule, layout_for,
+    DeficitContexts, Header, LevelHeader, LevelTable, PositionMode, Schedule, layout_for,
 };
 use splitstream_encoder::emit::{TranscodeOptions, transcode};
 
@@ -243,11 +243,13 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
                 .get(e.offset as usize..(e.offset + e.length as u64) as usize)
                 .and_then(|b| LevelHeader::parse(b, k == 0, header.level_rules()).ok())
                 .map_or(("?", "?", "?", "?"), |lh| {
-                    // Under `every-vertex` no split valences are coded
-                    // (SPEC §3.2): no deficit contexts to name.
-                    let deficits = match header.schedule {
-                        Schedule::SplitValences => lh.deficit_contexts.name(),
-                        Schedule::EveryVertex => "-",
+                    // Byte 10 (SPEC §5.1): the deficit contexts, or under
+                    // `every-vertex`, which codes no split valences, the
+                    // flags' contexts (`valence`, or 3.10 `split-history`).
+                    let deficits = match (header.schedule, lh.deficit_contexts) {
+                        (Schedule::SplitValences, contexts) => contexts.name(),
+                        (Schedule::EveryVertex, DeficitContexts::SplitHistory) => "split-history",
+                        (Schedule::EveryVertex, _) => "valence",
                     };
                     (
                         lh.plane_policy.name(),
@@ -304,8 +306,9 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
                     "rounds": e.round_count, "geometric_error": e.geometric_error,
                     "plane_policy": policies[k as usize].0,
                     "wing_policy": policies[k as usize].1,
-                    // null where the schedule codes no split valences.
-                    "deficit_contexts": (policies[k as usize].2 != "-").then_some(policies[k as usize].2),
+                    // Byte 10 (SPEC §5.1): one of the two, the other null.
+                    "deficit_contexts": (header.schedule == Schedule::SplitValences).then_some(policies[k as usize].2),
+                    "flag_contexts": (header.schedule == Schedule::EveryVertex).then_some(policies[k as usize].2),
                     "record_order": policies[k as usize].3,
                     "workspace_bytes": memory[k as usize],
                     // null for a level that is not in the file.
@@ -419,12 +422,12 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
         header.max_chunk_len
     );
     println!(
-        "  level    offset     bytes   vertices  triangles rounds  plane     wings    deficits  records                  decoder memory  geometric error"
+        "  level    offset     bytes   vertices  triangles rounds  plane     wings    contexts       records                  decoder memory  geometric error"
     );
     for k in 0..table.len() {
         let e = table.get(k);
         println!(
-            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:<8} {:<23} {:>15}  {:.6}",
+            "  {:>5} {:>9} {:>9} {:>10} {:>10} {:>6}  {:<9} {:<8} {:<14} {:<23} {:>15}  {:.6}",
             k,
             e.offset,
             e.length,

@@ -170,6 +170,31 @@ impl DeficitsArg {
     }
 }
 
+/// Which contexts code each level's flags under the schedule
+/// `every-vertex` (SPEC §5.1, §5.5.5).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
+pub enum FlagsArg {
+    /// `split-history`, or on a small level the smaller of the two.
+    #[default]
+    Auto,
+    /// By the vertex's valence (3.6).
+    Valence,
+    /// By the vertex's valence and whether it has split in the level
+    /// (3.10).
+    SplitHistory,
+}
+
+impl FlagsArg {
+    pub fn contexts(self) -> Option<splitstream_decoder_core::DeficitContexts> {
+        use splitstream_decoder_core::DeficitContexts;
+        match self {
+            FlagsArg::Auto => None,
+            FlagsArg::Valence => Some(DeficitContexts::Plain),
+            FlagsArg::SplitHistory => Some(DeficitContexts::SplitHistory),
+        }
+    }
+}
+
 /// How each level reads its split records (SPEC §5.1, §7.4, format 3.7).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, ValueEnum)]
 pub enum RecordsArg {

@@ -18,13 +18,18 @@ use super::policies::ranking_params;
 pub struct DeficitCoding {
     /// Per choice of [`DeficitContexts::ALL`]: the deficit-p and deficit-c
     /// values, or `None` when the choice is ruled out.
-    coded: [Option<[SubstreamWriter; 2]>; 2],
+    coded: [Option<[SubstreamWriter; 2]>; DeficitContexts::ALL.len()],
 }
 
 impl DeficitCoding {
-    /// Every choice, or only `forced`.
+    /// Every choice of `split-valences` (`split-history` is
+    /// `every-vertex`'s, whose levels code no split valences and force
+    /// their contexts), or only `forced`.
     pub fn new(forced: Option<DeficitContexts>) -> DeficitCoding {
-        let used = |c: DeficitContexts| forced.is_none_or(|f| f == c);
+        let used = |c: DeficitContexts| match forced {
+            Some(f) => f == c,
+            None => c != DeficitContexts::SplitHistory,
+        };
         DeficitCoding {
             coded: DeficitContexts::ALL.map(|c| used(c).then(Default::default)),
         }

@@ -3,6 +3,7 @@
 //! split record is written exactly as that procedure asks for it.
 
 mod deficits;
+mod flags;
 mod geometry;
 mod levels;
 mod policies;
@@ -85,8 +86,12 @@ pub struct EncodeOptions {
     /// The wing policy of every level (SPEC §7.4, format 3.2); `None`: per
     /// level, the one whose wing ranks take fewest bytes.
     pub wings: Option<WingPolicy>,
-    /// The deficit contexts of every level (SPEC §5.5.5, format 3.3);
-    /// `None`: per level, the ones whose split valences take fewest bytes.
+    /// Level header byte 10 of every level (SPEC §5.1, §5.5.5): under
+    /// `split-valences` the deficit contexts (format 3.3), `None`: per
+    /// level, the ones whose split valences take fewest bytes; under
+    /// `every-vertex` the flags' contexts, `Plain` by valence (3.6) or
+    /// `SplitHistory` (3.10), `None`: `split-history`, and on a level of
+    /// fewer than 65,536 splits the smaller of the two.
     pub deficits: Option<DeficitContexts>,
     /// How every level reads its records (SPEC §5.1, §7.4, format 3.7);
     /// `None`: per level, positions first where it is allowed (constrained

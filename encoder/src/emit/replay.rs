@@ -11,7 +11,6 @@ use splitstream_decoder_core::writer::{
 use splitstream_decoder_core::{
     CornerRefs, DeficitContexts, Error, MeshState, PlanePolicy, PositionMode, RecordOrder,
     RecordSource, Ring, Schedule, SplitOutcome, SplitRecord, StateMemory, Ties, WingPolicy,
-    context,
 };
 
 use std::sync::mpsc;
@@ -19,6 +18,7 @@ use std::sync::mpsc;
 use rayon::prelude::*;
 
 use super::deficits::DeficitCoding;
+use super::flags::FlagCoding;
 use super::geometry::{
     GeometryBatch, GeometrySender, LevelGeometry, SplitGeometry, code_geometry, geometry_channels,
 };
@@ -67,7 +67,10 @@ pub struct ReplayOptions {
     pub plane: Option<PlanePolicy>,
     /// The wing policy of every level; by default each level's cheapest.
     pub wings: Option<WingPolicy>,
-    /// The deficit contexts of every level; by default each level's cheapest.
+    /// The contexts of every level (SPEC §5.1, level header byte 10): under
+    /// `split-valences` the deficit contexts, by default each level's
+    /// cheapest; under `every-vertex` the flag contexts, `Plain` (by
+    /// valence, 3.6) or by default `SplitHistory` (3.10).
     pub deficits: Option<DeficitContexts>,
     /// The record order of every level (format 3.7); by default each
     /// level's cheaper where `positions-first` is allowed
@@ -139,13 +142,14 @@ struct StepSource<'a> {
     /// another there, overlap their cache misses instead of each waiting
     /// inside its record.
     wings: &'a [[u32; 2]],
+    /// The level's flags, in the contexts of each choice still open.
+    flags: &'a mut FlagCoding,
     /// For each decoder id, the index of its vertex's collapse in this step
     /// (or NONE): the decoder asks by its own ids, one look-up instead of
     /// two through `dec2enc` for every candidate.
     current: &'a mut [u32],
     enc2dec: &'a mut [u32],
     dec2enc: &'a mut Vec<u32>,
-    subs: &'a mut [SubstreamWriter],
     /// The level's split-valence symbols in every choice of contexts.
     deficit_coding: &'a mut DeficitCoding,
     /// What the records take from the state for their wing ranks,
@@ -174,8 +178,7 @@ impl RecordSource for StepSource<'_> {
     fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
         let flagged = self.current[v as usize] != NONE;
         let byte = state.deficits().get(v as usize).copied().unwrap_or(0);
-        let context = context::flag(state.schedule(), byte);
-        self.subs[slot(substream::FLAGS)].bit_in(context, flagged);
+        self.flags.write(byte, state.split_in_level(v), flagged);
         Ok(flagged)
     }
 
@@ -348,6 +351,15 @@ pub fn replay(
     let try_positions_first = records != Some(RecordOrder::WingsFirst)
         && positions_first_allowed(params.position_mode, plane, wing_policy);
     let mode = params.position_mode;
+    // Byte 10 of every level header (SPEC §5.1): `split-history` names the
+    // flags' contexts of `every-vertex` (3.10), not deficit contexts.
+    if params.schedule == Schedule::SplitValences
+        && deficit_contexts == Some(DeficitContexts::SplitHistory)
+    {
+        return Err(ReplayError(
+            "the contexts split-history apply to the schedule every-vertex only".into(),
+        ));
+    }
     let n = mesh.positions.len();
     let t_total = mesh.triangles.len();
     // Base mesh: survivors in ascending id.
@@ -416,6 +428,9 @@ pub fn replay(
         let mut choosing = Vec::with_capacity(plan.rounds.len());
         let mut input_sorted = None;
         for (l, steps) in plan.rounds.iter().enumerate() {
+            // SPEC §6.1 (3.10): the split-history bits start each level at
+            // 0. (The replay's own rounds are its triangle count's check.)
+            state.start_level(u32::MAX);
             if l + 1 == plan.rounds.len() {
                 // The input's side of the exactness check needs nothing
                 // from the replay: it is sorted beside the last level,
@@ -435,6 +450,7 @@ pub fn replay(
             // they on to a thread that codes them under every plane policy.
             let (batches, coded_batches) = mpsc::channel();
             let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
+            let mut flag_coding = FlagCoding::new(params.schedule, deficit_contexts, splits);
             let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
             let (geometry_batches, geometry_in) = geometry_channels();
             let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
@@ -478,10 +494,10 @@ pub fn replay(
                 let mut source = StepSource {
                     collapses,
                     wings: &wings,
+                    flags: &mut flag_coding,
                     current: &mut current,
                     enc2dec: &mut enc2dec,
                     dec2enc: &mut dec2enc,
-                    subs: &mut subs,
                     deficit_coding: &mut deficit_coding,
                     geometry: &mut geometry,
                     geometry_out: &geometry_batches,
@@ -529,6 +545,13 @@ pub fn replay(
                     .map_err(|why| level_error(why.to_string()))?;
                 let wings = wing_coding.choose(&mut subs, params);
                 let deficits = deficit_coding.choose(&mut subs, params);
+                let flag_contexts = flag_coding.choose(&mut subs, params);
+                // Byte 10: the deficit contexts, or under `every-vertex`
+                // (which codes no split valences) the flags' (SPEC §5.1).
+                let deficits = match params.schedule {
+                    Schedule::SplitValences => deficits,
+                    Schedule::EveryVertex => flag_contexts,
+                };
                 let (plane, wings, records, ties) =
                     choose_record_order(&mut subs, positions_first, params, records, forced_ties)
                         .unwrap_or((plane, wings, RecordOrder::WingsFirst, Ties::Ring));
@@ -707,7 +730,7 @@ mod tests {
         for (i, d) in [1usize, 2, 6].into_iter().enumerate() {
             current[d] = i as u32;
         }
-        let mut subs = vec![SubstreamWriter::default(); 7];
+        let mut flags = FlagCoding::new(Schedule::SplitValences, None, 0);
         let mut deficit_coding = DeficitCoding::new(None);
         let mut geometry = GeometryBatch::default();
         let (geometry_out, _geometry_in) = geometry_channels();
@@ -717,7 +740,7 @@ mod tests {
             current: &mut current,
             enc2dec: &mut enc2dec,
             dec2enc: &mut dec2enc,
-            subs: &mut subs,
+            flags: &mut flags,
             deficit_coding: &mut deficit_coding,
             geometry: &mut geometry,
             geometry_out: &geometry_out,

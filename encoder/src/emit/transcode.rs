@@ -44,7 +44,9 @@ pub struct TranscodeOptions {
     pub plane: Option<PlanePolicy>,
     /// The wing policy of every level; `None`: chosen per level by size.
     pub wings: Option<WingPolicy>,
-    /// The deficit contexts of every level; `None`: chosen per level by size.
+    /// Level header byte 10 of every level (as [`super::EncodeOptions`]'s
+    /// `deficits`): the deficit contexts, or under `every-vertex` the flags'
+    /// contexts; `None`: chosen per level.
     pub deficits: Option<DeficitContexts>,
     /// The record order of every level (format 3.7); `None`: chosen per
     /// level by size where positions first is allowed.

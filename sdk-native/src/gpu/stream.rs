@@ -156,7 +156,7 @@ fn capture_into(
         // SPEC §5.1: the level header against the table entry.
         let is_base = k == 0;
         let level_header = table.level_header(k, bytes, header.level_rules())?;
-        state.set_triangle_limit(info.triangle_count);
+        state.start_level(info.triangle_count);
         if is_base {
             let slots = buffers.each_mut().map(|b| &mut **b);
             let mut seed = Substreams::open(
