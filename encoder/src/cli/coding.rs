@@ -67,7 +67,7 @@ pub struct CodingArgs {
     /// `every-vertex`: `valence`, by the vertex's valence (format 3.6), or
     /// `split-history`, also by whether the vertex has split in the level
     /// (format 3.10) (SPEC §5.5.5); `auto` takes `split-history`, and on a
-    /// level of fewer than 65,536 splits the smaller of the two.
+    /// level of at most 65,536 flags the smaller of the two.
     #[arg(long, value_enum, default_value_t = FlagsArg::Auto)]
     pub flags: FlagsArg,
     /// How each level reads its split records: `wings-first` (every 3.x

@@ -5,21 +5,32 @@
 //! every flag in the contexts of each choice still open, and the level
 //! keeps the one whose flags code smaller.
 //!
-//! Only levels of fewer than [`EARLY_CHOICE_SPLITS`] splits weigh both:
-//! three more tables can outweigh what the split-history bit saves on a
-//! small level (the npm bunny's stream was 3 bytes larger with it), while on
-//! every large level measured it saved 2 to 3 % of the flags
-//! (encoder/BENCHMARKS.md), and pricing a large level's flags twice would
-//! sit on the emission's critical path for its last level. A small level
-//! is priced as it is written (adaptive tables included), not under the
-//! ranking's static tables: the three tables are the difference there.
+//! A level writes its first [`PRICED_FLAGS`] flags both ways. A level with
+//! no more keeps the choice whose flags code smaller; a larger one takes
+//! `split-history` from there on, unpriced. Three more tables can outweigh
+//! what the split-history bit saves on a small level (the npm bunny keeps
+//! `valence` on four of its five levels), while every level of the scanned
+//! meshes, the DEM and the 1M terrain takes `split-history` when priced
+//! (2 to 3 % of the flags, encoder/BENCHMARKS.md). Pricing whole levels
+//! made the 1M terrain's emission about 6 % slower (its level 0 has 68
+//! rounds of flags for up to 63,058 vertices, coded twice more). Choosing
+//! on a large level's first flags instead made its stream 0.4 % larger:
+//! they are its first round's, where no vertex has split yet and the bit
+//! tells nothing. A regular grid's finest level can do better without the
+//! bit (the 160 × 160 grid vector's level 4 would be 95 bytes smaller under
+//! `valence`); that is the price of not pricing. The flags are priced as
+//! they are written (adaptive tables included), not under the ranking's
+//! static tables: the tables are the difference on a small level.
 
 use splitstream_decoder_core::context;
 use splitstream_decoder_core::limits::substream;
 use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter, coded_len_in};
 use splitstream_decoder_core::{DeficitContexts, Schedule};
 
-use super::policies::EARLY_CHOICE_SPLITS;
+/// How many of a level's flags are written in both contexts before a
+/// larger level settles on `split-history` (see the module
+/// documentation).
+pub const PRICED_FLAGS: usize = 65_536;
 
 /// The choices, in the order of their bytes (ties go to the first, which
 /// 3.9 decoders read).
@@ -29,30 +40,36 @@ const CHOICES: [DeficitContexts; 2] = [DeficitContexts::Plain, DeficitContexts::
 #[derive(Clone)]
 pub struct FlagCoding {
     schedule: Schedule,
+    /// What the flags are priced under.
+    params: StreamParams,
     /// Per choice of [`CHOICES`]: the flags, or `None` when ruled out.
     coded: [Option<SubstreamWriter>; 2],
+    /// Flags written so far.
+    written: usize,
 }
 
 impl FlagCoding {
-    /// The flags of a level of `splits` splits in a stream of schedule
-    /// `schedule`: under `split-valences` one context (SPEC §5.5.5); under
-    /// `every-vertex` the contexts `forced` (`valence` for `Plain` or
-    /// `Valence`), or by default `split-history`, weighed against
-    /// `valence` on a small level.
-    pub fn new(schedule: Schedule, forced: Option<DeficitContexts>, splits: usize) -> FlagCoding {
+    /// The flags of a level in a stream of schedule `schedule`: under
+    /// `split-valences` one context (SPEC §5.5.5); under `every-vertex` the
+    /// contexts `forced` (`valence` for `Plain` or `Valence`), or by
+    /// default `split-history`, weighed against `valence` on a level of at
+    /// most [`PRICED_FLAGS`] flags. `params` are the stream's: the flags
+    /// are priced as they will be written.
+    pub fn new(params: &StreamParams, forced: Option<DeficitContexts>) -> FlagCoding {
+        let schedule = params.schedule;
         let open = |c: DeficitContexts| match (schedule, forced) {
             (Schedule::SplitValences, _) => c == DeficitContexts::Plain,
             (Schedule::EveryVertex, Some(DeficitContexts::SplitHistory)) => {
                 c == DeficitContexts::SplitHistory
             }
             (Schedule::EveryVertex, Some(_)) => c == DeficitContexts::Plain,
-            (Schedule::EveryVertex, None) => {
-                c == DeficitContexts::SplitHistory || splits < EARLY_CHOICE_SPLITS
-            }
+            (Schedule::EveryVertex, None) => true,
         };
         FlagCoding {
             schedule,
+            params: *params,
             coded: CHOICES.map(|c| open(c).then(SubstreamWriter::default)),
+            written: 0,
         }
     }
 
@@ -65,28 +82,44 @@ impl FlagCoding {
                 sub.bit_in(context::flag(self.schedule, contexts, byte, split), flagged);
             }
         }
+        self.written += 1;
+        if self.written == PRICED_FLAGS && self.coded.iter().all(Option::is_some) {
+            // A large level: `split-history`, unpriced.
+            self.coded[0] = None;
+        }
+    }
+
+    /// The choice still open whose flags so far code smaller (`valence`
+    /// on a tie, which 3.9 decoders read).
+    fn cheaper(&self) -> DeficitContexts {
+        let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
+        CHOICES
+            .into_iter()
+            .zip(&self.coded)
+            .filter_map(|(c, sub)| Some((c, sub.as_ref()?)))
+            .min_by_key(|&(c, sub)| {
+                let cost = if single {
+                    0
+                } else {
+                    coded_len_in(sub, substream::FLAGS, c, &self.params)
+                };
+                (cost, c.to_byte())
+            })
+            .expect("at least one choice of flag contexts")
+            .0
     }
 
     /// Puts the cheaper choice's flags into `subs` (ids 1..=7 at 0..=6)
     /// and returns its contexts byte's meaning: `Plain` is `valence` under
     /// `every-vertex`.
-    pub fn choose(self, subs: &mut [SubstreamWriter], params: &StreamParams) -> DeficitContexts {
-        let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
-        let cost = |sub: &SubstreamWriter, c: DeficitContexts| {
-            if single {
-                0
-            } else {
-                coded_len_in(sub, substream::FLAGS, c, params)
-            }
-        };
-        let (contexts, flags) = CHOICES
-            .into_iter()
-            .zip(self.coded)
-            .filter_map(|(c, sub)| sub.map(|s| (c, s)))
-            .min_by_key(|(c, sub)| (cost(sub, *c), c.to_byte()))
-            .expect("at least one choice of flag contexts");
+    pub fn choose(mut self, subs: &mut [SubstreamWriter]) -> DeficitContexts {
+        let contexts = self.cheaper();
+        let at = CHOICES
+            .iter()
+            .position(|&c| c == contexts)
+            .expect("a choice");
         // Substream ids start at FLAGS: its slot is the first.
-        subs[0] = flags;
+        subs[0] = self.coded[at].take().expect("the cheaper choice is open");
         contexts
     }
 }
@@ -95,56 +128,71 @@ impl FlagCoding {
 mod tests {
     use super::*;
 
+    fn every_vertex() -> StreamParams {
+        StreamParams {
+            schedule: Schedule::EveryVertex,
+            ..StreamParams::default()
+        }
+    }
+
+    /// `n` pseudo-random flags (a periodic pattern would deflate to
+    /// nothing, and the rANS codec keeps deflate where smaller): a third
+    /// of the vertices have split, and `split_again` is the chance (of 32)
+    /// that such a vertex splits again; the others split half the time.
+    fn write_flags(coding: &mut FlagCoding, n: usize, split_again: u64) {
+        let mut x = 0x9e37_79b9u64;
+        for _ in 0..n {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let (split, draw) = ((x >> 40).is_multiple_of(3), (x >> 20) % 32);
+            let flagged = if split { draw < split_again } else { draw < 16 };
+            coding.write(6, split, flagged);
+        }
+    }
+
     /// Flags that follow the split-history bit make `split-history` the
     /// cheaper choice once there are enough of them; a handful keep
     /// `valence`, whose five tables cost less than eight.
     #[test]
     fn the_choice_follows_the_cost() {
-        let params = StreamParams {
-            schedule: Schedule::EveryVertex,
-            ..StreamParams::default()
-        };
         let pick = |n: usize| {
-            let mut coding = FlagCoding::new(Schedule::EveryVertex, None, n / 4);
-            // Pseudo-random flags (a periodic pattern would deflate to
-            // nothing, and the rANS codec keeps deflate where smaller).
-            let mut x = 0x9e37_79b9u64;
-            for _ in 0..n {
-                x = x
-                    .wrapping_mul(6364136223846793005)
-                    .wrapping_add(1442695040888963407);
-                let (split, draw) = ((x >> 40).is_multiple_of(3), (x >> 20) % 32);
-                // Split vertices rarely split again, the others half the time.
-                let flagged = if split { draw == 0 } else { draw < 16 };
-                coding.write(6, split, flagged);
-            }
+            let mut coding = FlagCoding::new(&every_vertex(), None);
+            write_flags(&mut coding, n, 1);
             let mut subs = vec![SubstreamWriter::default(); 7];
-            coding.choose(&mut subs, &params)
+            coding.choose(&mut subs)
         };
         assert_eq!(pick(6), DeficitContexts::Plain);
         assert_eq!(pick(6000), DeficitContexts::SplitHistory);
     }
 
-    /// A large level takes `split-history` without weighing; forcing and
-    /// the schedule `split-valences` leave one choice.
+    /// A level settles on `split-history` after its first
+    /// [`PRICED_FLAGS`] flags, unpriced, even where the bit tells nothing
+    /// (split vertices flagged as often as the others); forcing and the
+    /// schedule `split-valences` leave one choice.
     #[test]
-    fn large_levels_and_forced_choices_write_one_substream() {
+    fn large_levels_settle_and_forced_choices_write_one_substream() {
         let open =
             |coding: &FlagCoding| coding.coded.iter().map(Option::is_some).collect::<Vec<_>>();
-        let every = Schedule::EveryVertex;
-        assert_eq!(
-            open(&FlagCoding::new(every, None, EARLY_CHOICE_SPLITS)),
-            [false, true]
-        );
-        assert_eq!(open(&FlagCoding::new(every, None, 10)), [true, true]);
+        let mut large = FlagCoding::new(&every_vertex(), None);
+        write_flags(&mut large, PRICED_FLAGS - 1, 1);
+        assert_eq!(open(&large), [true, true]);
+        write_flags(&mut large, 1, 1);
+        assert_eq!(open(&large), [false, true]);
+        let mut blind = FlagCoding::new(&every_vertex(), None);
+        write_flags(&mut blind, PRICED_FLAGS, 16);
+        assert_eq!(open(&blind), [false, true]);
         let valence = Some(DeficitContexts::Valence);
-        assert_eq!(open(&FlagCoding::new(every, valence, 10)), [true, false]);
-        let history = Some(DeficitContexts::SplitHistory);
-        assert_eq!(open(&FlagCoding::new(every, history, 10)), [false, true]);
-        let split_valences = Schedule::SplitValences;
         assert_eq!(
-            open(&FlagCoding::new(split_valences, None, 10)),
+            open(&FlagCoding::new(&every_vertex(), valence)),
             [true, false]
         );
+        let history = Some(DeficitContexts::SplitHistory);
+        assert_eq!(
+            open(&FlagCoding::new(&every_vertex(), history)),
+            [false, true]
+        );
+        let split_valences = StreamParams::default();
+        assert_eq!(open(&FlagCoding::new(&split_valences, None)), [true, false]);
     }
 }

@@ -91,7 +91,7 @@ pub struct EncodeOptions {
     /// level, the ones whose split valences take fewest bytes; under
     /// `every-vertex` the flags' contexts, `Plain` by valence (3.6) or
     /// `SplitHistory` (3.10), `None`: `split-history`, and on a level of
-    /// fewer than 65,536 splits the smaller of the two.
+    /// at most 65,536 flags the smaller of the two.
     pub deficits: Option<DeficitContexts>,
     /// How every level reads its records (SPEC §5.1, §7.4, format 3.7);
     /// `None`: per level, positions first where it is allowed (constrained

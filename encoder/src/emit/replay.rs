@@ -450,7 +450,7 @@ pub fn replay(
             // they on to a thread that codes them under every plane policy.
             let (batches, coded_batches) = mpsc::channel();
             let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
-            let mut flag_coding = FlagCoding::new(params.schedule, deficit_contexts, splits);
+            let mut flag_coding = FlagCoding::new(params, deficit_contexts);
             let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
             let (geometry_batches, geometry_in) = geometry_channels();
             let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
@@ -545,7 +545,7 @@ pub fn replay(
                     .map_err(|why| level_error(why.to_string()))?;
                 let wings = wing_coding.choose(&mut subs, params);
                 let deficits = deficit_coding.choose(&mut subs, params);
-                let flag_contexts = flag_coding.choose(&mut subs, params);
+                let flag_contexts = flag_coding.choose(&mut subs);
                 // Byte 10: the deficit contexts, or under `every-vertex`
                 // (which codes no split valences) the flags' (SPEC §5.1).
                 let deficits = match params.schedule {
@@ -730,7 +730,11 @@ mod tests {
         for (i, d) in [1usize, 2, 6].into_iter().enumerate() {
             current[d] = i as u32;
         }
-        let mut flags = FlagCoding::new(Schedule::SplitValences, None, 0);
+        let split_valences = StreamParams {
+            schedule: Schedule::SplitValences,
+            ..StreamParams::default()
+        };
+        let mut flags = FlagCoding::new(&split_valences, None);
         let mut deficit_coding = DeficitCoding::new(None);
         let mut geometry = GeometryBatch::default();
         let (geometry_out, _geometry_in) = geometry_channels();
