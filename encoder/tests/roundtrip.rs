@@ -276,6 +276,26 @@ fn both_flag_contexts_roundtrip_and_set_the_minor_version() {
     }
 }
 
+/// `split-history` names flag contexts, which only `every-vertex` codes:
+/// asked for under `split-valences` it is refused with a message, not
+/// written as a byte 10 no decoder accepts (SPEC §5.1).
+#[test]
+fn split_history_under_split_valences_is_refused() {
+    let options = EncodeOptions {
+        deficits: Some(DeficitContexts::SplitHistory),
+        schedule: Schedule::SplitValences,
+        ..EncodeOptions::default()
+    };
+    let err = match encode(&common::icosphere(2), &options, |_| {}) {
+        Ok(_) => panic!("split-history under split-valences was encoded"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        err.contains("split-history") && err.contains("every-vertex"),
+        "{err}"
+    );
+}
+
 /// By default a small level keeps whichever flag contexts code smaller:
 /// never larger than `valence` (a few bytes of slack), and a large enough
 /// refinement takes `split-history` somewhere.
