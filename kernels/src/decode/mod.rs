@@ -19,6 +19,7 @@
 //! the sources, layouts and the host-side adjacency builder are compiled.
 
 pub mod adjacency;
+pub mod device_state;
 pub mod host;
 pub mod layout;
 #[cfg(feature = "opencl")]
