@@ -18,11 +18,20 @@ use crate::split::{SplitOutcome, SplitRecord};
 use crate::state::MeshState;
 use crate::substream::Substreams;
 
-/// Sees every split record as the decoder reads it (SPEC §7.4), with the
-/// state it is read against: for tools that study a stream (the
-/// `split_fields` example) or mirror its splits, through
-/// [`LevelDecoder::next_round_observed`]. Nothing it does changes decoding.
+/// Sees every flag and split record as the decoder reads them (SPEC §7.3,
+/// §7.4), with the state they are read against: for tools that study a
+/// stream (the `split_fields` example) or mirror its rounds (sdk-native's
+/// GPU capture), through [`LevelDecoder::next_round_observed`]. Nothing it
+/// does changes decoding.
 pub trait SplitObserver {
+    /// The flag of `v`, read from the stream (not inferred: a vertex whose
+    /// flag the format infers is not shown, §7.2). `state` is as the flag
+    /// saw it.
+    #[inline(always)]
+    fn flag(&mut self, state: &MeshState<'_>, v: u32, flag: bool) {
+        let _ = (state, v, flag);
+    }
+
     /// The record of the split of `r`, whose canonical ring is `ring`, read
     /// and not applied yet: `state` is as the record saw it.
     fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring, record: &SplitRecord);
@@ -43,7 +52,9 @@ struct Observed<'o, S, O> {
 impl<S: RecordSource, O: SplitObserver> RecordSource for Observed<'_, S, O> {
     #[inline(always)]
     fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
-        self.source.flag(state, v)
+        let flag = self.source.flag(state, v)?;
+        self.observer.flag(state, v, flag);
+        Ok(flag)
     }
 
     #[inline(always)]

@@ -88,3 +88,65 @@ fn the_candidates_are_the_scheduled_vertices_before_every_round() {
         assert!(rounds > 0, "{}", g.base);
     }
 }
+
+/// Records the flags it is shown, and the splits.
+#[derive(Default)]
+struct Flags {
+    /// (vertex, flag, vertex count when read) of the current round.
+    round: Vec<(u32, bool, u32)>,
+    splits: Vec<u32>,
+}
+
+impl SplitObserver for Flags {
+    fn flag(&mut self, state: &MeshState<'_>, v: u32, flag: bool) {
+        self.round.push((v, flag, state.vertex_count()));
+    }
+
+    fn record(&mut self, _: &MeshState<'_>, r: u32, _: &Ring, _: &SplitRecord) {
+        self.splits.push(r);
+    }
+}
+
+#[test]
+fn the_observer_sees_each_coded_flag_in_candidate_order() {
+    for g in streams::seed_generated() {
+        let stream = &g.stream;
+        let mut ws = vec![0u8; workspace_len(stream).unwrap()];
+        let mut inflater = Box::new(Inflater::new());
+        let mut d = Decoder::new(stream, &mut ws, &mut inflater).unwrap();
+        let mut seen = Flags::default();
+        while let Some(k) = d.next_level() {
+            let bytes = d.level_bytes(k, stream).unwrap();
+            let mut level = d.begin_level(k, bytes).unwrap();
+            loop {
+                let start = level.state().vertex_count();
+                let candidates: Vec<u32> = scanned(level.state());
+                let Some(info) = level.next_round_observed(&mut seen).unwrap() else {
+                    break;
+                };
+                // Ascending candidates of the round's start, each once; the
+                // flagged ones are the round's splits, in order.
+                let shown: Vec<u32> = seen.round.iter().map(|&(v, _, _)| v).collect();
+                assert!(shown.windows(2).all(|w| w[0] < w[1]), "{}", g.base);
+                assert!(shown.iter().all(|v| candidates.contains(v)), "{}", g.base);
+                let flagged: Vec<u32> = seen
+                    .round
+                    .iter()
+                    .filter(|&&(_, f, _)| f)
+                    .map(|&(v, _, _)| v)
+                    .collect();
+                assert_eq!(flagged, seen.splits, "{}", g.base);
+                assert_eq!(flagged.len(), info.stats.splits as usize, "{}", g.base);
+                // A flag is read before its own split (the state it sees
+                // has the vertices of the splits before it only).
+                for &(v, _, n) in &seen.round {
+                    let before = seen.splits.iter().take_while(|&&r| r < v).count() as u32;
+                    assert_eq!(n, start + before, "{}", g.base);
+                }
+                seen.round.clear();
+                seen.splits.clear();
+            }
+        }
+        assert_eq!(d.state_hash(), *g.hashes.last().unwrap(), "{}", g.base);
+    }
+}

@@ -1,11 +1,8 @@
-//! A [`RecordSource`] that passes a round through unchanged and keeps what
-//! the GPU needs to replay it: the candidate count, one flag bit per
-//! candidate (in ascending candidate order) and the flagged splits' records
-//! with their final positions.
+//! A [`SplitObserver`] that keeps what the GPU needs to replay a round:
+//! the candidate count, one flag bit per candidate (in ascending candidate
+//! order) and the flagged splits' records with their final positions.
 
-use splitstream_decoder_core::{
-    Error, MeshState, RecordSource, Ring, Schedule, SplitOutcome, SplitRecord,
-};
+use splitstream_decoder_core::{MeshState, Ring, Schedule, SplitObserver, SplitRecord};
 use splitstream_kernels::decode::GpuRecord;
 
 /// One round as the stream gave it, in the GPU's terms.
@@ -21,9 +18,10 @@ pub struct CapturedRound {
     pub records: Vec<GpuRecord>,
 }
 
-/// Wraps the source a round reads from (decoder-core's `StreamSource`).
-pub struct Capture<S> {
-    inner: S,
+/// Watches a round's flags and records (decoder-core's
+/// `LevelDecoder::next_round_observed`).
+#[derive(Default)]
+pub struct Capture {
     round: CapturedRound,
     /// The round's candidates, ascending, once the first flag is asked.
     candidates: Vec<u32>,
@@ -34,18 +32,7 @@ pub struct Capture<S> {
     pub out_of_order: bool,
 }
 
-impl<S> Capture<S> {
-    pub fn new(inner: S) -> Capture<S> {
-        Capture {
-            inner,
-            round: CapturedRound::default(),
-            candidates: Vec::new(),
-            cursor: 0,
-            started: false,
-            out_of_order: false,
-        }
-    }
-
+impl Capture {
     /// The round captured since the last call; starts a new one.
     pub fn take_round(&mut self) -> CapturedRound {
         self.started = false;
@@ -95,12 +82,11 @@ pub fn gpu_record(rec: &SplitRecord) -> GpuRecord {
     }
 }
 
-impl<S: RecordSource> RecordSource for Capture<S> {
-    fn flag(&mut self, state: &MeshState<'_>, v: u32) -> Result<bool, Error> {
+impl SplitObserver for Capture {
+    fn flag(&mut self, state: &MeshState<'_>, v: u32, flag: bool) {
         if !self.started {
             self.start(state);
         }
-        let flag = self.inner.flag(state, v)?;
         while self.candidates.get(self.cursor).is_some_and(|&c| c < v) {
             self.cursor += 1;
         }
@@ -109,20 +95,9 @@ impl<S: RecordSource> RecordSource for Capture<S> {
         } else if flag {
             self.round.flags[self.cursor / 32] |= 1 << (self.cursor % 32);
         }
-        Ok(flag)
     }
 
-    fn likely_flags(&mut self, state: &MeshState<'_>, upcoming: &[u32]) -> u128 {
-        self.inner.likely_flags(state, upcoming)
-    }
-
-    fn record(&mut self, state: &MeshState<'_>, r: u32, ring: &Ring) -> Result<SplitRecord, Error> {
-        let rec = self.inner.record(state, r, ring)?;
-        self.round.records.push(gpu_record(&rec));
-        Ok(rec)
-    }
-
-    fn applied(&mut self, r: u32, c: u32, outcome: &SplitOutcome) {
-        self.inner.applied(r, c, outcome);
+    fn record(&mut self, _: &MeshState<'_>, _: u32, _: &Ring, record: &SplitRecord) {
+        self.round.records.push(gpu_record(record));
     }
 }

@@ -3,22 +3,17 @@
 //! applies every round itself; a [`Capture`] keeps each round's flags and
 //! records so that the GPU can replay the same rounds ([`super::replay`]).
 //!
-//! [`capture_stream`] reads on one thread, with the level framing of
-//! decoder-core's `Decoder` (SPEC §10.3 order) rebuilt from its public
-//! pieces so that a [`Capture`] wraps the record source of its rounds.
-//! [`capture_stream_two_threads`] reads with `Decoder` itself, the records
+//! [`capture_stream`] reads on one thread with decoder-core's `Decoder`,
+//! a [`Capture`] observing each round's flags and records.
+//! [`capture_stream_two_threads`] reads with `Decoder` too, the records
 //! on a second thread ([`crate::threaded`]), and sees each round's splits
 //! through a [`RoundTap`]: the same capture, about as much faster as the
 //! two-thread decode (sdk-native/README.md, "On two cores"), which is what
 //! a GPU decode of a large stream waits for.
 
-use splitstream_decoder_core::limits::substream;
 use splitstream_decoder_core::owned::OwnedWorkspace;
-use splitstream_decoder_core::record::{StreamSource, read_base};
-use splitstream_decoder_core::substream::Substreams;
 use splitstream_decoder_core::{
-    Error, Header, Inflater, LevelTable, MeshState, Ring, RoundInfo, Schedule, SplitRecord,
-    declared_layout, layout_for,
+    Error, MeshState, RoundInfo, Schedule, SplitRecord, declared_layout,
 };
 
 use super::capture::{Capture, CapturedRound, gpu_record};
@@ -124,95 +119,39 @@ fn capture_into(
     hash_rounds: bool,
     out: &mut CapturedStream,
 ) -> Result<(), CaptureError> {
-    let header = Header::parse(stream)?;
-    let table = LevelTable::parse(stream, &header)?;
-    let layout = splitstream_decoder_core::declared_layout(&header, &table)?;
+    let mut workspace = OwnedWorkspace::for_stream(stream)?;
+    let mut decoder = workspace.decoder(stream)?;
+    let layout = declared_layout(decoder.header(), decoder.level_table())?;
     out.vertex_capacity = layout.vertex_capacity;
     out.triangle_capacity = layout.triangle_capacity;
-    let full = layout_for(&header, &table, header.level_count - 1);
-    let len = usize::try_from(full.bytes_unaligned()).map_err(|_| Error::CapacityExceeded)?;
-    // The same bound as decoder-core's OwnedWorkspace: no absurd allocation
-    // from a hostile header.
-    let limit = table
-        .stream_len()
-        .saturating_mul(splitstream_decoder_core::owned::MAX_WORKSPACE_PER_STREAM_BYTE)
-        .saturating_add(1 << 20);
-    if len as u64 > limit {
-        return Err(Error::CapacityExceeded.into());
-    }
-    let mut workspace = vec![0u8; len];
-    let (memory, mut buffers) = full.carve(&mut workspace)?;
-    // SPEC §3.2 (3.6): the seed's bytes and the rounds' candidates follow
-    // the schedule, as in decoder-core's `Decoder`.
-    let mut state = MeshState::new(memory, header.bits, header.schedule);
-    let mut inflater = Box::new(Inflater::new());
-    let mut ring = Box::new(Ring::default());
-    for k in 0..header.level_count {
-        let info = table.get(k);
-        let bytes = usize::try_from(info.offset)
-            .ok()
-            .and_then(|s| stream.get(s..s.checked_add(info.length as usize)?))
-            .ok_or(Error::Truncated)?;
-        // SPEC §5.1: the level header against the table entry.
-        let is_base = k == 0;
-        let level_header = table.level_header(k, bytes, header.level_rules())?;
-        state.start_level(info.triangle_count);
-        if is_base {
-            let slots = buffers.each_mut().map(|b| &mut **b);
-            let mut seed = Substreams::open(
-                bytes,
-                level_header,
-                substream::BASE_POSITIONS,
-                slots,
-                &mut inflater,
-                header.lane_count,
-            );
-            let (v, t) = (level_header.seed_vertices, level_header.seed_triangles);
-            read_base(&mut state, &mut seed, v, t)?;
-            out.base = Some(BaseState::of(&state));
+    while let Some(k) = decoder.next_level() {
+        let triangle_limit = decoder.level_table().get(k).triangle_count;
+        let bytes = decoder.level_bytes(k, stream)?;
+        let mut level = decoder.begin_level(k, bytes)?;
+        if k == 0 {
+            // The seed mesh, read by `begin_level` (SPEC §6.3), and its hash
+            // before the rounds (§8).
+            out.base = Some(BaseState::of(level.state()));
             if hash_rounds {
-                out.cpu_hashes.push(state.state_hash());
+                out.cpu_hashes.push(level.state().state_hash());
             }
         }
         out.levels.push(CapturedLevel {
-            triangle_limit: info.triangle_count,
+            triangle_limit,
             rounds: Vec::new(),
         });
-        let slots = buffers.each_mut().map(|b| &mut **b);
-        let mut subs = Substreams::open(
-            bytes,
-            level_header,
-            substream::FLAGS,
-            slots,
-            &mut inflater,
-            header.lane_count,
-        );
-        for r in 0..level_header.round_count {
-            let source = StreamSource::new(&mut subs, header.position_mode);
-            let mut capture = Capture::new(source);
-            state
-                .run_round(level_header.split_count(r), &mut capture, &mut ring)
-                .map_err(|e| match e {
-                    Error::FlagCountMismatch { .. } => Error::FlagCountMismatch { round: r },
-                    other => other,
-                })?;
+        let mut capture = Capture::default();
+        while level.next_round_observed(&mut capture)?.is_some() {
             if capture.out_of_order {
                 return Err(CaptureError::FlagOrder);
             }
             let round = capture.take_round();
-            if let Some(level) = out.levels.last_mut() {
-                level.rounds.push(round);
+            if let Some(captured) = out.levels.last_mut() {
+                captured.rounds.push(round);
             }
             if hash_rounds {
-                out.cpu_hashes.push(state.state_hash());
+                out.cpu_hashes.push(level.state().state_hash());
             }
-        }
-        // SPEC §7.6: end of level.
-        subs.finish()?;
-        if state.vertex_count() != info.vertex_count
-            || state.triangle_count() != info.triangle_count
-        {
-            return Err(Error::LevelCountMismatch.into());
         }
     }
     Ok(())
