@@ -361,6 +361,34 @@ impl<'b> ChunkDecoder<'b> {
         )
     }
 
+    /// [`ChunkDecoder::decode`] for a value read as a bit (a flag, SPEC
+    /// §7.3): the same value, lane and table updates and errors, with a
+    /// shorter path for a context of one or two tokens (one comparison, no
+    /// bucket search, no raw bits). Any other table takes the general
+    /// path, whose value the caller then refuses.
+    #[inline(always)]
+    pub fn decode_bit(&mut self, bytes: &[u8], context: usize) -> Result<u32, Error> {
+        let index = self.lane & (MAX_LANES as usize - 1);
+        let lane = &mut self.lanes[index];
+        self.lane = if self.lane + 1 >= self.lane_count {
+            0
+        } else {
+            self.lane + 1
+        };
+        decode_bit_in(
+            Tables {
+                tokens: &self.tokens,
+                rates: &self.rates,
+                cums: self.cums,
+                buckets: self.buckets,
+            },
+            lane,
+            index,
+            bytes,
+            context,
+        )
+    }
+
     /// The next bits as [`ChunkDecoder::decode`] would give them in
     /// `contexts`, one context per value, without consuming anything: `(bits,
     /// count)`, bit i the i-th next value, `count` at most 128 and at most
@@ -390,7 +418,7 @@ impl<'b> ChunkDecoder<'b> {
             } else {
                 lane + 1
             };
-            match decode_in(tables.reborrow(), l, index, bytes, context as usize) {
+            match decode_bit_in(tables.reborrow(), l, index, bytes, context as usize) {
                 Ok(v @ (0 | 1)) => halves[known as usize / 64] |= (v as u64) << (known % 64),
                 _ => break,
             }
@@ -464,6 +492,54 @@ fn decode_in(
         )?
     };
     raw_bits(token, x, lane, bytes)
+}
+
+/// [`decode_in`] for a value read as a bit: a table of one or two tokens
+/// (§5.5.2) is read with one comparison; tokens 0 and 1 have no raw bits
+/// (§5.5.1). Every other table goes through [`decode_in`].
+#[inline]
+fn decode_bit_in(
+    tables: Tables<'_>,
+    lane: &mut [u32; LANE_WORDS],
+    index: usize,
+    bytes: &[u8],
+    context: usize,
+) -> Result<u32, Error> {
+    let context = context & (MAX_CONTEXTS - 1);
+    let n = tables.tokens[context];
+    if !(1..=2).contains(&n) {
+        return decode_in(tables, lane, index, bytes, context);
+    }
+    let mut x = lane[0];
+    let bit = if tables.rates[context] == 0 {
+        // cum[0] = 0 and cum[n..] = PROB_SCALE: token 1 from cum[1] on
+        // (never with one token).
+        let cum = &tables.cums[context];
+        let slot = x & (PROB_SCALE - 1);
+        let split = cum[1] as u32;
+        let is_one = slot >= split;
+        let mask = 0u32.wrapping_sub(is_one as u32);
+        let start = split & mask;
+        let freq = split ^ ((split ^ (cum[2] as u32 - split)) & mask);
+        x = freq * (x >> PROB_BITS) + slot - start;
+        renormalise(bytes, lane, &mut x)?;
+        is_one
+    } else if n == 1 {
+        // An adaptive table of one token makes no decision.
+        false
+    } else {
+        // One decision, lane `index`'s (`open_adaptive` checked the room).
+        let rate = tables.rates[context];
+        let (Some(q), Some(count)) = (
+            tables.cums[context].get_mut(index),
+            tables.buckets[context].get_mut(index),
+        ) else {
+            return Err(Error::InvalidRansChunk("adaptive table without room"));
+        };
+        decide(q, count, rate, lane, bytes, &mut x)?
+    };
+    lane[0] = x;
+    Ok(bit as u32)
 }
 
 /// The token of a static table (§5.5.4) read from a lane with state `x`.
@@ -801,7 +877,67 @@ mod tests {
         assert!(chunk.exhausted());
     }
 
+    /// Each value read (or the error), with the lanes' words after it.
+    type Steps = Vec<Result<(u32, Vec<u32>), Error>>;
+
+    /// Decodes `contexts` from `payload` value by value with
+    /// [`ChunkDecoder::decode`] and with [`ChunkDecoder::decode_bit`]:
+    /// each value or error, and the lanes after it.
+    fn both_ways(payload: &[u8], contexts: &[u8], n_contexts: usize, lanes: usize) -> [Steps; 2] {
+        core::array::from_fn(|as_bit| {
+            let mut words = vec![0u32; TABLE_WORDS + LANE_WORDS * MAX_LANES as usize];
+            let mut chunk = ChunkDecoder::new(&mut words, lanes).expect("room");
+            let mut out = Vec::new();
+            if let Err(e) = chunk.open(payload, 0, payload.len(), n_contexts, contexts.len() as u32)
+            {
+                out.push(Err(e));
+                return out;
+            }
+            for &ctx in contexts {
+                let value = if as_bit == 1 {
+                    chunk.decode_bit(payload, ctx as usize)
+                } else {
+                    chunk.decode(payload, ctx as usize)
+                };
+                let lanes: Vec<u32> = chunk.lanes[..lanes].iter().flatten().copied().collect();
+                let failed = value.is_err();
+                out.push(value.map(|v| (v, lanes)));
+                if failed {
+                    break;
+                }
+            }
+            out
+        })
+    }
+
     proptest! {
+        /// A value read as a bit takes the same value, lane steps and
+        /// errors as the general read, whatever the tables: skewed bits in
+        /// adaptive and static tables, larger values, and chunks with bytes
+        /// changed.
+        #[test]
+        fn bits_read_as_any_value(
+            bits in proptest::collection::vec((0u8..4, 0u32..8), 1..600),
+            lanes in 1usize..=8,
+            adaptive in any::<bool>(),
+            edits in proptest::collection::vec((any::<prop::sample::Index>(), 1u8..=255), 0..3),
+        ) {
+            // Contexts 0 and 1 hold bits, 2 a bit or a constant, 3 anything.
+            let symbols: Vec<Symbol> = bits
+                .iter()
+                .map(|&(ctx, v)| (ctx, match ctx { 0 | 1 => v & 1, 2 => (v == 0) as u32, _ => v }))
+                .collect();
+            let (mut payload, _) =
+                crate::rans_writer::encode_chunk_with(&symbols, 4, lanes, adaptive);
+            for (at, flip) in &edits {
+                let i = at.index(payload.len());
+                payload[i] ^= flip;
+            }
+            let contexts: Vec<u8> = symbols.iter().map(|s| s.0).collect();
+            let [general, as_bit] = both_ways(&payload, &contexts, 4, lanes);
+            prop_assert_eq!(general, as_bit);
+        }
+
         #[test]
         fn chunks_round_trip(
             values in proptest::collection::vec((0u8..8, any::<u32>(), 0u8..4), 1..400),

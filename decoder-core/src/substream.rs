@@ -228,6 +228,13 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// Next value of the rANS-coded substream in `slot`, in `context` (SPEC §5.5).
     #[inline(always)]
     fn rans_value(&mut self, slot: usize, context: u8) -> Result<u32, Error> {
+        self.rans_value_as(slot, context, false)
+    }
+
+    /// [`Substreams::rans_value`], for a value read as a bit when `bit`
+    /// ([`ChunkDecoder::decode_bit`]: the same value, a shorter path).
+    #[inline(always)]
+    fn rans_value_as(&mut self, slot: usize, context: u8, bit: bool) -> Result<u32, Error> {
         let r = &mut self.readers[slot];
         if r.pos == r.len {
             self.refill(slot)?;
@@ -236,7 +243,11 @@ impl<'l, 'b> Substreams<'l, 'b> {
         let Some(chunk) = r.chunk.as_mut() else {
             return Err(Error::CapacityExceeded);
         };
-        let value = chunk.decode(self.level, context as usize)?;
+        let value = if bit {
+            chunk.decode_bit(self.level, context as usize)?
+        } else {
+            chunk.decode(self.level, context as usize)?
+        };
         r.pos += 1;
         // The chunk's last value: every lane must end exactly here.
         if r.pos == r.len && !chunk.exhausted() {
@@ -269,7 +280,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
             if self.header.schedule == Schedule::EveryVertex {
                 // Each flag has its own context (SPEC §5.5.5, 3.6): no
                 // decoding ahead in one.
-                let v = self.rans_value(slot, context)?;
+                let v = self.rans_value_as(slot, context, true)?;
                 return match v {
                     0 | 1 => Ok(v == 1),
                     _ => Err(Error::ValueOutOfRange(self.readers[slot].id)),
@@ -319,7 +330,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
             && self.readers[slot].ahead_error.is_none()
             && self.readers[slot].pos < self.readers[slot].len
         {
-            let value = match self.rans_value(slot, context) {
+            let value = match self.rans_value_as(slot, context, true) {
                 Ok(0) => 0u64,
                 Ok(1) => 1,
                 Ok(_) => {
