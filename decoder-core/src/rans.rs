@@ -35,6 +35,10 @@ const BUCKETS: usize = 1 << BUCKET_BITS;
 /// `u32` words of one lane: state, cursor, end (offsets in the level).
 pub const LANE_WORDS: usize = 3;
 
+/// Most values one look-ahead decodes ([`ChunkDecoder::look_ahead`]): the
+/// candidates of one batch of fans walked ahead.
+pub const LOOKAHEAD: usize = 128;
+
 // A context's cumulative frequencies (u16) and bucket index (u8) take no
 // more room than the `TOKENS + 2` words per context that SPEC §9 gives a
 // rANS slot.
@@ -391,40 +395,149 @@ impl<'b> ChunkDecoder<'b> {
 
     /// The next bits as [`ChunkDecoder::decode`] would give them in
     /// `contexts`, one context per value, without consuming anything: `(bits,
-    /// count)`, bit i the i-th next value, `count` at most 128 and at most
-    /// `remaining` (the values left in the chunk), and nothing from a value
-    /// that is not a bit or fails. Works on copies of the lanes (and of the
-    /// adaptive tables' probabilities).
+    /// count)`, bit i the i-th next value, `count` at most
+    /// [`LOOKAHEAD`] and at most `remaining` (the values left in the
+    /// chunk), and nothing from a value that is not a bit or fails
+    /// ([`ChunkDecoder::look_ahead`] into a look-ahead of its own).
+    #[cfg(test)]
     pub fn peek_bits(&self, bytes: &[u8], contexts: &[u8], remaining: usize) -> (u128, u32) {
-        let mut lanes = [[0u32; LANE_WORDS]; MAX_LANES as usize];
+        let mut ahead = Lookahead::default();
+        self.look_ahead(bytes, contexts, remaining, &mut ahead)
+    }
+
+    /// Decodes the next bits in `contexts` (one per value) on a copy of
+    /// this decoder's state kept in `ahead`, consuming nothing here:
+    /// `(bits, count)` as [`ChunkDecoder::peek_bits`]. Reading them then
+    /// through [`Lookahead::next`] and taking the copy with
+    /// [`ChunkDecoder::adopt`] once all are read leaves this decoder as
+    /// decoding them one by one would: each is decoded once.
+    pub fn look_ahead(
+        &self,
+        bytes: &[u8],
+        contexts: &[u8],
+        remaining: usize,
+        ahead: &mut Lookahead,
+    ) -> (u128, u32) {
         let count = self.lane_count.min(MAX_LANES as usize);
-        lanes[..count].copy_from_slice(&self.lanes[..count]);
-        let (mut cums, mut buckets) = (*self.cums, *self.buckets);
+        ahead.lanes[..count].copy_from_slice(&self.lanes[..count]);
+        ahead.cums.copy_from_slice(&self.cums[..]);
+        ahead.buckets.copy_from_slice(&self.buckets[..]);
         let mut tables = Tables {
             tokens: &self.tokens,
             rates: &self.rates,
-            cums: &mut cums,
-            buckets: &mut buckets,
+            cums: &mut ahead.cums,
+            buckets: &mut ahead.buckets,
         };
         let mut lane = self.lane;
         // By 64-bit halves: a variable 128-bit shift is a library call on
         // 32-bit targets.
         let (mut halves, mut known) = ([0u64; 2], 0u32);
-        for &context in contexts.iter().take(remaining.min(128)) {
+        for &context in contexts.iter().take(remaining.min(LOOKAHEAD)) {
+            // Only the tables of a bit (one or two tokens): their reads
+            // change nothing but the lane when they fail, and give 0 or 1
+            // when they do not. Any other value is left to the reader.
+            if !(1..=2).contains(&self.tokens[context as usize & (MAX_CONTEXTS - 1)]) {
+                break;
+            }
             let index = lane & (MAX_LANES as usize - 1);
-            let l = &mut lanes[index];
-            lane = if lane + 1 >= self.lane_count {
+            let l = &mut ahead.lanes[index];
+            let before = *l;
+            let next = if lane + 1 >= self.lane_count {
                 0
             } else {
                 lane + 1
             };
             match decode_bit_in(tables.reborrow(), l, index, bytes, context as usize) {
-                Ok(v @ (0 | 1)) => halves[known as usize / 64] |= (v as u64) << (known % 64),
-                _ => break,
+                Ok(v) => halves[known as usize / 64] |= (v as u64) << (known % 64),
+                Err(_) => {
+                    // The state adopted is the one after the values before.
+                    *l = before;
+                    break;
+                }
             }
+            ahead.contexts[known as usize] = context;
+            lane = next;
             known += 1;
         }
+        ahead.lane = lane;
+        ahead.halves = halves;
+        ahead.known = known;
+        ahead.served = 0;
         ((halves[1] as u128) << 64 | halves[0] as u128, known)
+    }
+
+    /// Takes the state `ahead` reached after all its values
+    /// ([`ChunkDecoder::look_ahead`]): the lanes, the adaptive tables'
+    /// probabilities (static tables never change) and the next lane.
+    pub fn adopt(&mut self, ahead: &Lookahead) {
+        let count = self.lane_count.min(MAX_LANES as usize);
+        self.lanes[..count].copy_from_slice(&ahead.lanes[..count]);
+        for c in 0..MAX_CONTEXTS {
+            if self.rates[c] != 0 {
+                self.cums[c].copy_from_slice(&ahead.cums[c]);
+                self.buckets[c].copy_from_slice(&ahead.buckets[c]);
+            }
+        }
+        self.lane = ahead.lane;
+    }
+}
+
+/// Values decoded ahead of a reader ([`ChunkDecoder::look_ahead`]), and
+/// the decoder state after them.
+#[derive(Clone)]
+pub struct Lookahead {
+    lanes: [[u32; LANE_WORDS]; MAX_LANES as usize],
+    cums: [[u16; CUM_LEN]; MAX_CONTEXTS],
+    buckets: [[u8; BUCKETS]; MAX_CONTEXTS],
+    /// Lane of the value after them.
+    lane: usize,
+    /// The context each was decoded in.
+    contexts: [u8; LOOKAHEAD],
+    halves: [u64; 2],
+    known: u32,
+    /// How many the reader has taken ([`Lookahead::next`]).
+    served: u32,
+}
+
+impl Default for Lookahead {
+    fn default() -> Self {
+        Lookahead {
+            lanes: [[0; LANE_WORDS]; MAX_LANES as usize],
+            cums: [[0; CUM_LEN]; MAX_CONTEXTS],
+            buckets: [[0; BUCKETS]; MAX_CONTEXTS],
+            lane: 0,
+            contexts: [0; LOOKAHEAD],
+            halves: [0; 2],
+            known: 0,
+            served: 0,
+        }
+    }
+}
+
+impl Lookahead {
+    /// The next value decoded ahead, when the reader asks for it in the
+    /// context it was decoded in; `None` otherwise (the reader went
+    /// another way: [`Lookahead::taken`] tells how far it followed).
+    #[inline]
+    pub fn next(&mut self, context: u8) -> Option<bool> {
+        let i = self.served as usize;
+        if i < self.known as usize && self.contexts[i] == context {
+            self.served += 1;
+            Some(self.halves[i / 64] >> (i % 64) & 1 != 0)
+        } else {
+            None
+        }
+    }
+
+    /// Whether the reader has taken every value decoded ahead.
+    #[inline]
+    pub fn all_taken(&self) -> bool {
+        self.served == self.known
+    }
+
+    /// The contexts of the values the reader has taken, in order.
+    pub fn taken(&self) -> &[u8] {
+        &self.contexts[..self.served as usize]
     }
 }
 

@@ -14,7 +14,7 @@ use crate::inflate::Inflater;
 use crate::level_header::LevelHeader;
 use crate::limits::codec;
 use crate::limits::substream::SLOTS;
-use crate::rans::ChunkDecoder;
+use crate::rans::{ChunkDecoder, Lookahead};
 use crate::{ChecksumScope, Error, Schedule, bytes::crc32};
 
 struct Reader<'b> {
@@ -71,6 +71,11 @@ pub struct Substreams<'l, 'b> {
     header: LevelHeader<'l>,
     readers: [Reader<'b>; SLOTS],
     inflater: &'b mut Inflater,
+    /// Bits decoded ahead by [`Substreams::peek_bits_in`] for the reader
+    /// of slot `lookahead_slot` (`SLOTS`: none), served to it while it
+    /// reads them in the same contexts.
+    lookahead: Lookahead,
+    lookahead_slot: usize,
 }
 
 impl<'l, 'b> Substreams<'l, 'b> {
@@ -132,6 +137,8 @@ impl<'l, 'b> Substreams<'l, 'b> {
             header,
             readers,
             inflater,
+            lookahead: Lookahead::default(),
+            lookahead_slot: SLOTS,
         }
     }
 
@@ -142,6 +149,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// nothing to read, so [`Substreams::finish`] passes them).
     /// [`Substreams::join`] puts them back.
     pub fn split_off(&mut self, keep: usize, inflater: &'b mut Inflater) -> Substreams<'l, 'b> {
+        self.settle();
         let mut i = 0;
         let readers = self.readers.each_mut().map(|r| {
             let slot = i;
@@ -158,12 +166,16 @@ impl<'l, 'b> Substreams<'l, 'b> {
             header: self.header,
             readers,
             inflater,
+            lookahead: Lookahead::default(),
+            lookahead_slot: SLOTS,
         }
     }
 
     /// Takes back the readers [`Substreams::split_off`] moved into `part`
     /// (all but `keep`'s, as there).
-    pub fn join(&mut self, keep: usize, part: Substreams<'l, 'b>) {
+    pub fn join(&mut self, keep: usize, mut part: Substreams<'l, 'b>) {
+        self.settle();
+        part.settle();
         for (slot, (mine, theirs)) in self.readers.iter_mut().zip(part.readers).enumerate() {
             if slot != keep {
                 *mine = theirs;
@@ -279,7 +291,14 @@ impl<'l, 'b> Substreams<'l, 'b> {
         if self.is_rans(slot) {
             if self.header.schedule == Schedule::EveryVertex {
                 // Each flag has its own context (SPEC §5.5.5, 3.6): no
-                // decoding ahead in one.
+                // decoding ahead in one, but the bits looked ahead in
+                // the contexts they are read in are served as decoded.
+                if self.lookahead_slot == slot {
+                    if let Some(bit) = self.lookahead.next(context) {
+                        return self.served(slot, bit);
+                    }
+                    self.settle();
+                }
                 let v = self.rans_value_as(slot, context, true)?;
                 return match v {
                     0 | 1 => Ok(v == 1),
@@ -316,6 +335,42 @@ impl<'l, 'b> Substreams<'l, 'b> {
         let bit = (r.bit_byte >> r.bit_index) & 1 != 0;
         r.bit_index += 1;
         Ok(bit)
+    }
+
+    /// A bit of `slot` served from the look-ahead: counted as read, and
+    /// once the look-ahead's last is read its state becomes the chunk's,
+    /// checked at the chunk's end as [`Substreams::rans_value`] checks it.
+    #[inline]
+    fn served(&mut self, slot: usize, bit: bool) -> Result<bool, Error> {
+        let r = &mut self.readers[slot];
+        r.pos += 1;
+        if self.lookahead.all_taken() {
+            self.lookahead_slot = SLOTS;
+            if let Some(chunk) = r.chunk.as_mut() {
+                chunk.adopt(&self.lookahead);
+                if r.pos == r.len && !chunk.exhausted() {
+                    return Err(Error::InvalidRansChunk("a lane did not end exactly"));
+                }
+            }
+        }
+        Ok(bit)
+    }
+
+    /// Brings the look-ahead's reader to the values it has read: those it
+    /// took from the look-ahead are decoded again, in their contexts, from
+    /// the chunk's own state (they decode as they did ahead), and the rest
+    /// is dropped. Rare: the reader follows its look-ahead to the end
+    /// unless a flagged candidate blocks a later one of the same batch.
+    fn settle(&mut self) {
+        let slot = core::mem::replace(&mut self.lookahead_slot, SLOTS);
+        let Some(r) = self.readers.get_mut(slot) else {
+            return;
+        };
+        if let Some(chunk) = r.chunk.as_mut() {
+            for &context in self.lookahead.taken() {
+                let _ = chunk.decode_bit(self.level, context as usize);
+            }
+        }
     }
 
     /// Decodes values of the current rANS chunk of bit substream `slot`
@@ -370,21 +425,35 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// [`Substreams::peek_bits`] for bits read each in its own context,
     /// `contexts[i]` for the i-th next one (the flags under the schedule
     /// `every-vertex`, SPEC §5.5.5): decoded from copies of the current rANS
-    /// chunk's lanes, so nothing is consumed and nothing is loaded (`count`
-    /// is 0 at a chunk's end, at most 128, and at most 64 for a byte
-    /// codec). A decoder uses it to look ahead, never to decide.
+    /// chunk's lanes and tables, so nothing is consumed and nothing is
+    /// loaded (`count` is 0 at a chunk's end, at most 128, and at most 64
+    /// for a byte codec). A decoder uses it to look ahead, never to decide.
+    /// The bits are kept: while [`Substreams::bit`] then asks for them in
+    /// the same contexts it gets them without decoding them again, and the
+    /// chunk takes the copies' state after the last; a read in another
+    /// context first brings the chunk to the bits taken. What is read is
+    /// the same either way.
     pub fn peek_bits_in(&mut self, slot: usize, contexts: &[u8]) -> (u128, u32) {
         if !self.is_rans(slot) {
             let (bits, count) = self.peek_byte_bits(slot);
             return (bits as u128, count);
         }
+        self.settle();
         let r = &self.readers[slot];
         if r.ahead_len > 0 || r.ahead_error.is_some() {
             // Bits decoded ahead in one context: not this reader's way.
             return (0, 0);
         }
         match r.chunk.as_ref() {
-            Some(chunk) if r.pos < r.len => chunk.peek_bits(self.level, contexts, r.len - r.pos),
+            Some(chunk) if r.pos < r.len => {
+                let (bits, known) =
+                    chunk.look_ahead(self.level, contexts, r.len - r.pos, &mut self.lookahead);
+                if known > 0 {
+                    // Served to `bit` as it reads them (each decoded once).
+                    self.lookahead_slot = slot;
+                }
+                (bits, known)
+            }
             _ => (0, 0),
         }
     }
@@ -571,6 +640,97 @@ mod tests {
         (out, consistent)
     }
 
+    /// A level of the schedule `every-vertex` whose flags are `flags`
+    /// (context, bit), in rANS chunks of at most `chunk` values.
+    fn every_vertex_level(flags: &[(u8, bool)], lanes: u8, chunk: u32, adaptive: bool) -> Vec<u8> {
+        let mut substreams = vec![SubstreamWriter::default(); SLOTS];
+        for &(context, b) in flags {
+            substreams[0].bit_in(context, b);
+        }
+        let payload = LevelPayload {
+            round_splits: vec![1],
+            substreams,
+            ..LevelPayload::default()
+        };
+        let params = StreamParams {
+            position_mode: PositionMode::Constrained,
+            bits: 14,
+            origin: [0.0; 3],
+            scale: [1.0; 3],
+            codec: ChunkCodec::RansAlways { lanes },
+            chunk_limit: 1 << 16,
+            rans_chunk_limit: chunk,
+            schedule: Schedule::EveryVertex,
+            adaptive_tables: adaptive,
+        };
+        frame_level(&payload, None, &params).bytes
+    }
+
+    /// Reads the flags of `bytes` in `contexts` (one per flag, in order),
+    /// up to and including the first error; before flag `i` where
+    /// `guesses` has an entry `(i, list)`, looks `list` ahead
+    /// (`peek_bits_in`).
+    fn read_every_vertex(
+        bytes: &[u8],
+        lanes: u8,
+        contexts: &[u8],
+        guesses: &[(usize, Vec<u8>)],
+    ) -> Vec<Result<bool, Error>> {
+        let rules = crate::LevelRules {
+            schedule: Schedule::EveryVertex,
+            ..crate::LevelRules::TEST
+        };
+        let Ok(header) = LevelHeader::parse(bytes, false, rules) else {
+            return vec![Err(Error::Truncated)];
+        };
+        let mut memory = slot_memory(lanes);
+        let mut inflater = Inflater::new();
+        let buffers = slot_buffers(&mut memory);
+        let mut subs = Substreams::open(bytes, header, 1, buffers, &mut inflater, lanes);
+        let mut out = Vec::new();
+        for (i, &context) in contexts.iter().enumerate() {
+            for (_, list) in guesses.iter().filter(|(at, _)| *at == i) {
+                subs.peek_bits_in(0, list);
+            }
+            let got = subs.bit(0, context);
+            let stop = got.is_err();
+            out.push(got);
+            if stop {
+                return out;
+            }
+        }
+        out.push(subs.finish().map(|()| true));
+        out
+    }
+
+    /// Flips bits of the payload byte at `at` (an index into the payload)
+    /// with `x | 1` and refreshes its chunk's CRC and the header's, so that
+    /// the damage reaches the decoders rather than the CRC checks.
+    fn corrupt_payload(bytes: &mut [u8], rules: crate::LevelRules, at: prop::sample::Index, x: u8) {
+        let copy = bytes.to_vec();
+        let header = LevelHeader::parse(&copy, false, rules).expect("header");
+        let start = header.payload_start;
+        if bytes.len() <= start {
+            return;
+        }
+        let at = start + at.index(bytes.len() - start);
+        bytes[at] ^= x | 1;
+        let mut offset = start;
+        for k in 0..header.chunk_count {
+            let e = header.chunk(k).expect("entry");
+            let end = offset + e.stored_len as usize;
+            if (offset..end).contains(&at) {
+                let crc = crate::bytes::crc32(&bytes[offset..end]);
+                let entry_at = header.payload_start - 4 - 16 * (header.chunk_count - k) as usize;
+                bytes[entry_at + 12..entry_at + 16].copy_from_slice(&crc.to_le_bytes());
+            }
+            offset = end;
+        }
+        let head_len = header.payload_start - 4;
+        let crc = crate::bytes::crc32(&bytes[..head_len]);
+        bytes[head_len..head_len + 4].copy_from_slice(&crc.to_le_bytes());
+    }
+
     fn codec_of(which: u8, lanes: u8) -> ChunkCodec {
         match which % 3 {
             0 => ChunkCodec::Stored,
@@ -580,6 +740,68 @@ mod tests {
     }
 
     proptest! {
+        /// Looking flags ahead in their contexts (`peek_bits_in`, which the
+        /// rounds then read without decoding them again) changes nothing:
+        /// the same bits and the same first error as reading without it,
+        /// whether the reader follows the look-ahead, leaves it (a context
+        /// put in or changed: a candidate blocked by a flagged one of the
+        /// same batch), or reads past it; with adaptive and static tables,
+        /// chunk ends inside a look-ahead, corrupted bytes, and bits asked
+        /// for after the last.
+        #[test]
+        fn looking_ahead_never_changes_what_is_read(
+            flags in proptest::collection::vec((0u8..5, 0u8..8), 1..400),
+            lanes in 1u8..6,
+            chunk in 1u32..200,
+            adaptive in any::<bool>(),
+            guesses in proptest::collection::vec(
+                (any::<prop::sample::Index>(), 0usize..140, proptest::collection::vec((any::<prop::sample::Index>(), 0u8..6), 0..3)),
+                0..12,
+            ),
+            corrupt in any::<Option<(prop::sample::Index, u8)>>(),
+            extra in 0usize..3,
+        ) {
+            // Skewed bits, more often 0 in the higher contexts.
+            let flags: Vec<(u8, bool)> = flags.iter().map(|&(c, v)| (c, v < 3 - c.min(2))).collect();
+            let mut bytes = every_vertex_level(&flags, lanes, chunk, adaptive);
+            if let Some((at, x)) = corrupt {
+                let rules = crate::LevelRules { schedule: Schedule::EveryVertex, ..crate::LevelRules::TEST };
+                corrupt_payload(&mut bytes, rules, at, x);
+            }
+            // The reader's contexts: the flags', then a few more past the
+            // end (asked for after the last flag).
+            let mut contexts: Vec<u8> = flags.iter().map(|f| f.0).collect();
+            contexts.extend((0..extra).map(|k| k as u8));
+            // Each look-ahead names the contexts from flag `i` on, up to
+            // `len` of them, with edits: a context put in or changed.
+            let n = contexts.len();
+            let guesses: Vec<(usize, Vec<u8>)> = guesses
+                .iter()
+                .map(|(at, len, edits)| {
+                    let i = at.index(n);
+                    let mut list: Vec<u8> = contexts[i..(i + len).min(n)].to_vec();
+                    for (pos, c) in edits {
+                        let p = pos.index(list.len() + 1);
+                        if *c == 5 || p == list.len() {
+                            list.insert(p, *c % 5);
+                        } else {
+                            list[p] = *c;
+                        }
+                    }
+                    list.truncate(128);
+                    (i, list)
+                })
+                .collect();
+            let plain = read_every_vertex(&bytes, lanes, &contexts, &[]);
+            let ahead = read_every_vertex(&bytes, lanes, &contexts, &guesses);
+            prop_assert_eq!(&plain, &ahead);
+            if corrupt.is_none() && extra == 0 {
+                let expected: Vec<Result<bool, Error>> =
+                    flags.iter().map(|f| Ok(f.1)).chain([Ok(true)]).collect();
+                prop_assert_eq!(plain, expected);
+            }
+        }
+
         /// Peeking changes nothing: the same bits and the same first error
         /// (here: running out, then a corrupted byte) as reading without
         /// peeks, and every peek shows exactly the bits that follow.
@@ -590,34 +812,12 @@ mod tests {
             lanes in 1u8..6,
             chunk in 1u32..40,
             peeks in proptest::collection::vec(any::<bool>(), 1..8),
-            corrupt in any::<Option<(usize, u8)>>(),
+            corrupt in any::<Option<(prop::sample::Index, u8)>>(),
         ) {
             let lanes = if which % 3 == 2 { lanes } else { 1 };
             let mut bytes = level(&bits, codec_of(which, lanes), chunk);
             if let Some((at, x)) = corrupt {
-                // Corrupt a payload byte and refresh its chunk's CRC, so that
-                // the damage reaches the decoders rather than the CRC check.
-                let copy = bytes.clone();
-                let header = LevelHeader::parse(&copy, false, crate::LevelRules::TEST).expect("header");
-                let start = header.payload_start;
-                if bytes.len() > start {
-                    let at = start + at % (bytes.len() - start);
-                    bytes[at] ^= x | 1;
-                    let mut offset = start;
-                    for k in 0..header.chunk_count {
-                        let e = header.chunk(k).expect("entry");
-                        let end = offset + e.stored_len as usize;
-                        if (offset..end).contains(&at) {
-                            let crc = crate::bytes::crc32(&bytes[offset..end]);
-                            let entry_at = header.payload_start - 4 - 16 * (header.chunk_count - k) as usize;
-                            bytes[entry_at + 12..entry_at + 16].copy_from_slice(&crc.to_le_bytes());
-                        }
-                        offset = end;
-                    }
-                    let head_len = header.payload_start - 4;
-                    let crc = crate::bytes::crc32(&bytes[..head_len]);
-                    bytes[head_len..head_len + 4].copy_from_slice(&crc.to_le_bytes());
-                }
+                corrupt_payload(&mut bytes, crate::LevelRules::TEST, at, x);
             }
             let (plain, _) = read_all(&bytes, lanes, &[false]);
             let (peeked, consistent) = read_all(&bytes, lanes, &peeks);
