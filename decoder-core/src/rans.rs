@@ -339,30 +339,32 @@ impl<'b> ChunkDecoder<'b> {
             .all(|l| l[0] == STATE_LOW && l[1] == l[2])
     }
 
-    /// Decodes the next value, in `context`, from the next lane
-    /// (§5.5.1, §5.5.4); `bytes` are the level's.
+    /// The tables, the lane of the next value and its number; moves on to
+    /// the lane after it.
     #[inline(always)]
-    pub fn decode(&mut self, bytes: &[u8], context: usize) -> Result<u32, Error> {
+    fn next_lane(&mut self) -> (Tables<'_>, &mut [u32; LANE_WORDS], usize) {
         // lane < lane_count <= MAX_LANES, a power of two.
         let index = self.lane & (MAX_LANES as usize - 1);
-        let lane = &mut self.lanes[index];
         self.lane = if self.lane + 1 >= self.lane_count {
             0
         } else {
             self.lane + 1
         };
-        decode_in(
-            Tables {
-                tokens: &self.tokens,
-                rates: &self.rates,
-                cums: self.cums,
-                buckets: self.buckets,
-            },
-            lane,
-            index,
-            bytes,
-            context,
-        )
+        let tables = Tables {
+            tokens: &self.tokens,
+            rates: &self.rates,
+            cums: self.cums,
+            buckets: self.buckets,
+        };
+        (tables, &mut self.lanes[index], index)
+    }
+
+    /// Decodes the next value, in `context`, from the next lane
+    /// (§5.5.1, §5.5.4); `bytes` are the level's.
+    #[inline(always)]
+    pub fn decode(&mut self, bytes: &[u8], context: usize) -> Result<u32, Error> {
+        let (tables, lane, index) = self.next_lane();
+        decode_in(tables, lane, index, bytes, context)
     }
 
     /// [`ChunkDecoder::decode`] for a value read as a bit (a flag, SPEC
@@ -372,25 +374,8 @@ impl<'b> ChunkDecoder<'b> {
     /// path, whose value the caller then refuses.
     #[inline(always)]
     pub fn decode_bit(&mut self, bytes: &[u8], context: usize) -> Result<u32, Error> {
-        let index = self.lane & (MAX_LANES as usize - 1);
-        let lane = &mut self.lanes[index];
-        self.lane = if self.lane + 1 >= self.lane_count {
-            0
-        } else {
-            self.lane + 1
-        };
-        decode_bit_in(
-            Tables {
-                tokens: &self.tokens,
-                rates: &self.rates,
-                cums: self.cums,
-                buckets: self.buckets,
-            },
-            lane,
-            index,
-            bytes,
-            context,
-        )
+        let (tables, lane, index) = self.next_lane();
+        decode_bit_in(tables, lane, index, bytes, context)
     }
 
     /// The next bits as [`ChunkDecoder::decode`] would give them in
