@@ -247,6 +247,12 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// ([`ChunkDecoder::decode_bit`]: the same value, a shorter path).
     #[inline(always)]
     fn rans_value_as(&mut self, slot: usize, context: u8, bit: bool) -> Result<u32, Error> {
+        // Any read of a slot with bits looked ahead and taken (a caller of
+        // this public API may mix `bit` with other reads) first brings its
+        // chunk to them.
+        if self.lookahead_slot == slot {
+            self.settle();
+        }
         let r = &mut self.readers[slot];
         if r.pos == r.len {
             self.refill(slot)?;
@@ -361,6 +367,8 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// the chunk's own state (they decode as they did ahead), and the rest
     /// is dropped. Rare: the reader follows its look-ahead to the end
     /// unless a flagged candidate blocks a later one of the same batch.
+    #[cold]
+    #[inline(never)]
     fn settle(&mut self) {
         let slot = core::mem::replace(&mut self.lookahead_slot, SLOTS);
         let Some(r) = self.readers.get_mut(slot) else {
@@ -737,6 +745,37 @@ mod tests {
             1 => ChunkCodec::Deflate(6),
             _ => ChunkCodec::RansAlways { lanes },
         }
+    }
+
+    /// A bit looked ahead and taken, then the next value read as a byte
+    /// of the same slot (the public API allows it): the byte is the value
+    /// after the bit, as without the look-ahead.
+    #[test]
+    fn a_byte_read_after_bits_taken_from_a_look_ahead_follows_them() {
+        let flags: Vec<(u8, bool)> = (0..40).map(|i| ((i % 5) as u8, i % 3 == 0)).collect();
+        let bytes = every_vertex_level(&flags, 2, 200, true);
+        let rules = crate::LevelRules {
+            schedule: Schedule::EveryVertex,
+            ..crate::LevelRules::TEST
+        };
+        let header = LevelHeader::parse(&bytes, false, rules).expect("level header");
+        let mut memory = slot_memory(2);
+        let mut inflater = Inflater::new();
+        let buffers = slot_buffers(&mut memory);
+        let mut subs = Substreams::open(&bytes, header, 1, buffers, &mut inflater, 2);
+        let contexts: Vec<u8> = flags.iter().map(|f| f.0).collect();
+        // The first read loads the chunk; the look-ahead sees the rest.
+        assert_eq!(subs.bit(0, flags[0].0), Ok(flags[0].1));
+        let (_, known) = subs.peek_bits_in(0, &contexts[1..]);
+        assert_eq!(known, 39);
+        for f in &flags[1..3] {
+            assert_eq!(subs.bit(0, f.0), Ok(f.1));
+        }
+        assert_eq!(subs.byte(0, flags[3].0), Ok(flags[3].1 as u8));
+        for f in &flags[4..] {
+            assert_eq!(subs.bit(0, f.0), Ok(f.1));
+        }
+        assert_eq!(subs.finish(), Ok(()));
     }
 
     proptest! {
