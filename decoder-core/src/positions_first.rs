@@ -694,22 +694,11 @@ impl PositionsFirst {
     /// on an axis), taken in key order. `None` when fewer than `j + 1` of
     /// them are free: then the fan is listed.
     fn near_point(&self, j: usize) -> Option<[i64; 2]> {
-        let (fx, fy) = (self.sx.div_euclid(self.n), self.sy.div_euclid(self.n));
-        if j == 0 {
-            // The nearest lattice point to the centroid is a corner of the
-            // unit square that holds it (per axis the nearer integer), and
-            // so are the points as near (the centroid halfway): the least
-            // of the four keys is the least key of all.
-            let key = (0..4)
-                .map(|i| {
-                    let p = [fx + (i & 1), fy + (i >> 1)];
-                    self.key_near(p).unwrap_or(u64::MAX)
-                })
-                .min()
-                .unwrap_or(u64::MAX);
-            if key != u64::MAX && self.is_free(self.point_of(key)) {
-                return Some(self.point_of(key));
-            }
+        // Past rank 1 the corners hold the point in about half the fans
+        // (measured on terrain: rank 2 in 59 %, rank 3 in 8 %, rank 4 in
+        // none), and the window then tests them again.
+        if let Some(p) = (j < 2).then(|| self.corner_point(j)).flatten() {
+            return Some(p);
         }
         let mut window = self.window();
         let mut found = 0;
@@ -733,6 +722,49 @@ impl PositionsFirst {
                 found += 1;
             }
         }
+    }
+
+    /// `F[j]` when it is one of the four lattice points around the
+    /// centroid `c` (the corners of the unit square that holds it) and
+    /// provably so; `None` leaves it to the window. Every other point lies
+    /// at least `b` from `c` on one axis, `b` the least distance from `c`
+    /// to the columns and rows just outside the square, so a free corner
+    /// nearer than `b` comes after no other point (nor ties with one) in
+    /// key order. On terrain the nearest point is often R itself (not
+    /// free) and the rank 0 is then the next corner: this takes most ranks
+    /// below 3 without the window's nine keys.
+    #[inline]
+    fn corner_point(&self, j: usize) -> Option<[i64; 2]> {
+        let n = self.n;
+        let (fx, fy) = (self.sx.div_euclid(n), self.sy.div_euclid(n));
+        let mut corners: [u64; 4] = core::array::from_fn(|i| {
+            let p = [fx + (i & 1) as i64, fy + (i >> 1) as i64];
+            self.key_near(p).unwrap_or(u64::MAX)
+        });
+        // A sorting network: five compare-exchanges.
+        for (a, b) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
+            let (lo, hi) = (corners[a].min(corners[b]), corners[a].max(corners[b]));
+            (corners[a], corners[b]) = (lo, hi);
+        }
+        // In units of 1/n, as the keys' distances: the centroid sits `rx`
+        // past column fx, so the columns fx − 1 and fx + 2 lie n + rx and
+        // 2n − rx from it; rows likewise.
+        let (rx, ry) = (self.sx - fx * n, self.sy - fy * n);
+        let b = (n + rx).min(2 * n - rx).min(n + ry).min(2 * n - ry);
+        let mut found = 0;
+        for key in corners {
+            if key == u64::MAX {
+                return None;
+            }
+            let p = self.point_of(key);
+            if self.is_free(p) {
+                if found == j {
+                    return (((key >> 20) as i64) < b * b).then_some(p);
+                }
+                found += 1;
+            }
+        }
+        None
     }
 
     /// [`Self::rank_of`] for a simple fan not listed: `Some(rank)` when

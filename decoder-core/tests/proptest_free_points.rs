@@ -329,6 +329,12 @@ proptest! {
             }
             pf.free_points(&positions, R, &ring);
             prop_assert_eq!(pf.rank_of([0, 0]), None);
+            // Each rank asked first of a fan just counted (the low ranks
+            // are then often taken among the corners around the centroid).
+            for (j, p) in expected.iter().enumerate() {
+                pf.free_points(&positions, R, &ring);
+                prop_assert_eq!(pf.point_at(j), Some(*p), "rank {} first", j);
+            }
             // Ranks in decreasing order, the fan counted once.
             pf.free_points(&positions, R, &ring);
             for j in (0..expected.len()).rev() {
