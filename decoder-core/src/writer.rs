@@ -18,7 +18,7 @@ use crate::limits::{
 use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
 use crate::rans_segments::rans_segments;
-use crate::rans_writer::{Symbol, encode_chunk_with};
+use crate::rans_writer::{Symbol, encode_chunk_with, encoded_chunk_len};
 use crate::wing_order::WingPolicy;
 
 /// A growing substream: bytes, bits (least significant first) or varints
@@ -611,10 +611,51 @@ pub fn coded_len_under(
     params: &StreamParams,
 ) -> usize {
     let contexts = context::count(id, deficits, records, params.schedule);
-    substream_chunks(sub, contexts, params, &one_by_one)
-        .iter()
-        .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)
-        .sum()
+    // The rANS chunks' payloads and count, their lanes counted, not
+    // written: the same cuts, tables and lengths as `substream_chunks`,
+    // which `frame_level` writes.
+    let rans_len = |lanes: u8| {
+        let symbols = sub.symbols();
+        let limit = params.rans_chunk_limit.max(1) as usize;
+        let segments = rans_segments(symbols, contexts, lanes as usize, limit);
+        let payloads: usize = segments
+            .iter()
+            .map(|range| {
+                let values = &symbols[range.clone()];
+                encoded_chunk_len(values, contexts, lanes as usize, params.adaptive_tables).0
+            })
+            .sum();
+        (payloads, segments.len())
+    };
+    let framed = |(payloads, chunks): (usize, usize)| payloads + chunks * CHUNK_ENTRY_LEN;
+    let byte_codec = |level: Option<u8>| {
+        let chunks = byte_chunks(
+            sub.as_bytes(),
+            params.chunk_limit.max(1) as usize,
+            level,
+            &one_by_one,
+        );
+        (
+            chunks.iter().map(|c| c.stored.len()).sum::<usize>(),
+            chunks.len(),
+        )
+    };
+    framed(match params.codec {
+        ChunkCodec::Stored => byte_codec(None),
+        ChunkCodec::Deflate(l) => byte_codec(Some(l)),
+        ChunkCodec::RansAlways { lanes } => rans_len(lanes),
+        // `substream_chunks`' choice between rANS and deflate.
+        ChunkCodec::Rans { lanes } => {
+            let rans = rans_len(lanes);
+            let quick = byte_codec(Some(1));
+            if quick.0 * DEFLATE_QUICK_RATIO.1 >= rans.0 * DEFLATE_QUICK_RATIO.0 {
+                rans
+            } else {
+                let deflate = byte_codec(Some(10));
+                if rans.0 < deflate.0 { rans } else { deflate }
+            }
+        }
+    })
 }
 
 /// [`coded_len_in`] of a substream that is still being written, costed
@@ -751,4 +792,57 @@ fn rans_chunks(
             adaptive,
         }
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::limits::substream;
+    use proptest::prelude::*;
+
+    proptest! {
+        /// `coded_len_under` counts the rANS lanes instead of writing them;
+        /// its length is still that of the chunks `frame_level` writes,
+        /// under every codec, with and without adaptive tables.
+        #[test]
+        fn the_coded_length_is_the_framed_one(
+            values in proptest::collection::vec((any::<u8>(), -3000i32..3000), 0..600),
+            skew in 1i32..3000,
+            codec_choice in 0u8..6,
+            adaptive_tables in any::<bool>(),
+            chunk_limit in 1u32..300,
+            rans_chunk_limit in 1u32..300,
+        ) {
+            let codec = match codec_choice {
+                0 => ChunkCodec::Stored,
+                1 => ChunkCodec::Deflate(1),
+                2 => ChunkCodec::Deflate(10),
+                3 => ChunkCodec::RansAlways { lanes: 1 },
+                4 => ChunkCodec::RansAlways { lanes: 4 },
+                _ => ChunkCodec::Rans { lanes: 2 },
+            };
+            let params = StreamParams {
+                codec,
+                chunk_limit,
+                rans_chunk_limit,
+                adaptive_tables,
+                ..StreamParams::default()
+            };
+            let mut sub = SubstreamWriter::default();
+            for &(ctx, v) in &values {
+                sub.signed_in(ctx % 3, v % skew);
+            }
+            let contexts = context::count(
+                substream::EDGE,
+                DeficitContexts::Plain,
+                RecordOrder::WingsFirst,
+                params.schedule,
+            );
+            let framed: usize = substream_chunks(&sub, contexts, &params, &one_by_one)
+                .iter()
+                .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)
+                .sum();
+            prop_assert_eq!(coded_len(&sub, substream::EDGE, &params), framed);
+        }
+    }
 }
