@@ -267,9 +267,15 @@ fn choose_models(
             }
         })
         .collect();
-    for (i, &(ctx, value)) in symbols.iter().enumerate() {
-        if let Some(lane) = lanes_tokens[ctx as usize].get_mut(i % lanes) {
-            lane.push(token_of(value).0 as u8);
+    // (Skipped where no context may adapt: ranking costs static tables
+    // only. The lane is counted, not divided for.)
+    if lanes_tokens.iter().any(|l| !l.is_empty()) {
+        let mut lane = 0;
+        for &(ctx, value) in symbols {
+            if let Some(tokens) = lanes_tokens[ctx as usize].get_mut(lane) {
+                tokens.push(token_of(value).0 as u8);
+            }
+            lane = if lane + 1 == lanes { 0 } else { lane + 1 };
         }
     }
     let mut models = Vec::with_capacity(contexts);
