@@ -540,7 +540,9 @@ const DEFLATE_QUICK_RATIO: (usize, usize) = (3, 2);
 /// The chunks of a substream as `frame_level` codes them, in a level whose
 /// rANS chunks have `contexts` tables for it (`context::count`): byte-codec
 /// chunks of at most `params.chunk_limit` bytes, rANS chunks of at most
-/// `params.rans_chunk_limit` values.
+/// `params.rans_chunk_limit` values. [`coded_len_under`] counts the same
+/// choices without writing the rANS lanes: a change here goes there too
+/// (`tests::the_coded_length_is_the_framed_one`).
 fn substream_chunks(
     sub: &SubstreamWriter,
     contexts: usize,
