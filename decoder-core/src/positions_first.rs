@@ -343,6 +343,12 @@ fn mark_bits(inside: &mut [u64; INSIDE_WORDS], index: usize, bits: u64) {
     inside[word + 1] |= (bits >> 1) >> (63 - shift);
 }
 
+/// The squared distance to the centroid (times n²) of a packed key.
+#[inline]
+fn distance_of(key: u64) -> i64 {
+    (key >> 20) as i64
+}
+
 /// A split's fan in xy, its free lattice points and its wing pairs: the
 /// scratch a record read positions first needs, kept between records so
 /// that nothing is cleared per split but what it uses.
@@ -724,33 +730,18 @@ impl PositionsFirst {
         }
     }
 
-    /// `F[j]` when it is one of the four lattice points around the
-    /// centroid `c` (the corners of the unit square that holds it) and
-    /// provably so; `None` leaves it to the window. Every other point lies
-    /// at least `b` from `c` on one axis, `b` the least distance from `c`
-    /// to the columns and rows just outside the square, so a free corner
-    /// nearer than `b` comes after no other point (nor ties with one) in
-    /// key order. On terrain the nearest point is often R itself (not
-    /// free) and the rank 0 is then the next corner: this takes most ranks
-    /// below 3 without the window's nine keys.
+    /// `F[j]` when it is one of the four corners around the centroid
+    /// ([`Self::corners`]) and provably so; `None` leaves it to the
+    /// window. On terrain the nearest point is often R itself (not free)
+    /// and rank 0 then the next corner.
     #[inline]
     fn corner_point(&self, j: usize) -> Option<[i64; 2]> {
-        let n = self.n;
-        let (fx, fy) = (self.sx.div_euclid(n), self.sy.div_euclid(n));
-        let mut corners: [u64; 4] = core::array::from_fn(|i| {
-            let p = [fx + (i & 1) as i64, fy + (i >> 1) as i64];
-            self.key_near(p).unwrap_or(u64::MAX)
-        });
+        let (mut corners, bound) = self.corners();
         // A sorting network: five compare-exchanges.
         for (a, b) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
             let (lo, hi) = (corners[a].min(corners[b]), corners[a].max(corners[b]));
             (corners[a], corners[b]) = (lo, hi);
         }
-        // In units of 1/n, as the keys' distances: the centroid sits `rx`
-        // past column fx, so the columns fx − 1 and fx + 2 lie n + rx and
-        // 2n − rx from it; rows likewise.
-        let (rx, ry) = (self.sx - fx * n, self.sy - fy * n);
-        let b = (n + rx).min(2 * n - rx).min(n + ry).min(2 * n - ry);
         let mut found = 0;
         for key in corners {
             if key == u64::MAX {
@@ -759,12 +750,36 @@ impl PositionsFirst {
             let p = self.point_of(key);
             if self.is_free(p) {
                 if found == j {
-                    return (((key >> 20) as i64) < b * b).then_some(p);
+                    return (distance_of(key) < bound).then_some(p);
                 }
                 found += 1;
             }
         }
         None
+    }
+
+    /// The keys of the four lattice points around the centroid `c` (the
+    /// corners of the unit square that holds it; `u64::MAX` for those
+    /// outside the bounding box or the window), and `b²` in the keys'
+    /// units: every other lattice point lies at least `b` from `c` on one
+    /// axis, `b` the least distance from `c` to the columns and rows just
+    /// outside the square. So a key whose distance is below `b²` is a
+    /// corner's, and only corners come before it in key order (none ties
+    /// with it).
+    #[inline(always)]
+    fn corners(&self) -> ([u64; 4], i64) {
+        let n = self.n;
+        let (fx, fy) = (self.sx.div_euclid(n), self.sy.div_euclid(n));
+        let keys = core::array::from_fn(|i| {
+            let p = [fx + (i & 1) as i64, fy + (i >> 1) as i64];
+            self.key_near(p).unwrap_or(u64::MAX)
+        });
+        // In units of 1/n, as the keys' distances: the centroid sits `rx`
+        // past column fx, so the columns fx − 1 and fx + 2 lie n + rx and
+        // 2n − rx from it; rows likewise.
+        let (rx, ry) = (self.sx - fx * n, self.sy - fy * n);
+        let b = (n + rx).min(2 * n - rx).min(n + ry).min(2 * n - ry);
+        (keys, b * b)
     }
 
     /// [`Self::rank_of`] for a simple fan not listed: `Some(rank)` when
@@ -775,11 +790,17 @@ impl PositionsFirst {
         if !self.is_free(p) {
             return Some(None);
         }
-        let nearer = self
-            .window()
-            .iter()
-            .filter(|&&other| other < key && self.is_free(self.point_of(other)))
-            .count();
+        let nearer_free = |keys: &[u64]| {
+            keys.iter()
+                .filter(|&&other| other < key && self.is_free(self.point_of(other)))
+                .count()
+        };
+        let (corners, bound) = self.corners();
+        let nearer = if distance_of(key) < bound {
+            nearer_free(&corners)
+        } else {
+            nearer_free(&self.window())
+        };
         Some(Some(nearer))
     }
 
