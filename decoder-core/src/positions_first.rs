@@ -731,12 +731,13 @@ impl PositionsFirst {
     }
 
     /// `F[j]` when it is one of the four corners around the centroid
-    /// ([`Self::corners`]) and provably so; `None` leaves it to the
+    /// ([`Self::centroid_cell`]) and provably so; `None` leaves it to the
     /// window. On terrain the nearest point is often R itself (not free)
     /// and rank 0 then the next corner.
     #[inline]
     fn corner_point(&self, j: usize) -> Option<[i64; 2]> {
-        let (mut corners, bound) = self.corners();
+        let (low, bound) = self.centroid_cell();
+        let mut corners = self.corner_keys(low);
         // A sorting network: five compare-exchanges.
         for (a, b) in [(0, 1), (2, 3), (0, 2), (1, 3), (1, 2)] {
             let (lo, hi) = (corners[a].min(corners[b]), corners[a].max(corners[b]));
@@ -758,28 +759,33 @@ impl PositionsFirst {
         None
     }
 
-    /// The keys of the four lattice points around the centroid `c` (the
-    /// corners of the unit square that holds it; `u64::MAX` for those
-    /// outside the bounding box or the window), and `b²` in the keys'
-    /// units: every other lattice point lies at least `b` from `c` on one
-    /// axis, `b` the least distance from `c` to the columns and rows just
-    /// outside the square. So a key whose distance is below `b²` is a
-    /// corner's, and only corners come before it in key order (none ties
-    /// with it).
+    /// The unit square that holds the centroid `c`, by its low corner,
+    /// and `b²` in the keys' units: every lattice point but the square's
+    /// four corners lies at least `b` from `c` on one axis, `b` the least
+    /// distance from `c` to the columns and rows just outside the square.
+    /// So a key whose distance is below `b²` is a corner's, and only
+    /// corners come before it in key order (none ties with it).
     #[inline(always)]
-    fn corners(&self) -> ([u64; 4], i64) {
+    fn centroid_cell(&self) -> ([i64; 2], i64) {
         let n = self.n;
         let (fx, fy) = (self.sx.div_euclid(n), self.sy.div_euclid(n));
-        let keys = core::array::from_fn(|i| {
-            let p = [fx + (i & 1) as i64, fy + (i >> 1) as i64];
-            self.key_near(p).unwrap_or(u64::MAX)
-        });
         // In units of 1/n, as the keys' distances: the centroid sits `rx`
         // past column fx, so the columns fx − 1 and fx + 2 lie n + rx and
         // 2n − rx from it; rows likewise.
         let (rx, ry) = (self.sx - fx * n, self.sy - fy * n);
         let b = (n + rx).min(2 * n - rx).min(n + ry).min(2 * n - ry);
-        (keys, b * b)
+        ([fx, fy], b * b)
+    }
+
+    /// The keys of the four corners of the square at `low`
+    /// ([`Self::centroid_cell`]); `u64::MAX` for those outside the
+    /// bounding box or the window.
+    #[inline(always)]
+    fn corner_keys(&self, low: [i64; 2]) -> [u64; 4] {
+        core::array::from_fn(|i| {
+            let p = [low[0] + (i & 1) as i64, low[1] + (i >> 1) as i64];
+            self.key_near(p).unwrap_or(u64::MAX)
+        })
     }
 
     /// [`Self::rank_of`] for a simple fan not listed: `Some(rank)` when
@@ -795,9 +801,9 @@ impl PositionsFirst {
                 .filter(|&&other| other < key && self.is_free(self.point_of(other)))
                 .count()
         };
-        let (corners, bound) = self.corners();
+        let (low, bound) = self.centroid_cell();
         let nearer = if distance_of(key) < bound {
-            nearer_free(&corners)
+            nearer_free(&self.corner_keys(low))
         } else {
             nearer_free(&self.window())
         };

@@ -398,16 +398,22 @@ fn code_step(x: &mut u32, step: Step, mut put: impl FnMut(u8)) {
     }
 }
 
-/// The bytes of one lane's payload under `models`: its values are every
-/// `lanes`-th symbol from `lane`. Static tables let the steps be taken
+/// The bytes of one lane's payload under `models` (`adaptive`: one of them
+/// is): its values are every `lanes`-th symbol from `lane`. Static tables let the steps be taken
 /// backwards straight from the values; an adaptive table's decisions
 /// depend on the values before, so they are listed forwards first.
-fn lane_len(symbols: &[Symbol], models: &[Model], lane: usize, lanes: usize) -> usize {
+fn lane_len(
+    symbols: &[Symbol],
+    models: &[Model],
+    adaptive: bool,
+    lane: usize,
+    lanes: usize,
+) -> usize {
     if lane >= symbols.len() {
         return 0;
     }
     let (mut x, mut bytes) = (STATE_LOW, 0usize);
-    if models.iter().any(|m| matches!(m, Model::Adaptive { .. })) {
+    if adaptive {
         let mine: Vec<&Symbol> = symbols.iter().skip(lane).step_by(lanes).collect();
         for step in lane_steps(&mine, models, lane, lanes).into_iter().rev() {
             code_step(&mut x, step, |_| bytes += 1);
@@ -450,7 +456,7 @@ pub fn encoded_chunk_len(
     let adaptive = models.iter().any(|m| matches!(m, Model::Adaptive { .. }));
     let lanes_len: usize = (0..lanes)
         .map(|lane| {
-            let len = lane_len(symbols, &models, lane, lanes);
+            let len = lane_len(symbols, &models, adaptive, lane, lanes);
             varint_len(len as u32) + len
         })
         .sum();

@@ -541,7 +541,7 @@ const DEFLATE_QUICK_RATIO: (usize, usize) = (3, 2);
 /// rANS chunks have `contexts` tables for it (`context::count`): byte-codec
 /// chunks of at most `params.chunk_limit` bytes, rANS chunks of at most
 /// `params.rans_chunk_limit` values. [`coded_len_under`] counts the same
-/// choices without writing the rANS lanes: a change here goes there too
+/// chunks without writing the rANS lanes
 /// (`tests::the_coded_length_is_the_framed_one`).
 fn substream_chunks(
     sub: &SubstreamWriter,
@@ -565,22 +565,34 @@ fn substream_chunks(
         ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None, map),
         ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l), map),
         ChunkCodec::Rans { lanes } => {
-            let rans = rans_in(lanes);
             let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
-            // Level 10 is slow (up to 1,500 match probes per byte); a quick
-            // level-1 pass first rules it out where it cannot win.
-            let quick = byte_chunks(sub.as_bytes(), limit, Some(1), map);
-            if size(&quick) * DEFLATE_QUICK_RATIO.1 >= size(&rans) * DEFLATE_QUICK_RATIO.0 {
-                return rans;
-            }
-            let deflate = byte_chunks(sub.as_bytes(), limit, Some(10), map);
-            if size(&rans) < size(&deflate) {
-                rans
-            } else {
-                deflate
-            }
+            let rans = rans_in(lanes);
+            let rans_size = size(&rans);
+            rans_or_deflate((rans, rans_size), |level| {
+                let deflate = byte_chunks(sub.as_bytes(), limit, Some(level), map);
+                let deflate_size = size(&deflate);
+                (deflate, deflate_size)
+            })
         }
         ChunkCodec::RansAlways { lanes } => rans_in(lanes),
+    }
+}
+
+/// The rANS codec's choice (SPEC §5.2: any codec per chunk): `rans`, or
+/// `deflate_at(10)` where that is smaller, each with its payload bytes.
+/// Level 10 is slow (up to 1,500 match probes per byte); a quick level-1
+/// pass first rules it out where it cannot win ([`DEFLATE_QUICK_RATIO`]).
+/// [`substream_chunks`] chooses chunks so, [`coded_len_under`] lengths.
+fn rans_or_deflate<T>(rans: (T, usize), mut deflate_at: impl FnMut(u8) -> (T, usize)) -> T {
+    let quick = deflate_at(1);
+    if quick.1 * DEFLATE_QUICK_RATIO.1 >= rans.1 * DEFLATE_QUICK_RATIO.0 {
+        return rans.0;
+    }
+    let deflate = deflate_at(10);
+    if rans.1 < deflate.1 {
+        rans.0
+    } else {
+        deflate.0
     }
 }
 
@@ -646,16 +658,12 @@ pub fn coded_len_under(
         ChunkCodec::Stored => byte_codec(None),
         ChunkCodec::Deflate(l) => byte_codec(Some(l)),
         ChunkCodec::RansAlways { lanes } => rans_len(lanes),
-        // `substream_chunks`' choice between rANS and deflate.
         ChunkCodec::Rans { lanes } => {
             let rans = rans_len(lanes);
-            let quick = byte_codec(Some(1));
-            if quick.0 * DEFLATE_QUICK_RATIO.1 >= rans.0 * DEFLATE_QUICK_RATIO.0 {
-                rans
-            } else {
-                let deflate = byte_codec(Some(10));
-                if rans.0 < deflate.0 { rans } else { deflate }
-            }
+            rans_or_deflate((rans, rans.0), |level| {
+                let deflate = byte_codec(Some(level));
+                (deflate, deflate.0)
+            })
         }
     })
 }
