@@ -701,6 +701,48 @@ fn the_chosen_record_order_is_never_larger_than_wings_first() {
     assert!(auto * 20 < wings_first * 19, "{auto} against {wings_first}");
 }
 
+/// A level of 65,536 splits or more chooses its record order on its first
+/// eighth where one order is clearly smaller, and writes the other's
+/// records no further (`geometry::code_geometry`): a terrain whose finest
+/// level has more than 65,536 splits still round-trips, reads that level
+/// positions first (it is about a fifth smaller), and is smaller than the
+/// same terrain read wings first. Forced, positions first and a tie rule
+/// take the same early path.
+#[test]
+fn a_large_level_chooses_its_record_order_on_its_first_eighth() {
+    let terrain = splitstream_encoder::input::fractal_terrain(400, 7);
+    let finest = |options: &EncodeOptions| {
+        let stream = encode(&terrain, options, |_| {}).expect("encode").stream;
+        let header = Header::parse(&stream).expect("header");
+        let table = LevelTable::parse(&stream, &header).expect("table");
+        let k = table.len() - 1;
+        let (e, previous) = (table.get(k), table.get(k - 1));
+        let splits = e.vertex_count - previous.vertex_count;
+        assert!(splits >= 65_536, "{splits} splits");
+        let bytes = &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
+        let lh = LevelHeader::parse(bytes, false, header.level_rules()).expect("level");
+        (stream.len(), lh.record_order, lh.ties)
+    };
+    let auto = EncodeOptions::default();
+    assert_roundtrip(&terrain, &auto);
+    let (size, order, _) = finest(&auto);
+    assert_eq!(order, RecordOrder::PositionsFirst);
+    let wings_first = EncodeOptions {
+        records: Some(RecordOrder::WingsFirst),
+        ..EncodeOptions::default()
+    };
+    let (wings_first_size, ..) = finest(&wings_first);
+    assert!(size < wings_first_size, "{size} against {wings_first_size}");
+    let forced = EncodeOptions {
+        records: Some(RecordOrder::PositionsFirst),
+        ties: Some(Ties::Falling),
+        ..EncodeOptions::default()
+    };
+    assert_roundtrip(&terrain, &forced);
+    let (_, order, ties) = finest(&forced);
+    assert_eq!((order, ties), (RecordOrder::PositionsFirst, Ties::Falling));
+}
+
 /// Adaptive rANS tables (format 3.9, the default): streams round-trip
 /// with and without them in 1 and 4 lanes, under both schedules; a stream
 /// with one marks minor version 9, one without keeps its feature's, and

@@ -12,14 +12,14 @@
 
 use std::sync::mpsc::{self, Receiver, Sender, SyncSender};
 
-use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, NONE};
-use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter};
+use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, NONE, substream};
+use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter, coded_len};
 use splitstream_decoder_core::{
-    Plane, PlanePolicy, PositionMode, Ring, SplitFan, Target, WingCandidates, add_residual,
-    arc_means, constrained_positions, context, predict, residual,
+    Plane, PlanePolicy, PositionMode, RecordOrder, Ring, SplitFan, Target, Ties, WingCandidates,
+    add_residual, arc_means, constrained_positions, context, predict, residual,
 };
 
-use super::policies::{SplitResiduals, early_choice_at};
+use super::policies::{SplitResiduals, early_choice_at, ranking_params};
 use super::positions_first::{
     PositionsFirstCoding, SplitSeen, WingsFirstRecord, escape_wing_context,
 };
@@ -130,18 +130,35 @@ pub struct LevelGeometry {
     pub positions_first: Option<PositionsFirstCoding>,
 }
 
+/// What a level whose records may be read positions first needs to choose
+/// its record order on its first eighth, as it chooses its policies
+/// (`policies::EARLY_CHOICE_SPLITS`).
+pub struct EarlyOrder {
+    /// What the residual coder's kept plane policy costs so far
+    /// (`policies::code_policies`).
+    pub edge_cost: Receiver<usize>,
+    /// `--records positions-first`: nothing to weigh.
+    pub forced: bool,
+    /// `--ties`: the only tie rule.
+    pub forced_ties: Option<Ties>,
+}
+
 /// Codes the batches arriving on `batches` for one level of `splits` splits
 /// and passes each batch's residual vectors on to `residuals` (the plane
 /// policies' coder); `heights`: whether the residuals under `height` are
 /// worth computing. A large level keeps one wing policy once its first
-/// eighth is coded (`policies::EARLY_CHOICE_SPLITS`). An error names the
-/// first split whose record does not give back its positions or whose
+/// eighth is coded (`policies::EARLY_CHOICE_SPLITS`), and with `order`
+/// its record order where one is clearly smaller ([`EARLY_ORDER_MARGIN`]):
+/// the other order's records are not written after that. An error names
+/// the first split whose record does not give back its positions or whose
 /// wings may not be wings: an encoder bug.
+#[allow(clippy::too_many_arguments)]
 pub fn code_geometry(
     batches: GeometryReceiver,
     residuals: Sender<Vec<SplitResiduals>>,
     mut wings: WingCoding,
     mut positions_first: Option<PositionsFirstCoding>,
+    order: Option<EarlyOrder>,
     params: &StreamParams,
     splits: usize,
     heights: bool,
@@ -150,6 +167,9 @@ pub fn code_geometry(
     // A large level's wing policy is chosen on its first eighth (unless
     // forced: then there is nothing to choose).
     let mut early = early_choice_at(splits);
+    // Whether the records read wings first are still written (until the
+    // level chooses positions first).
+    let mut wings_first = true;
     let mut seen = 0;
     let mut placement = SubstreamWriter::default();
     let mut ring = Ring::default();
@@ -170,7 +190,7 @@ pub fn code_geometry(
                 return Err(format!("the ring of {} is too long", g.id));
             }
             let (o, d) = (g.o as usize, g.d as usize);
-            if !wings.write(positions, &ring, &g.eligible, o, d) {
+            if wings_first && !wings.write(positions, &ring, &g.eligible, o, d) {
                 return Err(format!(
                     "a wing of the collapse of {} was a candidate at the start of its round",
                     g.id
@@ -206,11 +226,23 @@ pub fn code_geometry(
         }
         // A closed channel means the coder failed: its error is reported
         // when it is joined.
-        let _ = residuals.send(out);
+        if wings_first {
+            let _ = residuals.send(out);
+        }
         seen += batch.splits.len();
         if early.is_some_and(|at| seen >= at) {
             early = None;
-            wings.choose_early(params);
+            let wing_cost = wings.choose_early(params);
+            if let (Some(pf), Some(order)) = (&mut positions_first, &order) {
+                match choose_order_early(pf, order, wing_cost, &placement, params) {
+                    Some(RecordOrder::PositionsFirst) => {
+                        pf.chosen = true;
+                        wings_first = false;
+                    }
+                    Some(RecordOrder::WingsFirst) => positions_first = None,
+                    None => {}
+                }
+            }
         }
         batch.splits.clear();
         batch.ring_positions.clear();
@@ -221,6 +253,62 @@ pub fn code_geometry(
         placement,
         positions_first,
     })
+}
+
+/// A large level chooses its record order on its first eighth only where
+/// one order codes it smaller than the other by more than this share
+/// (1/32, about 3 %); closer ones are weighed on the whole level.
+/// Measured on the demo terrains and the Jacksboro DEM (BENCHMARKS.md,
+/// "The record order chosen early"): the first eighth ranked the orders as
+/// the whole level did wherever they were 3.7 % apart or more, and the one
+/// level it ranked otherwise (the 4M terrain's level 1) was 0.3 % apart.
+const EARLY_ORDER_MARGIN: usize = 32;
+
+/// The early choice of a level's record order, on its first eighth, by
+/// the same measure as at the level's end (`replay::choose_record_order`)
+/// on what is written so far: the four substreams under positions first
+/// (under their cheapest tie rule) against the wings (`wing_cost`), the
+/// `placement` codes and the residuals (`order.edge_cost`) under wings
+/// first. `None`: too close to call ([`EARLY_ORDER_MARGIN`]). Residuals
+/// whose coder failed (its error ends the level) count as costing more
+/// than any alternative.
+fn choose_order_early(
+    pf: &PositionsFirstCoding,
+    order: &EarlyOrder,
+    wing_cost: Option<usize>,
+    placement: &SubstreamWriter,
+    params: &StreamParams,
+) -> Option<RecordOrder> {
+    if order.forced {
+        return Some(RecordOrder::PositionsFirst);
+    }
+    let ranking = ranking_params(params);
+    let edge = order.edge_cost.recv().unwrap_or(usize::MAX);
+    let wings_first = [
+        wing_cost.unwrap_or(usize::MAX),
+        coded_len(placement, substream::PLACEMENT, &ranking),
+        edge,
+    ]
+    .into_iter()
+    .fold(0usize, usize::saturating_add);
+    let positions_first = match order.forced_ties {
+        Some(ties) => pf.cost_under(params, ties),
+        None => pf.cost(params).0,
+    };
+    clearly_smaller(positions_first, wings_first)
+}
+
+/// The order whose cost is below the other's by more than
+/// [`EARLY_ORDER_MARGIN`], if one is.
+fn clearly_smaller(positions_first: usize, wings_first: usize) -> Option<RecordOrder> {
+    let below = |a: usize, b: usize| a < b - b / EARLY_ORDER_MARGIN;
+    if below(positions_first, wings_first) {
+        Some(RecordOrder::PositionsFirst)
+    } else if below(wings_first, positions_first) {
+        Some(RecordOrder::WingsFirst)
+    } else {
+        None
+    }
 }
 
 /// The residual vectors of split `g` (and in constrained mode its placement
@@ -313,4 +401,26 @@ fn split_residuals(
         },
         placed,
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An order is chosen early only when it is clearly smaller: within
+    /// 1/32 of each other, the whole level decides.
+    #[test]
+    fn the_early_order_needs_a_clear_margin() {
+        use RecordOrder::{PositionsFirst, WingsFirst};
+        assert_eq!(clearly_smaller(900, 1000), Some(PositionsFirst));
+        assert_eq!(clearly_smaller(1000, 900), Some(WingsFirst));
+        // 1000 − 1000/32 = 969: 968 is clearly below, 969 is not.
+        assert_eq!(clearly_smaller(968, 1000), Some(PositionsFirst));
+        assert_eq!(clearly_smaller(969, 1000), None);
+        assert_eq!(clearly_smaller(1000, 969), None);
+        assert_eq!(clearly_smaller(1000, 1000), None);
+        assert_eq!(clearly_smaller(0, 0), None);
+        // A failed residual coder costs `usize::MAX`: never chosen.
+        assert_eq!(clearly_smaller(5, usize::MAX), Some(PositionsFirst));
+    }
 }

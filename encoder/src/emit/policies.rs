@@ -8,7 +8,7 @@
 //! written are the same as if each split had been coded six ways on the
 //! spot.
 
-use std::sync::mpsc::Receiver;
+use std::sync::mpsc::{Receiver, Sender};
 
 use splitstream_decoder_core::limits::substream;
 use splitstream_decoder_core::writer::{
@@ -126,12 +126,17 @@ pub fn early_choice_at(splits: usize) -> Option<usize> {
 /// [`choose_policy`] under `params`' ranking parameters as they grow;
 /// returns the substreams in `PlanePolicy::ALL` order (unused policies stay
 /// empty and unusable). A large level keeps only the cheapest policy once
-/// its first eighth is coded ([`EARLY_CHOICE_SPLITS`]).
+/// its first eighth is coded ([`EARLY_CHOICE_SPLITS`]), and then sends
+/// what its edge substream (and in optimal mode its placement substream)
+/// costs so far on `early_cost`, for the level's early choice of its
+/// record order (`geometry::code_geometry`): `usize::MAX` where no policy
+/// is usable.
 pub fn code_policies(
     batches: Receiver<Vec<SplitResiduals>>,
     params: &StreamParams,
     forced: Option<PlanePolicy>,
     splits: usize,
+    early_cost: Option<Sender<usize>>,
 ) -> Result<Vec<PolicyResiduals>, String> {
     let optimal = params.position_mode == PositionMode::Optimal;
     let ranking = ranking_params(params);
@@ -157,7 +162,7 @@ pub fn code_policies(
         .collect();
     // The policies still coded: all, or one once forced or chosen early.
     let mut only = forced;
-    let mut early = forced.is_none().then(|| early_choice_at(splits)).flatten();
+    let mut early = early_choice_at(splits);
     let mut seen = 0;
     for batch in batches {
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(out.iter_mut()) {
@@ -185,16 +190,31 @@ pub fn code_policies(
             // `choose_policy`). Coded values fit in 32 bits by
             // construction (both additions wrap, SPEC §7.4), so the
             // policy kept stays usable.
-            let best = (0..out.len())
-                .filter(|&i| out[i].usable)
-                .min_by_key(|&i| (out[i].cost(optimal, &ranking), i));
-            if let Some(best) = best {
-                only = Some(PlanePolicy::ALL[best]);
-                for (i, residuals) in out.iter_mut().enumerate() {
-                    if i != best {
-                        *residuals = PolicyResiduals::default();
+            let mut kept_cost = None;
+            if only.is_none() {
+                let best = (0..out.len())
+                    .filter(|&i| out[i].usable)
+                    .map(|i| (out[i].cost(optimal, &ranking), i))
+                    .min();
+                if let Some((cost, best)) = best {
+                    only = Some(PlanePolicy::ALL[best]);
+                    kept_cost = Some(cost);
+                    for (i, residuals) in out.iter_mut().enumerate() {
+                        if i != best {
+                            *residuals = PolicyResiduals::default();
+                        }
                     }
                 }
+            } else if early_cost.is_some() {
+                kept_cost = PlanePolicy::ALL
+                    .iter()
+                    .zip(&out)
+                    .find(|&(p, r)| only == Some(*p) && r.usable)
+                    .map(|(_, r)| r.cost(optimal, &ranking));
+            }
+            if let Some(tell) = &early_cost {
+                // Nobody listening (no record order to choose) is fine.
+                let _ = tell.send(kept_cost.unwrap_or(usize::MAX));
             }
         }
     }
@@ -332,7 +352,7 @@ mod tests {
         let splits = splits();
         let params = StreamParams::default();
         assert_eq!(params.position_mode, PositionMode::Optimal);
-        let coded = code_policies(batches(&splits), &params, None, splits.len()).unwrap();
+        let coded = code_policies(batches(&splits), &params, None, splits.len(), None).unwrap();
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(&coded) {
             assert!(residuals.usable);
             let (mut edge, mut placement) =
@@ -371,7 +391,7 @@ mod tests {
             };
             let ranking = ranking_params(&params);
             let splits = splits();
-            let coded = code_policies(batches(&splits), &params, None, splits.len()).unwrap();
+            let coded = code_policies(batches(&splits), &params, None, splits.len(), None).unwrap();
             for residuals in &coded {
                 let whole = coded_len(&residuals.edge, substream::EDGE, &ranking)
                     + coded_len(&residuals.placement, substream::PLACEMENT, &ranking);
@@ -421,14 +441,14 @@ mod tests {
             }
             rx
         };
-        let early = code_policies(send(&splits), &params, None, n).unwrap();
+        let early = code_policies(send(&splits), &params, None, n, None).unwrap();
         assert_eq!(early.iter().filter(|r| r.usable).count(), 1);
         let kept = early.iter().position(|r| r.usable).unwrap();
         // Every policy forced, over the whole level.
         let whole: Vec<(usize, Vec<u8>)> = PlanePolicy::ALL
             .iter()
             .map(|&p| {
-                let coded = code_policies(send(&splits), &params, Some(p), n).unwrap();
+                let coded = code_policies(send(&splits), &params, Some(p), n, None).unwrap();
                 let r = coded.into_iter().find(|r| r.usable).unwrap();
                 (
                     coded_len(&r.edge, substream::EDGE, &ranking),
@@ -457,7 +477,7 @@ mod tests {
             position_mode: PositionMode::Constrained,
             ..StreamParams::default()
         };
-        let coded = code_policies(batches(&splits()), &params, Some(forced), 40).unwrap();
+        let coded = code_policies(batches(&splits()), &params, Some(forced), 40, None).unwrap();
         for (policy, residuals) in PlanePolicy::ALL.iter().zip(&coded) {
             assert_eq!(residuals.usable, *policy == forced);
             assert_eq!(residuals.edge.as_bytes().is_empty(), *policy != forced);

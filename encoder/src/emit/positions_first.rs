@@ -1,7 +1,8 @@
 //! A level's records read positions first (SPEC §7.4 "Positions first",
 //! format 3.7): the geometry thread writes every split's record both ways,
 //! and the level keeps the record order whose four substreams (wing-offset,
-//! wing-distance, edge, placement) code smallest.
+//! wing-distance, edge, placement) code smallest (a large level, where
+//! one order is clearly smaller, on its first eighth).
 //!
 //! A split is written positions first when its fan has free lattice
 //! points, its new vertex is one of them and its wings are one of the
@@ -38,6 +39,10 @@ pub struct PositionsFirstCoding {
     /// rules ([`Ties::Rising`], [`Ties::Falling`]): the level keeps the
     /// rule whose wings code smallest (SPEC §5.1, §7.4; 3.8).
     diagonal_wings: [[SubstreamWriter; 2]; 2],
+    /// Whether a large level chose this order on its first eighth
+    /// (`geometry::code_geometry`): its records read wings first are not
+    /// written after that, and the level is not weighed again.
+    pub chosen: bool,
     /// Splits read positions first, and escapes.
     pub named: usize,
     pub escaped: usize,

@@ -20,7 +20,8 @@ use rayon::prelude::*;
 use super::deficits::DeficitCoding;
 use super::flags::FlagCoding;
 use super::geometry::{
-    GeometryBatch, GeometrySender, LevelGeometry, SplitGeometry, code_geometry, geometry_channels,
+    EarlyOrder, GeometryBatch, GeometrySender, LevelGeometry, SplitGeometry, code_geometry,
+    geometry_channels,
 };
 use super::levels::LevelPlan;
 use super::policies::{choose_policy, code_policies, early_choice_at, ranking_params};
@@ -451,7 +452,22 @@ pub fn replay(
             let (batches, coded_batches) = mpsc::channel();
             let splits = steps.iter().map(|&k| s.steps[k].len()).sum();
             let mut flag_coding = FlagCoding::new(params, deficit_contexts);
-            let coder = scope.spawn(move || code_policies(coded_batches, params, plane, splits));
+            // A large level whose records may be read positions first
+            // chooses its record order on its first eighth, with the
+            // residuals' cost so far from their coder.
+            let (early_cost, order) = if try_positions_first {
+                let (tell, edge_cost) = mpsc::channel();
+                let order = EarlyOrder {
+                    edge_cost,
+                    forced: records == Some(RecordOrder::PositionsFirst),
+                    forced_ties,
+                };
+                (Some(tell), Some(order))
+            } else {
+                (None, None)
+            };
+            let coder = scope
+                .spawn(move || code_policies(coded_batches, params, plane, splits, early_cost));
             let (geometry_batches, geometry_in) = geometry_channels();
             let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
             let wing_coding = WingCoding::new(wing_policy);
@@ -462,6 +478,7 @@ pub fn replay(
                     batches,
                     wing_coding,
                     positions_first,
+                    order,
                     params,
                     splits,
                     heights,
@@ -628,7 +645,9 @@ fn choose_record_order(
     forced_ties: Option<Ties>,
 ) -> Option<(PlanePolicy, WingPolicy, RecordOrder, Ties)> {
     let pf = positions_first?;
-    let ties = if forced == Some(RecordOrder::PositionsFirst) {
+    // A large level that chose positions first on its first eighth
+    // (`geometry::code_geometry`) wrote no wings-first records after it.
+    let ties = if forced == Some(RecordOrder::PositionsFirst) || pf.chosen {
         forced_ties.unwrap_or_else(|| pf.cost(params).1)
     } else {
         // The eight substreams are costed in parallel: after the last

@@ -71,19 +71,18 @@ impl WingCoding {
     /// Keeps only the policy whose wing substreams code smallest so far,
     /// ties to the earlier policy (a large level's early choice, see
     /// `policies::EARLY_CHOICE_SPLITS`): later splits are written under it
-    /// alone.
-    pub fn choose_early(&mut self, params: &StreamParams) {
+    /// alone. Returns what its two substreams cost so far.
+    pub fn choose_early(&mut self, params: &StreamParams) -> Option<usize> {
         let ranking = ranking_params(params);
-        let best = (0..self.coded.len())
+        let (cost, best) = (0..self.coded.len())
             .filter_map(|i| Some((cost(self.coded[i].as_ref()?, &ranking), i)))
-            .min();
-        if let Some((_, best)) = best {
-            for (i, coded) in self.coded.iter_mut().enumerate() {
-                if i != best {
-                    *coded = None;
-                }
+            .min()?;
+        for (i, coded) in self.coded.iter_mut().enumerate() {
+            if i != best {
+                *coded = None;
             }
         }
+        Some(cost)
     }
 
     /// Puts the cheapest policy's wing substreams into `subs` (ids 1..=7 at
