@@ -743,6 +743,26 @@ fn a_large_level_chooses_its_record_order_on_its_first_eighth() {
     assert_eq!((order, ties), (RecordOrder::PositionsFirst, Ties::Falling));
 }
 
+/// The other way: a sphere's fans have few free lattice points in x and
+/// y, so a large level of it is clearly smaller read wings first, chooses
+/// that on its first eighth, and drops its positions-first records.
+#[test]
+fn a_large_level_of_a_sphere_chooses_wings_first_early() {
+    let sphere = splitstream_encoder::input::icosphere(7);
+    let options = EncodeOptions::default();
+    assert_roundtrip(&sphere, &options);
+    let stream = encode(&sphere, &options, |_| {}).expect("encode").stream;
+    let header = Header::parse(&stream).expect("header");
+    let table = LevelTable::parse(&stream, &header).expect("table");
+    let k = table.len() - 1;
+    let (e, previous) = (table.get(k), table.get(k - 1));
+    let splits = e.vertex_count - previous.vertex_count;
+    assert!(splits >= 65_536, "{splits} splits");
+    let bytes = &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
+    let lh = LevelHeader::parse(bytes, false, header.level_rules()).expect("level");
+    assert_eq!(lh.record_order, RecordOrder::WingsFirst);
+}
+
 /// Adaptive rANS tables (format 3.9, the default): streams round-trip
 /// with and without them in 1 and 4 lanes, under both schedules; a stream
 /// with one marks minor version 9, one without keeps its feature's, and
