@@ -15,13 +15,13 @@ use std::sync::mpsc::{self, Receiver, Sender, SyncSender};
 use splitstream_decoder_core::limits::{MAX_SPLIT_VALENCE, NONE, substream};
 use splitstream_decoder_core::writer::{StreamParams, SubstreamWriter, coded_len};
 use splitstream_decoder_core::{
-    Plane, PlanePolicy, PositionMode, RecordOrder, Ring, SplitFan, Target, Ties, WingCandidates,
-    add_residual, arc_means, constrained_positions, context, predict, residual,
+    Plane, PlanePolicy, PositionMode, Ring, SplitFan, Target, Ties, WingCandidates, add_residual,
+    arc_means, constrained_positions, context, predict, residual,
 };
 
 use super::policies::{SplitResiduals, early_choice_at, ranking_params};
 use super::positions_first::{
-    PositionsFirstCoding, SplitSeen, WingsFirstRecord, escape_wing_context,
+    PositionsFirstCoding, SplitSeen, WingsFirstRecord, cheapest, escape_wing_context,
 };
 use super::wings::WingCoding;
 
@@ -235,11 +235,14 @@ pub fn code_geometry(
             let wing_cost = wings.choose_early(params);
             if let (Some(pf), Some(order)) = (&mut positions_first, &order) {
                 match choose_order_early(pf, order, wing_cost, &placement, params) {
-                    Some(RecordOrder::PositionsFirst) => {
+                    Some(EarlyChoice::PositionsFirst(ties)) => {
                         pf.chosen = true;
+                        if let Some(ties) = ties {
+                            pf.keep_ties(ties);
+                        }
                         wings_first = false;
                     }
-                    Some(RecordOrder::WingsFirst) => positions_first = None,
+                    Some(EarlyChoice::WingsFirst) => positions_first = None,
                     None => {}
                 }
             }
@@ -255,14 +258,22 @@ pub fn code_geometry(
     })
 }
 
-/// A large level chooses its record order on its first eighth only where
-/// one order codes it smaller than the other by more than this share
-/// (1/32, about 3 %); closer ones are weighed on the whole level.
+/// A large level chooses its record order, and its tie rule, on its first
+/// eighth only where one codes it smaller than the other by more than this
+/// share (1/32, about 3 %); closer ones are weighed on the whole level.
 /// Measured on the demo terrains and the Jacksboro DEM (BENCHMARKS.md,
 /// "The record order chosen early"): the first eighth ranked the orders as
 /// the whole level did wherever they were 3.7 % apart or more, and the one
 /// level it ranked otherwise (the 4M terrain's level 1) was 0.3 % apart.
 const EARLY_ORDER_MARGIN: usize = 32;
+
+/// A record order chosen on a level's first eighth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum EarlyChoice {
+    WingsFirst,
+    /// With the tie rule, where one was clearly the cheapest (or forced).
+    PositionsFirst(Option<Ties>),
+}
 
 /// The early choice of a level's record order, on its first eighth, by
 /// the same measure as at the level's end (`replay::choose_record_order`)
@@ -278,9 +289,14 @@ fn choose_order_early(
     wing_cost: Option<usize>,
     placement: &SubstreamWriter,
     params: &StreamParams,
-) -> Option<RecordOrder> {
+) -> Option<EarlyChoice> {
+    let (rest, by_rule) = pf.costs_by_rule(params, order.forced_ties);
+    let ties = match order.forced_ties {
+        Some(ties) => Some(ties),
+        None => clear_tie_rule(&by_rule),
+    };
     if order.forced {
-        return Some(RecordOrder::PositionsFirst);
+        return Some(EarlyChoice::PositionsFirst(ties));
     }
     let ranking = ranking_params(params);
     let edge = order.edge_cost.recv().unwrap_or(usize::MAX);
@@ -291,24 +307,29 @@ fn choose_order_early(
     ]
     .into_iter()
     .fold(0usize, usize::saturating_add);
-    let positions_first = match order.forced_ties {
-        Some(ties) => pf.cost_under(params, ties),
-        None => pf.cost(params).0,
-    };
-    clearly_smaller(positions_first, wings_first)
-}
-
-/// The order whose cost is below the other's by more than
-/// [`EARLY_ORDER_MARGIN`], if one is.
-fn clearly_smaller(positions_first: usize, wings_first: usize) -> Option<RecordOrder> {
-    let below = |a: usize, b: usize| a < b - b / EARLY_ORDER_MARGIN;
-    if below(positions_first, wings_first) {
-        Some(RecordOrder::PositionsFirst)
-    } else if below(wings_first, positions_first) {
-        Some(RecordOrder::WingsFirst)
+    let positions_first = rest + cheapest(&by_rule).0;
+    if clearly_below(positions_first, wings_first) {
+        Some(EarlyChoice::PositionsFirst(ties))
+    } else if clearly_below(wings_first, positions_first) {
+        Some(EarlyChoice::WingsFirst)
     } else {
         None
     }
+}
+
+/// Whether `a` is below `b` by more than [`EARLY_ORDER_MARGIN`].
+fn clearly_below(a: usize, b: usize) -> bool {
+    a < b - b / EARLY_ORDER_MARGIN
+}
+
+/// The tie rule whose wings cost clearly less than every other's, if one
+/// does.
+fn clear_tie_rule(by_rule: &[(usize, Ties)]) -> Option<Ties> {
+    let (best, ties) = cheapest(by_rule);
+    by_rule
+        .iter()
+        .all(|&(cost, other)| other == ties || clearly_below(best, cost))
+        .then_some(ties)
 }
 
 /// The residual vectors of split `g` (and in constrained mode its placement
@@ -407,20 +428,30 @@ fn split_residuals(
 mod tests {
     use super::*;
 
-    /// An order is chosen early only when it is clearly smaller: within
-    /// 1/32 of each other, the whole level decides.
+    /// An order or a tie rule is chosen early only when it is clearly
+    /// smaller: within 1/32 of each other, the whole level decides.
     #[test]
-    fn the_early_order_needs_a_clear_margin() {
-        use RecordOrder::{PositionsFirst, WingsFirst};
-        assert_eq!(clearly_smaller(900, 1000), Some(PositionsFirst));
-        assert_eq!(clearly_smaller(1000, 900), Some(WingsFirst));
+    fn early_choices_need_a_clear_margin() {
         // 1000 − 1000/32 = 969: 968 is clearly below, 969 is not.
-        assert_eq!(clearly_smaller(968, 1000), Some(PositionsFirst));
-        assert_eq!(clearly_smaller(969, 1000), None);
-        assert_eq!(clearly_smaller(1000, 969), None);
-        assert_eq!(clearly_smaller(1000, 1000), None);
-        assert_eq!(clearly_smaller(0, 0), None);
-        // A failed residual coder costs `usize::MAX`: never chosen.
-        assert_eq!(clearly_smaller(5, usize::MAX), Some(PositionsFirst));
+        assert!(clearly_below(968, 1000));
+        assert!(!clearly_below(969, 1000));
+        assert!(!clearly_below(1000, 1000));
+        assert!(!clearly_below(0, 0));
+        // A failed residual coder costs `usize::MAX`.
+        assert!(clearly_below(5, usize::MAX));
+        use Ties::{Falling, Ring, Rising};
+        assert_eq!(
+            clear_tie_rule(&[(1000, Ring), (900, Rising), (1100, Falling)]),
+            Some(Rising)
+        );
+        assert_eq!(
+            clear_tie_rule(&[(1000, Ring), (980, Rising), (1100, Falling)]),
+            None
+        );
+        assert_eq!(clear_tie_rule(&[(700, Falling)]), Some(Falling));
+        assert_eq!(
+            clear_tie_rule(&[(0, Ring), (0, Rising), (0, Falling)]),
+            None
+        );
     }
 }

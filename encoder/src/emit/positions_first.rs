@@ -1,8 +1,9 @@
 //! A level's records read positions first (SPEC §7.4 "Positions first",
 //! format 3.7): the geometry thread writes every split's record both ways,
 //! and the level keeps the record order whose four substreams (wing-offset,
-//! wing-distance, edge, placement) code smallest (a large level, where
-//! one order is clearly smaller, on its first eighth).
+//! wing-distance, edge, placement) code smallest, and the tie rule whose
+//! wings do (a large level, where one order or rule is clearly smaller,
+//! on its first eighth).
 //!
 //! A split is written positions first when its fan has free lattice
 //! points, its new vertex is one of them and its wings are one of the
@@ -31,17 +32,18 @@ use super::policies::ranking_params;
 #[derive(Clone, Default)]
 pub struct PositionsFirstCoding {
     pf: PositionsFirst,
-    /// Substreams 2, 3, 6 and 7 (wing-offset, wing-distance, edge,
-    /// placement) of the level under this order; the wing ranks of the
-    /// first two are those under [`Ties::Ring`].
-    subs: [SubstreamWriter; 4],
-    /// The wing-offset and wing-distance substreams under the other tie
-    /// rules ([`Ties::Rising`], [`Ties::Falling`]): the level keeps the
-    /// rule whose wings code smallest (SPEC §5.1, §7.4; 3.8).
-    diagonal_wings: [[SubstreamWriter; 2]; 2],
+    /// Substreams 6 and 7 (edge, placement) of the level under this order.
+    rest: [SubstreamWriter; 2],
+    /// Substreams 2 and 3 (wing-offset, wing-distance) under each tie rule
+    /// of [`Ties::ALL`]: the level keeps the rule whose wings code
+    /// smallest (SPEC §5.1, §7.4; 3.8).
+    wings: [[SubstreamWriter; 2]; 3],
+    /// The one tie rule still written, once a large level chose it on its
+    /// first eighth ([`Self::keep_ties`]).
+    kept: Option<Ties>,
     /// Whether a large level chose this order on its first eighth
     /// (`geometry::code_geometry`): its records read wings first are not
-    /// written after that, and the level is not weighed again.
+    /// written after that, and the orders are not weighed again.
     pub chosen: bool,
     /// Splits read positions first, and escapes.
     pub named: usize,
@@ -74,40 +76,37 @@ pub struct WingsFirstRecord {
     pub vector: [i64; 3],
 }
 
-const WING_OFFSET: usize = 0;
-const WING_DISTANCE: usize = 1;
-const EDGE: usize = 2;
-const PLACEMENT: usize = 3;
-
 impl PositionsFirstCoding {
     /// Writes the record of split `s`, positions first where it can be,
     /// else `escape`.
     pub fn write(&mut self, s: &SplitSeen<'_>, escape: &WingsFirstRecord) {
-        match self.name(s) {
+        let named = self.name(s);
+        let kept = self.kept;
+        let rules = Ties::ALL
+            .into_iter()
+            .zip(&mut self.wings)
+            .filter(move |&(ties, _)| kept.is_none_or(|k| k == ties));
+        let [edge, placement] = &mut self.rest;
+        match named {
             Ok(named) => {
-                let [offset, distance, edge, placement] = &mut self.subs;
                 placement.byte_in(KIND_CONTEXT, named.kind);
                 edge.varint_in(rank_context(named.free), named.rank as u32);
                 if let Some(t) = named.offset {
                     placement.byte_in(OFFSET_CONTEXT, t);
                 }
-                offset.byte_in(choice_context(named.xs), named.u[0] as u8);
-                distance.byte_in(choice_context(named.ys), named.v[0] as u8);
                 edge.signed_in(Z_CONTEXT, named.r_z as i32);
-                for (t, [offset, distance]) in self.diagonal_wings.iter_mut().enumerate() {
-                    offset.byte_in(choice_context(named.xs), named.u[t + 1] as u8);
-                    distance.byte_in(choice_context(named.ys), named.v[t + 1] as u8);
+                for (ties, [offset, distance]) in rules {
+                    let t = ties as usize;
+                    offset.byte_in(choice_context(named.xs), named.u[t] as u8);
+                    distance.byte_in(choice_context(named.ys), named.v[t] as u8);
                 }
                 self.named += 1;
             }
             Err(has_free_points) => {
                 if has_free_points {
-                    self.subs[PLACEMENT].byte_in(KIND_CONTEXT, KIND_ESCAPE);
+                    placement.byte_in(KIND_CONTEXT, KIND_ESCAPE);
                 }
-                let [offset, distance, edge, placement] = &mut self.subs;
-                offset.byte_in(escape.wing_context, escape.ranks.0);
-                distance.byte_in(escape.wing_context, escape.ranks.1);
-                for [offset, distance] in &mut self.diagonal_wings {
+                for (_, [offset, distance]) in rules {
                     offset.byte_in(escape.wing_context, escape.ranks.0);
                     distance.byte_in(escape.wing_context, escape.ranks.1);
                 }
@@ -174,16 +173,23 @@ impl PositionsFirstCoding {
         let rank = self.pf.rank_of(n)?;
         // The lists do not depend on the tie rule, only their order.
         let xs = self.pf.order_xs(s.eligible, &edge);
+        // Under the rules still written (`u`, `v`: by `Ties::ALL` index).
+        let kept = self.kept;
+        let rules = || {
+            Ties::ALL
+                .into_iter()
+                .filter(move |&t| kept.is_none_or(|k| k == t))
+        };
         let mut u = [0; 3];
-        for (u, ties) in u.iter_mut().zip(Ties::ALL) {
+        for ties in rules() {
             self.pf.set_ties(ties);
-            *u = self.pf.rank_of_choice(xs, pair.0)?;
+            u[ties as usize] = self.pf.rank_of_choice(xs, pair.0)?;
         }
         let ys = self.pf.order_ys(&edge, pair.0);
         let mut v = [0; 3];
-        for (v, ties) in v.iter_mut().zip(Ties::ALL) {
+        for ties in rules() {
             self.pf.set_ties(ties);
-            *v = self.pf.rank_of_choice(ys, pair.1)?;
+            v[ties as usize] = self.pf.rank_of_choice(ys, pair.1)?;
         }
         // z: the fan's surface at the new x and y, or 0 where no wedge
         // holds it.
@@ -212,15 +218,25 @@ impl PositionsFirstCoding {
     /// them smallest (the lowest rule of equal cost: `ring` keeps the
     /// stream readable by 3.7 decoders); and that rule.
     pub fn cost(&self, params: &StreamParams) -> (usize, Ties) {
-        self.costs(params, None)
+        let (rest, wings) = self.costs_by_rule(params, None);
+        let (wing_cost, best) = cheapest(&wings);
+        (rest + wing_cost, best)
     }
 
     /// [`Self::cost`] with the wings under `ties`.
     pub fn cost_under(&self, params: &StreamParams, ties: Ties) -> usize {
-        self.costs(params, Some(ties)).0
+        let (rest, wings) = self.costs_by_rule(params, Some(ties));
+        rest + cheapest(&wings).0
     }
 
-    fn costs(&self, params: &StreamParams, only: Option<Ties>) -> (usize, Ties) {
+    /// The edge and placement substreams' cost under `params`' ranking
+    /// parameters, and the two wing substreams' under each tie rule still
+    /// written, or only under `only`.
+    pub fn costs_by_rule(
+        &self,
+        params: &StreamParams,
+        only: Option<Ties>,
+    ) -> (usize, Vec<(usize, Ties)>) {
         let ranking = ranking_params(params);
         let cost = |id: u8, sub: &SubstreamWriter| {
             coded_len_under(
@@ -231,69 +247,74 @@ impl PositionsFirstCoding {
                 &ranking,
             )
         };
-        let [offset, distance, edge, placement] = &self.subs;
-        let [rising, falling] = &self.diagonal_wings;
-        // Only the forced rule's wings are costed when one is forced.
-        let wings: Vec<(Ties, [&SubstreamWriter; 2])> = [
-            (Ties::Ring, [offset, distance]),
-            (Ties::Rising, [&rising[0], &rising[1]]),
-            (Ties::Falling, [&falling[0], &falling[1]]),
-        ]
-        .into_iter()
-        .filter(|&(ties, _)| only.is_none_or(|forced| forced == ties))
-        .collect();
-        let (rest, wing_costs) = rayon::join(
-            || cost(IDS[EDGE], edge) + cost(IDS[PLACEMENT], placement),
+        let [edge, placement] = &self.rest;
+        let only = only.or(self.kept);
+        let wings: Vec<(Ties, &[SubstreamWriter; 2])> = Ties::ALL
+            .into_iter()
+            .zip(&self.wings)
+            .filter(|&(ties, _)| only.is_none_or(|forced| forced == ties))
+            .collect();
+        rayon::join(
+            || cost(substream::EDGE, edge) + cost(substream::PLACEMENT, placement),
             || {
                 wings
                     .par_iter()
                     .map(|&(ties, [o, d])| {
-                        (
-                            cost(IDS[WING_OFFSET], o) + cost(IDS[WING_DISTANCE], d),
-                            ties,
-                        )
+                        let wings =
+                            cost(substream::WING_OFFSET, o) + cost(substream::WING_DISTANCE, d);
+                        (wings, ties)
                     })
-                    .collect::<Vec<(usize, Ties)>>()
+                    .collect()
             },
-        );
-        // The cheapest, the lowest rule of equal cost (`Ties::ALL` order).
-        let (wing_cost, best) = wing_costs
-            .into_iter()
-            .min_by_key(|&(c, ties)| (c, ties as u8))
-            .unwrap_or((0, Ties::Ring));
-        (rest + wing_cost, best)
+        )
+    }
+
+    /// Writes the wings under `ties` alone from now on (a large level's
+    /// early choice: `geometry::code_geometry`).
+    pub fn keep_ties(&mut self, ties: Ties) {
+        for (rule, wings) in Ties::ALL.into_iter().zip(&mut self.wings) {
+            if rule != ties {
+                *wings = Default::default();
+            }
+        }
+        self.kept = Some(ties);
+    }
+
+    /// The tie rule [`Self::keep_ties`] kept, if it was called.
+    pub fn kept_ties(&self) -> Option<Ties> {
+        self.kept
     }
 
     /// Puts the four substreams into `subs` (ids 1..=7 at 0..=6), the wings
     /// those under `ties`.
     pub fn install(self, ties: Ties, subs: &mut [SubstreamWriter]) {
-        let [offset, distance, edge, placement] = self.subs;
-        let [rising, falling] = self.diagonal_wings;
+        let [edge, placement] = self.rest;
+        let [ring, rising, falling] = self.wings;
         let [offset, distance] = match ties {
-            Ties::Ring => [offset, distance],
+            Ties::Ring => ring,
             Ties::Rising => rising,
             Ties::Falling => falling,
         };
-        for (id, sub) in IDS.into_iter().zip([offset, distance, edge, placement]) {
+        for (id, sub) in [
+            (substream::WING_OFFSET, offset),
+            (substream::WING_DISTANCE, distance),
+            (substream::EDGE, edge),
+            (substream::PLACEMENT, placement),
+        ] {
             subs[(id - substream::FLAGS) as usize] = sub;
         }
     }
 }
 
-/// Substream ids of [`PositionsFirstCoding::subs`].
-const IDS: [u8; 4] = [
-    substream::WING_OFFSET,
-    substream::WING_DISTANCE,
-    substream::EDGE,
-    substream::PLACEMENT,
-];
-
-const _: () = assert!(
-    IDS[WING_OFFSET] == substream::WING_OFFSET
-        && IDS[WING_DISTANCE] == substream::WING_DISTANCE
-        && IDS[EDGE] == substream::EDGE
-        && IDS[PLACEMENT] == substream::PLACEMENT
-);
+/// The cheapest of the wing costs by tie rule, the lowest rule of equal
+/// cost (`Ties::ALL` order); `(0, Ring)` for none.
+pub fn cheapest(wings: &[(usize, Ties)]) -> (usize, Ties) {
+    wings
+        .iter()
+        .copied()
+        .min_by_key(|&(c, ties)| (c, ties as u8))
+        .unwrap_or((0, Ties::Ring))
+}
 
 /// A record read positions first: its values and the counts their
 /// contexts come from.

@@ -646,8 +646,11 @@ fn choose_record_order(
 ) -> Option<(PlanePolicy, WingPolicy, RecordOrder, Ties)> {
     let pf = positions_first?;
     // A large level that chose positions first on its first eighth
-    // (`geometry::code_geometry`) wrote no wings-first records after it.
-    let ties = if forced == Some(RecordOrder::PositionsFirst) || pf.chosen {
+    // (`geometry::code_geometry`) wrote no wings-first records after it,
+    // and where it chose its tie rule too, no other rule's wings.
+    let ties = if let Some(ties) = pf.kept_ties() {
+        ties
+    } else if forced == Some(RecordOrder::PositionsFirst) || pf.chosen {
         forced_ties.unwrap_or_else(|| pf.cost(params).1)
     } else {
         // The eight substreams are costed in parallel: after the last
