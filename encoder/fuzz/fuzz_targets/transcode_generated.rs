@@ -60,6 +60,10 @@ fn options(choices: &mut Choices<'_>, input: Schedule, mode: PositionMode) -> Tr
         // The tie rule (3.8): per level, the cheapest (no choice byte of its
         // own, so that existing corpora keep their meaning).
         ties: None,
+        // Adaptive rANS tables where smaller (3.9), or static ones only:
+        // read last, so that an input of the earlier corpora, whose bytes
+        // ran out before, keeps the default (a zero byte).
+        adaptive_tables: choices.byte() & 1 == 0,
     }
 }
 
