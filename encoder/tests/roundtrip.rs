@@ -713,14 +713,7 @@ fn a_large_level_chooses_its_record_order_on_its_first_eighth() {
     let terrain = splitstream_encoder::input::fractal_terrain(400, 7);
     let finest = |options: &EncodeOptions| {
         let stream = encode(&terrain, options, |_| {}).expect("encode").stream;
-        let header = Header::parse(&stream).expect("header");
-        let table = LevelTable::parse(&stream, &header).expect("table");
-        let k = table.len() - 1;
-        let (e, previous) = (table.get(k), table.get(k - 1));
-        let splits = e.vertex_count - previous.vertex_count;
-        assert!(splits >= 65_536, "{splits} splits");
-        let bytes = &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
-        let lh = LevelHeader::parse(bytes, false, header.level_rules()).expect("level");
+        let lh = large_finest_level(&stream);
         (stream.len(), lh.record_order, lh.ties)
     };
     let auto = EncodeOptions::default();
@@ -752,15 +745,23 @@ fn a_large_level_of_a_sphere_chooses_wings_first_early() {
     let options = EncodeOptions::default();
     assert_roundtrip(&sphere, &options);
     let stream = encode(&sphere, &options, |_| {}).expect("encode").stream;
-    let header = Header::parse(&stream).expect("header");
-    let table = LevelTable::parse(&stream, &header).expect("table");
+    assert_eq!(
+        large_finest_level(&stream).record_order,
+        RecordOrder::WingsFirst
+    );
+}
+
+/// The header of `stream`'s finest level, which must add 65,536 splits
+/// or more (a level that makes its choices on its first eighth).
+fn large_finest_level(stream: &[u8]) -> LevelHeader<'_> {
+    let header = Header::parse(stream).expect("header");
+    let table = LevelTable::parse(stream, &header).expect("table");
     let k = table.len() - 1;
     let (e, previous) = (table.get(k), table.get(k - 1));
     let splits = e.vertex_count - previous.vertex_count;
     assert!(splits >= 65_536, "{splits} splits");
     let bytes = &stream[e.offset as usize..(e.offset + e.length as u64) as usize];
-    let lh = LevelHeader::parse(bytes, false, header.level_rules()).expect("level");
-    assert_eq!(lh.record_order, RecordOrder::WingsFirst);
+    LevelHeader::parse(bytes, false, header.level_rules()).expect("level")
 }
 
 /// Adaptive rANS tables (format 3.9, the default): streams round-trip

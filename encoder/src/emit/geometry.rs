@@ -147,23 +147,24 @@ pub struct EarlyOrder {
 /// and passes each batch's residual vectors on to `residuals` (the plane
 /// policies' coder); `heights`: whether the residuals under `height` are
 /// worth computing. A large level keeps one wing policy once its first
-/// eighth is coded (`policies::EARLY_CHOICE_SPLITS`), and with `order`
-/// its record order where one is clearly smaller ([`EARLY_ORDER_MARGIN`]):
+/// eighth is coded (`policies::EARLY_CHOICE_SPLITS`), and where its records
+/// may be read positions first (`positions_first`, with what the early
+/// choice needs) its record order where one is clearly smaller
+/// ([`EARLY_ORDER_MARGIN`]):
 /// the other order's records are not written after that. An error names
 /// the first split whose record does not give back its positions or whose
 /// wings may not be wings: an encoder bug.
-#[allow(clippy::too_many_arguments)]
 pub fn code_geometry(
     batches: GeometryReceiver,
     residuals: Sender<Vec<SplitResiduals>>,
     mut wings: WingCoding,
-    mut positions_first: Option<PositionsFirstCoding>,
-    order: Option<EarlyOrder>,
+    positions_first: Option<(PositionsFirstCoding, EarlyOrder)>,
     params: &StreamParams,
     splits: usize,
     heights: bool,
 ) -> Result<LevelGeometry, String> {
     let mode = params.position_mode;
+    let (mut positions_first, order) = positions_first.unzip();
     // A large level's wing policy is chosen on its first eighth (unless
     // forced: then there is nothing to choose).
     let mut early = early_choice_at(splits);

@@ -455,14 +455,14 @@ pub fn replay(
             // A large level whose records may be read positions first
             // chooses its record order on its first eighth, with the
             // residuals' cost so far from their coder.
-            let (early_cost, order) = if try_positions_first {
+            let (early_cost, positions_first) = if try_positions_first {
                 let (tell, edge_cost) = mpsc::channel();
                 let order = EarlyOrder {
                     edge_cost,
                     forced: records == Some(RecordOrder::PositionsFirst),
                     forced_ties,
                 };
-                (Some(tell), Some(order))
+                (Some(tell), Some((PositionsFirstCoding::default(), order)))
             } else {
                 (None, None)
             };
@@ -471,14 +471,12 @@ pub fn replay(
             let (geometry_batches, geometry_in) = geometry_channels();
             let heights = plane.is_none_or(|p| p == PlanePolicy::Height);
             let wing_coding = WingCoding::new(wing_policy);
-            let positions_first = try_positions_first.then(PositionsFirstCoding::default);
             let geometry_coder = scope.spawn(move || {
                 code_geometry(
                     geometry_in,
                     batches,
                     wing_coding,
                     positions_first,
-                    order,
                     params,
                     splits,
                     heights,
