@@ -135,10 +135,9 @@ pub struct LevelGeometry {
 /// (`policies::EARLY_CHOICE_SPLITS`).
 pub struct EarlyOrder {
     /// What the residual coder's kept plane policy costs so far
-    /// (`policies::code_policies`).
-    pub edge_cost: Receiver<usize>,
-    /// `--records positions-first`: nothing to weigh.
-    pub forced: bool,
+    /// (`policies::code_policies`); `None` under `--records
+    /// positions-first`, where there is nothing to weigh.
+    pub edge_cost: Option<Receiver<usize>>,
     /// `--ties`: the only tie rule.
     pub forced_ties: Option<Ties>,
 }
@@ -293,16 +292,18 @@ fn choose_order_early(
     placement: &SubstreamWriter,
     params: &StreamParams,
 ) -> Option<EarlyChoice> {
-    let (rest, by_rule) = pf.costs_by_rule(params, order.forced_ties);
-    let ties = match order.forced_ties {
-        Some(ties) => Some(ties),
-        None => clear_tie_rule(&by_rule),
-    };
-    if order.forced {
+    let Some(edge_cost) = &order.edge_cost else {
+        // Positions first forced: only the tie rule may be chosen.
+        let ties = order.forced_ties.or_else(|| {
+            let (_, by_rule) = pf.costs_by_rule(params, None);
+            clear_tie_rule(&by_rule)
+        });
         return Some(EarlyChoice::PositionsFirst(ties));
-    }
+    };
+    let (rest, by_rule) = pf.costs_by_rule(params, order.forced_ties);
+    let ties = order.forced_ties.or_else(|| clear_tie_rule(&by_rule));
     let ranking = ranking_params(params);
-    let edge = order.edge_cost.recv().unwrap_or(usize::MAX);
+    let edge = edge_cost.recv().unwrap_or(usize::MAX);
     let wings_first = [
         wing_cost.unwrap_or(usize::MAX),
         coded_len(placement, substream::PLACEMENT, &ranking),

@@ -455,17 +455,17 @@ pub fn replay(
             // A large level whose records may be read positions first
             // chooses its record order on its first eighth, with the
             // residuals' cost so far from their coder.
-            let (early_cost, positions_first) = if try_positions_first {
-                let (tell, edge_cost) = mpsc::channel();
+            // (Forced, it has no order to weigh, and the coder no cost to
+            // send.)
+            let weighed = try_positions_first && records != Some(RecordOrder::PositionsFirst);
+            let (early_cost, edge_cost) = weighed.then(mpsc::channel).unzip();
+            let positions_first = try_positions_first.then(|| {
                 let order = EarlyOrder {
                     edge_cost,
-                    forced: records == Some(RecordOrder::PositionsFirst),
                     forced_ties,
                 };
-                (Some(tell), Some((PositionsFirstCoding::default(), order)))
-            } else {
-                (None, None)
-            };
+                (PositionsFirstCoding::default(), order)
+            });
             let coder = scope
                 .spawn(move || code_policies(coded_batches, params, plane, splits, early_cost));
             let (geometry_batches, geometry_in) = geometry_channels();
