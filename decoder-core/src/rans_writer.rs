@@ -321,7 +321,8 @@ enum Step {
 /// The steps of one lane's values, in the decoder's order: each value's
 /// token (one symbol, or an adaptive table's decisions), then its raw bits
 /// low steps first.
-fn lane_steps(values: &[&Symbol], models: &[Model], lane: usize, lanes: usize) -> Vec<Step> {
+fn lane_steps(symbols: &[Symbol], models: &[Model], lane: usize, lanes: usize) -> Vec<Step> {
+    let values = symbols.iter().skip(lane).step_by(lanes);
     let mut steps = Vec::with_capacity(values.len() * 2);
     let mut probs: Vec<Vec<(u16, u8)>> = models
         .iter()
@@ -331,7 +332,7 @@ fn lane_steps(values: &[&Symbol], models: &[Model], lane: usize, lanes: usize) -
         })
         .collect();
     debug_assert!(lane < lanes);
-    for &&(ctx, value) in values {
+    for &(ctx, value) in values {
         let (token, extra, low) = token_of(value);
         match &models[ctx as usize] {
             Model::Static { start, freq } => {
@@ -374,6 +375,46 @@ fn lane_steps(values: &[&Symbol], models: &[Model], lane: usize, lanes: usize) -
     steps
 }
 
+/// Bits of the numerators [`DIVISORS`] divides exactly: a coder state
+/// about to take a symbol step stays below `((STATE_LOW >> PROB_BITS) << 8)
+/// × freq` ≤ 2^31 (SPEC §5.5.4, taken backwards).
+const DIVIDEND_BITS: u32 = 31;
+
+/// For each frequency `f` in `1..=PROB_SCALE`, a multiplier `m` and shift
+/// `s` with `x / f == (x × m) >> s` for every `x < 2^DIVIDEND_BITS`
+/// (entry 0 unused). Coding a symbol divides the state by its frequency;
+/// a division takes a CPU several times the cycles of a multiplication, and
+/// every step of a lane depends on the one before.
+///
+/// With `l = ceil(log2 f)`, `s = DIVIDEND_BITS + l` and `m = ceil(2^s / f)`:
+/// `2^s ≤ m·f < 2^s + f ≤ 2^s + 2^l`, which makes the quotient exact for
+/// dividends below `2^DIVIDEND_BITS` (T. Granlund and P. L. Montgomery,
+/// "Division by invariant integers using multiplication", 1994, theorem
+/// 4.2); `m ≤ 2^32`, so `x × m` fits 64 bits.
+static DIVISORS: [(u64, u32); PROB_SCALE as usize + 1] = divisors();
+
+const fn divisors() -> [(u64, u32); PROB_SCALE as usize + 1] {
+    let mut table = [(0u64, 0u32); PROB_SCALE as usize + 1];
+    let mut f = 1u64;
+    while f <= PROB_SCALE as u64 {
+        let l = 64 - (f - 1).leading_zeros();
+        let s = DIVIDEND_BITS + l;
+        table[f as usize] = ((1u64 << s).div_ceil(f), s);
+        f += 1;
+    }
+    table
+}
+
+/// `x / freq` and `x % freq` for a coder state `x < 2^DIVIDEND_BITS` and a
+/// frequency in `1..=PROB_SCALE`, by [`DIVISORS`].
+#[inline(always)]
+fn div_rem(x: u32, freq: u32) -> (u32, u32) {
+    debug_assert!(x < 1 << DIVIDEND_BITS && (1..=PROB_SCALE).contains(&freq));
+    let (m, s) = DIVISORS[freq as usize];
+    let q = ((x as u64 * m) >> s) as u32;
+    (q, x - q * freq)
+}
+
 /// A lane's coder state `x` after one step taken backwards (rANS codes the
 /// decoder's last step first); `put` takes each byte it shifts out.
 #[inline(always)]
@@ -393,53 +434,52 @@ fn code_step(x: &mut u32, step: Step, mut put: impl FnMut(u8)) {
                 put(*x as u8);
                 *x >>= 8;
             }
-            *x = ((*x / freq) << PROB_BITS) + (*x % freq) + start;
+            let (q, r) = div_rem(*x, freq);
+            *x = (q << PROB_BITS) + r + start;
         }
     }
 }
 
-/// The bytes of one lane's payload under `models` (`adaptive`: one of them
-/// is): its values are every `lanes`-th symbol from `lane`. Static tables let the steps be taken
+/// Codes one lane of a chunk under `models` (`adaptive`: one of them is)
+/// backwards, the decoder's last step first: its values are every
+/// `lanes`-th symbol from `lane`. `put` takes the bytes in the order they
+/// are shifted out (the reverse of the lane's), and the final state, which
+/// the lane starts with, is returned. Static tables let the steps be taken
 /// backwards straight from the values; an adaptive table's decisions
 /// depend on the values before, so they are listed forwards first.
-fn lane_len(
+fn code_lane(
     symbols: &[Symbol],
     models: &[Model],
     adaptive: bool,
-    lane: usize,
-    lanes: usize,
-) -> usize {
-    if lane >= symbols.len() {
-        return 0;
-    }
-    let (mut x, mut bytes) = (STATE_LOW, 0usize);
+    (lane, lanes): (usize, usize),
+    mut put: impl FnMut(u8),
+) -> u32 {
+    let mut x = STATE_LOW;
     if adaptive {
-        let mine: Vec<&Symbol> = symbols.iter().skip(lane).step_by(lanes).collect();
-        for step in lane_steps(&mine, models, lane, lanes).into_iter().rev() {
-            code_step(&mut x, step, |_| bytes += 1);
+        for step in lane_steps(symbols, models, lane, lanes).into_iter().rev() {
+            code_step(&mut x, step, &mut put);
         }
-    } else {
-        let last = lane + (symbols.len() - 1 - lane) / lanes * lanes;
-        for i in (lane..=last).rev().step_by(lanes) {
-            let (ctx, value) = symbols[i];
-            let (token, extra, low) = token_of(value);
-            // The raw steps, high first, then the token.
-            let mut done = extra.div_ceil(RAW_BITS_STEP) * RAW_BITS_STEP;
-            while done > 0 {
-                done -= RAW_BITS_STEP;
-                let count = (extra - done).min(RAW_BITS_STEP);
-                let bits = (low >> done) & ((1 << count) - 1);
-                code_step(&mut x, Step::Raw { count, bits }, |_| bytes += 1);
-            }
-            let Model::Static { start, freq } = &models[ctx as usize] else {
-                unreachable!("only static tables here");
-            };
-            let (start, freq) = (start[token as usize], freq[token as usize]);
-            code_step(&mut x, Step::Symbol { start, freq }, |_| bytes += 1);
-        }
+        return x;
     }
-    // The final state.
-    bytes + 4
+    let last = lane + (symbols.len() - 1 - lane) / lanes * lanes;
+    for i in (lane..=last).rev().step_by(lanes) {
+        let (ctx, value) = symbols[i];
+        let (token, extra, low) = token_of(value);
+        // The raw steps, high first, then the token.
+        let mut done = extra.div_ceil(RAW_BITS_STEP) * RAW_BITS_STEP;
+        while done > 0 {
+            done -= RAW_BITS_STEP;
+            let count = (extra - done).min(RAW_BITS_STEP);
+            let bits = (low >> done) & ((1 << count) - 1);
+            code_step(&mut x, Step::Raw { count, bits }, &mut put);
+        }
+        let Model::Static { start, freq } = &models[ctx as usize] else {
+            unreachable!("only static tables here");
+        };
+        let (start, freq) = (start[token as usize], freq[token as usize]);
+        code_step(&mut x, Step::Symbol { start, freq }, &mut put);
+    }
+    x
 }
 
 /// The length of the payload [`encode_chunk_with`] writes for the same
@@ -454,12 +494,14 @@ pub fn encoded_chunk_len(
     let mut tables = Vec::new();
     let models = choose_models(symbols, contexts, lanes, adaptive_tables, &mut tables);
     let adaptive = models.iter().any(|m| matches!(m, Model::Adaptive { .. }));
-    let lanes_len: usize = (0..lanes)
+    let lanes_len: usize = (0..lanes.min(symbols.len()))
         .map(|lane| {
-            let len = lane_len(symbols, &models, adaptive, lane, lanes);
+            let mut len = 4; // the final state
+            code_lane(symbols, &models, adaptive, (lane, lanes), |_| len += 1);
             varint_len(len as u32) + len
         })
-        .sum();
+        .sum::<usize>()
+        + lanes.saturating_sub(symbols.len()); // empty lanes: a 0 length
     (tables.len() + lanes_len, adaptive)
 }
 
@@ -485,17 +527,12 @@ pub fn encode_chunk_with(
     let adaptive = models.iter().any(|m| matches!(m, Model::Adaptive { .. }));
     let mut lane_bytes: Vec<Vec<u8>> = Vec::with_capacity(lanes);
     for lane in 0..lanes {
-        let mine: Vec<&Symbol> = symbols.iter().skip(lane).step_by(lanes).collect();
-        if mine.is_empty() {
+        if lane >= symbols.len() {
             lane_bytes.push(Vec::new());
             continue;
         }
-        // rANS codes backwards: the decoder's last step first.
-        let mut x = STATE_LOW;
         let mut bytes = Vec::new(); // reversed
-        for step in lane_steps(&mine, &models, lane, lanes).into_iter().rev() {
-            code_step(&mut x, step, |b| bytes.push(b));
-        }
+        let x = code_lane(symbols, &models, adaptive, (lane, lanes), |b| bytes.push(b));
         bytes.extend_from_slice(&x.to_be_bytes());
         bytes.reverse();
         // The state was pushed big-endian then reversed: little-endian now.
@@ -514,6 +551,30 @@ pub fn encode_chunk_with(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// The multiplications divide exactly: for every frequency, at the
+    /// multiples and their neighbours near 0 and near the largest state,
+    /// and at pseudo-random states.
+    #[test]
+    fn the_reciprocals_divide_exactly() {
+        let top = (1u64 << DIVIDEND_BITS) - 1;
+        let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+        for f in 1..=PROB_SCALE as u64 {
+            let last = top / f * f;
+            let mut xs = vec![0, 1, f - 1, f, f + 1, 2 * f - 1, 2 * f, top, top - 1];
+            xs.extend([last - 1, last, last + 1, last - f, last - f - 1]);
+            for _ in 0..64 {
+                seed = seed
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                xs.push((seed >> 33) & top);
+            }
+            for x in xs.into_iter().filter(|&x| x <= top) {
+                let (x, f) = (x as u32, f as u32);
+                assert_eq!(div_rem(x, f), (x / f, x % f), "{x} / {f}");
+            }
+        }
+    }
 
     proptest! {
         /// The length counted without writing is the written payload's,
