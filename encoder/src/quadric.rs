@@ -3,6 +3,20 @@
 
 use core::ops::{Add, AddAssign};
 
+/// Errors at most this fraction of `a²x² + b²y² + c²z² + d²` are rounding
+/// noise and count as 0. A plane quadric is positive semidefinite, so each
+/// of [`Quadric::error`]'s ten terms is at most that sum (Cauchy–Schwarz:
+/// `|2ab·xy| ≤ a²x² + b²y²`), and the error of a point on every plane,
+/// truly 0, comes out as up to some 3e-14 of it (measured on tilted planes
+/// of 800 triangles, the test below; rounding grows with the planes
+/// merged into a quadric, hence the margin). There the noise ranked the flat
+/// collapses by chance instead of by the sub-grid tie-break, and it sat
+/// around the flat threshold: a 300 × 300 ramp took 186 rounds and 8.76
+/// bits per vertex instead of 77 and 8.18 (encoder/BENCHMARKS.md, "Flat
+/// and tilted rasters"). A real deviation is far above: one step of 14-bit
+/// quantization over the extent is about 4e-9 of the sum.
+pub const NUMERIC_ZERO: f64 = 1e-12;
+
 /// A symmetric quadric `Q` such that the error of a point `p` is
 /// `[p 1] Q [p 1]^T`, stored as its upper triangle.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -48,21 +62,29 @@ impl Quadric {
         Quadric::from_plane(unit, d, 0.5 * len)
     }
 
-    /// Error of point `p`.
+    /// Error of point `p`; exactly 0 where it is within the rounding noise
+    /// of its own terms ([`NUMERIC_ZERO`]).
     pub fn error(&self, p: [f64; 3]) -> f64 {
         let [a2, ab, ac, ad, b2, bc, bd, c2, cd, d2] = self.c;
         let [x, y, z] = p;
-        let e = a2 * x * x
+        let (xx, yy, zz) = (a2 * x * x, b2 * y * y, c2 * z * z);
+        let e = xx
             + 2.0 * ab * x * y
             + 2.0 * ac * x * z
             + 2.0 * ad * x
-            + b2 * y * y
+            + yy
             + 2.0 * bc * y * z
             + 2.0 * bd * y
-            + c2 * z * z
+            + zz
             + 2.0 * cd * z
             + d2;
-        e.max(0.0)
+        // Below 0 is rounding too, and NaN (terms that overflowed) stays 0
+        // as `max(0.0)` made it before; an infinite error stays infinite.
+        if e > NUMERIC_ZERO * (xx + yy + zz + d2) || e == f64::INFINITY {
+            e
+        } else {
+            0.0
+        }
     }
 
     /// The point minimising the error, or `None` when the 3x3 system is
@@ -271,6 +293,54 @@ mod tests {
         let q = Quadric::from_plane([0.0, 0.0, 1.0], -2.0, 1.0);
         assert!((q.error([5.0, -3.0, 5.0]) - 9.0).abs() < 1e-12);
         assert_eq!(q.minimizer(), None, "one plane is singular");
+    }
+
+    /// The triangles of a tilted plane far from the origin, merged as a
+    /// vertex's quadric: a point on the plane has no error at all (its
+    /// evaluation is rounding noise), a point a step off it has its
+    /// squared distance.
+    #[test]
+    fn a_tilted_plane_has_no_error_on_it() {
+        let z = |x: f64, y: f64| 1.5 * x - 2.25 * y + 333.0;
+        let mut q = Quadric::ZERO;
+        for i in 0..20 {
+            for j in 0..20 {
+                let (x, y) = (123.0 + i as f64, 77.0 + j as f64);
+                let p = |dx: f64, dy: f64| [x + dx, y + dy, z(x + dx, y + dy)];
+                q += Quadric::from_triangle(p(0.0, 0.0), p(1.0, 0.0), p(1.0, 1.0));
+                q += Quadric::from_triangle(p(0.0, 0.0), p(1.0, 1.0), p(0.0, 1.0));
+            }
+        }
+        let mut noisy = 0;
+        for i in 0..=20 {
+            for j in 0..=20 {
+                let (x, y) = (123.0 + i as f64 + 0.5, 77.0 + j as f64 + 0.25);
+                assert_eq!(q.error([x, y, z(x, y)]), 0.0, "({x}, {y})");
+                // Without the noise floor these are not 0.
+                let [a2, ab, ac, ad, b2, bc, bd, c2, cd, d2] = q.c;
+                let p = [x, y, z(x, y)];
+                let raw = a2 * p[0] * p[0]
+                    + 2.0 * ab * p[0] * p[1]
+                    + 2.0 * ac * p[0] * p[2]
+                    + 2.0 * ad * p[0]
+                    + b2 * p[1] * p[1]
+                    + 2.0 * bc * p[1] * p[2]
+                    + 2.0 * bd * p[1]
+                    + c2 * p[2] * p[2]
+                    + 2.0 * cd * p[2]
+                    + d2;
+                noisy += usize::from(raw > 0.0);
+                // A hundredth off the plane along z (about one step of
+                // 14-bit quantization over this extent): the distance is
+                // 0.01 / |n|, n = (1.5, -2.25, -1), times the 800
+                // triangles' area, 400 |n|.
+                let off = q.error([x, y, z(x, y) + 0.01]);
+                let n2: f64 = 1.5 * 1.5 + 2.25 * 2.25 + 1.0;
+                let want = 400.0 * 1e-4 / n2.sqrt();
+                assert!((off - want).abs() < 1e-4 * want, "{off} against {want}");
+            }
+        }
+        assert!(noisy > 100, "the plane is noisy enough to test: {noisy}");
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! ghost, valence limits, wings that keep a fan, no folded triangles.
 //! Read-only, so the pairs a step chooses can be checked in parallel.
 
+use super::select::{Scale, other_placements};
 use super::state::{MAX_VALENCE, State};
 use crate::corner_table::{Fan, NONE, next, prev};
 use crate::quadric::{cross, dot, sub};
@@ -101,6 +102,42 @@ pub fn check_walked(
     target: [f64; 3],
     k: &mut CheckScratch,
 ) -> Result<Plan, ()> {
+    let plan = check_linked(s, p, c, k)?;
+    if unfolded(s, p, c, target, k) {
+        Ok(plan)
+    } else {
+        Err(())
+    }
+}
+
+/// [`check_walked`] at `target`, the placement [`evaluate`](super::select::evaluate)
+/// gives, or where that folds a triangle at the first of its
+/// [`other_placements`] that does not: the placement taken, and the plan.
+/// On a flat raster a quarter of the first placements folded (a
+/// collapse into one end squashes a triangle onto a line of lattice
+/// points), and the steps spent two fifths of their time checking
+/// requests again (encoder/BENCHMARKS.md, "Flat and tilted rasters").
+pub fn check_placed(
+    s: &State,
+    p: u32,
+    c: u32,
+    target: [u32; 3],
+    scale: Scale,
+    k: &mut CheckScratch,
+) -> Result<([u32; 3], Plan), ()> {
+    let plan = check_linked(s, p, c, k)?;
+    if unfolded(s, p, c, s.to_metric(target), k) {
+        return Ok((target, plan));
+    }
+    other_placements(s, p, c, target, scale)
+        .find(|&other| unfolded(s, p, c, s.to_metric(other), k))
+        .map(|other| (other, plan))
+        .ok_or(())
+}
+
+/// Everything [`check_walked`] checks but the folds, which alone depend on
+/// where the merged vertex goes.
+fn check_linked(s: &State, p: u32, c: u32, k: &mut CheckScratch) -> Result<Plan, ()> {
     let t = &s.table;
     let left = k
         .fan_p
@@ -158,11 +195,6 @@ pub fn check_walked(
             return Err(());
         }
     }
-    if !keeps_orientation(s, p, c, target, &k.fan_p)
-        || !keeps_orientation(s, c, p, target, &k.fan_c)
-    {
-        return Err(());
-    }
     Ok(Plan {
         left,
         right,
@@ -170,6 +202,12 @@ pub fn check_walked(
         wing_b,
         valence_r,
     })
+}
+
+/// Whether collapsing `c` into `p` at `target` leaves every triangle of
+/// their fans (walked into `k`) unfolded.
+fn unfolded(s: &State, p: u32, c: u32, target: [f64; 3], k: &CheckScratch) -> bool {
+    keeps_orientation(s, p, c, target, &k.fan_p) && keeps_orientation(s, c, p, target, &k.fan_c)
 }
 
 /// Whether every triangle around `v` not containing `other` keeps a
@@ -205,4 +243,110 @@ fn keeps_orientation(s: &State, v: u32, other: u32, target: [f64; 3], fan: &Fan)
         let scale = dot(e1, e1) + dot(e2, e2);
         dot(old, new) > 0.0 && dot(new, new) > 1e-24 * scale * scale
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::corner_table::{next, prev};
+    use crate::mesh::Mesh;
+    use crate::quantize::{Lattice, Quantization, Units, quantize_with};
+    use crate::simplify::select::{Scale, evaluate};
+    use crate::simplify::state::SimplifyOptions;
+
+    /// A level raster whose inner samples are moved off the grid within the
+    /// plane: every collapse has error 0 in every placement, and some
+    /// placements fold triangles that others do not.
+    fn jittered_plane(side: usize) -> Mesh {
+        let mut x = 0x2545_F491u32;
+        let mut jitter = || {
+            x ^= x << 13;
+            x ^= x >> 17;
+            x ^= x << 5;
+            (x % 61) as f64 / 100.0 - 0.3
+        };
+        let mut positions = Vec::new();
+        for r in 0..side {
+            for c in 0..side {
+                let inner = (1..side - 1).contains(&r) && (1..side - 1).contains(&c);
+                let (dx, dy) = if inner {
+                    (jitter(), jitter())
+                } else {
+                    (0.0, 0.0)
+                };
+                positions.push([c as f64 + dx, r as f64 + dy, 0.0]);
+            }
+        }
+        let mut triangles = Vec::new();
+        for r in 0..side as u32 - 1 {
+            for c in 0..side as u32 - 1 {
+                let v = r * side as u32 + c;
+                let s = side as u32;
+                triangles.push([v, v + 1, v + s + 1]);
+                triangles.push([v, v + s + 1, v + s]);
+            }
+        }
+        Mesh {
+            positions,
+            triangles,
+        }
+    }
+
+    /// `check_placed` takes the first placement wherever `check_walked`
+    /// does, and otherwise another one only where that one passes
+    /// `check_walked` itself; on this plane that saves some collapses.
+    #[test]
+    fn a_folding_placement_gives_way_to_an_equal_one() {
+        let mesh = jittered_plane(24);
+        let q = quantize_with(
+            &mesh,
+            14,
+            Units::Linear,
+            Quantization::Uniform,
+            Lattice::Ignore,
+        );
+        let options = SimplifyOptions {
+            constrained: true,
+            ..SimplifyOptions::default()
+        };
+        let mut s = State::new(&q, &options);
+        s.quadrics = s.fan_quadrics(options.boundary_weight).expect("manifold");
+        let scale = Scale {
+            cell: 0.0,
+            flat: 1e-9,
+        };
+        let (mut k, mut rescued, mut valid) = (CheckScratch::default(), 0, 0);
+        for corner in 0..s.table.vertex.len() as u32 {
+            let (p, c) = (s.table.v(next(corner)), s.table.v(prev(corner)));
+            if p > c {
+                continue;
+            }
+            // (Collapses off the border have an error: its planes.)
+            let (target, error) = evaluate(&s, p, c).expect("no locked boundary");
+            if error != 0.0 {
+                continue;
+            }
+            let first = check_collapse(&s, p, c, s.to_metric(target), &mut k);
+            let placed = check_placed(&s, p, c, target, scale, &mut k);
+            match (first, placed) {
+                (Ok(plan), got) => {
+                    assert_eq!(got, Ok((target, plan)));
+                    valid += 1;
+                }
+                (Err(()), Ok((other, plan))) => {
+                    assert_ne!(other, target);
+                    assert_eq!(
+                        check_collapse(&s, p, c, s.to_metric(other), &mut k),
+                        Ok(plan)
+                    );
+                    rescued += 1;
+                }
+                (Err(()), Err(())) => {}
+            }
+        }
+        assert!(
+            valid > 1000 && rescued >= 10,
+            "{valid} valid, {rescued} rescued"
+        );
+    }
 }

@@ -7,7 +7,7 @@ use std::sync::atomic::Ordering::Relaxed;
 use rayon::prelude::*;
 
 use super::apply::Raw;
-use super::check::{CheckScratch, check_collapse};
+use super::check::{CheckScratch, check_placed};
 use super::parallel::{chunk_size, par_chunks_map};
 use super::refresh::RefreshChunk;
 use super::select::{Best, Choices, Known, Scale, evaluate, offer, pick_edge};
@@ -328,7 +328,9 @@ pub(super) fn validate(
                 let (p, c) = (v.min(b.other), v.max(b.other));
                 let (target, _) =
                     evaluate(s_now, p, c).expect("an edge with a finite error has a placement");
-                let ok = check_collapse(s_now, p, c, s_now.to_metric(target), &mut scratch).is_ok();
+                scratch.walk_p(s_now, p);
+                scratch.walk_c(s_now, c);
+                let ok = check_placed(s_now, p, c, target, scale, &mut scratch).is_ok();
                 out.push((v, ok));
             }
             out

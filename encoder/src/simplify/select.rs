@@ -58,11 +58,9 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
             _ => pc,
         }
     } else if s.constrained {
-        // P, C or the integer midpoint P + ((C - P) >> 1) (SPEC §7.4).
-        let mid: [u32; 3] =
-            std::array::from_fn(|k| (pp[k] as i64 + ((pc[k] as i64 - pp[k] as i64) >> 1)) as u32);
+        // P, C or their midpoint.
         let mut best = (pp, q.error(s.geometry(p)));
-        for cand in [pc, mid] {
+        for cand in [pc, midpoint(pp, pc)] {
             let e = q.error(s.to_metric(cand));
             if e < best.1 {
                 best = (cand, e);
@@ -77,6 +75,47 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
         std::array::from_fn(|k| to_grid(t[k] / s.metric[k], top))
     };
     Some((target, q.error(s.to_metric(target))))
+}
+
+/// The placements a collapse of (v, u) may take instead of `first`, the
+/// one [`evaluate`] gives, when that one folds a triangle: in constrained
+/// mode, those of P, C and their midpoint whose errors have `first`'s key
+/// under `scale`, in [`evaluate`]'s order; on a flat region (every error
+/// 0) all of them. None in optimal mode, whose placement has no equal.
+/// Taking an equal keeps the collapse's rank in its step.
+pub fn other_placements(
+    s: &State,
+    v: u32,
+    u: u32,
+    first: [u32; 3],
+    scale: Scale,
+) -> impl Iterator<Item = [u32; 3]> {
+    let (p, c) = (v.min(u), v.max(u));
+    let (pi, ci) = (p as usize, c as usize);
+    let locked = s.lock_boundary && (s.boundary[pi] || s.boundary[ci]);
+    let mut out = [[0u32; 3]; 2];
+    let mut len = 0;
+    if s.constrained && !locked {
+        let q = s.quadrics[pi] + s.quadrics[ci];
+        let (pp, pc) = (s.positions[pi], s.positions[ci]);
+        let key = error_key(q.error(s.to_metric(first)), scale);
+        for place in [pp, pc, midpoint(pp, pc)] {
+            if place != first
+                && !out[..len].contains(&place)
+                && error_key(q.error(s.to_metric(place)), scale) == key
+            {
+                out[len] = place;
+                len += 1;
+            }
+        }
+    }
+    out.into_iter().take(len)
+}
+
+/// The integer midpoint `P + ((C − P) >> 1)` of constrained mode (SPEC
+/// §7.4).
+fn midpoint(pp: [u32; 3], pc: [u32; 3]) -> [u32; 3] {
+    std::array::from_fn(|k| (pp[k] as i64 + ((pc[k] as i64 - pp[k] as i64) >> 1)) as u32)
 }
 
 /// `x.round().clamp(0.0, top) as u32` (round half away from zero) for a

@@ -6,7 +6,7 @@ use std::sync::atomic::Ordering::Relaxed;
 
 use rayon::prelude::*;
 
-use super::check::{CheckScratch, Plan, check_walked};
+use super::check::{CheckScratch, Plan, check_placed};
 use super::offers::prefetch_fan;
 use super::offers::{repick, validate};
 use super::parallel::{par_chunks_map, par_filter_into};
@@ -244,8 +244,9 @@ pub(super) fn step_winners(
                 let (target, error) =
                     evaluate(s_now, v, c).expect("an edge with a finite error has a placement");
                 debug_assert_eq!(error, b.error, "slot of ({v}, {c}) up to date");
-                let result = check_walked(s_now, v, c, s_now.to_metric(target), &mut scratch);
-                if result.is_ok() {
+                let placed = check_placed(s_now, v, c, target, scale, &mut scratch);
+                let result = placed.map(|(_, plan)| plan);
+                if let Ok((target, _)) = placed {
                     // The winner's endpoints and neighbours leave the
                     // game; no check of this pass reads the flags.
                     for x in scratch.neighbourhood() {
