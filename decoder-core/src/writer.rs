@@ -18,7 +18,7 @@ use crate::limits::{
 use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
 use crate::rans_segments::rans_segments;
-use crate::rans_writer::{Symbol, encode_chunk_with, encoded_chunk_len};
+use crate::rans_writer::{Symbol, encode_chunk_with, estimated_chunk_len};
 use crate::wing_order::WingPolicy;
 
 /// A growing substream: bytes, bits (least significant first) or varints
@@ -540,9 +540,9 @@ const DEFLATE_QUICK_RATIO: (usize, usize) = (3, 2);
 /// The chunks of a substream as `frame_level` codes them, in a level whose
 /// rANS chunks have `contexts` tables for it (`context::count`): byte-codec
 /// chunks of at most `params.chunk_limit` bytes, rANS chunks of at most
-/// `params.rans_chunk_limit` values. [`coded_len_under`] counts the same
-/// chunks without writing the rANS lanes
-/// (`tests::the_coded_length_is_the_framed_one`).
+/// `params.rans_chunk_limit` values. [`coded_len_under`] costs the same
+/// chunks, estimating the rANS lanes instead of coding them
+/// (`tests::the_coded_length_is_near_the_framed_one`).
 fn substream_chunks(
     sub: &SubstreamWriter,
     contexts: usize,
@@ -599,7 +599,10 @@ fn rans_or_deflate<T>(rans: (T, usize), mut deflate_at: impl FnMut(u8) -> (T, us
 /// Bytes substream `id` takes in a level framed with `params`, whose deficit
 /// contexts are `plain`: its chunk payloads and directory entries. Lets an
 /// encoder compare alternatives (the plane policies of SPEC §7.4) by their
-/// real cost.
+/// cost: exact under the byte codecs, and under rANS each lane of a chunk
+/// estimated from its values' bits ([`estimated_chunk_len`]; measured on
+/// the reference encoder's streams, exact with one lane and within 3 bytes
+/// a chunk with four).
 pub fn coded_len(sub: &SubstreamWriter, id: u8, params: &StreamParams) -> usize {
     coded_len_in(sub, id, DeficitContexts::Plain, params)
 }
@@ -625,9 +628,9 @@ pub fn coded_len_under(
     params: &StreamParams,
 ) -> usize {
     let contexts = context::count(id, deficits, records, params.schedule);
-    // The rANS chunks' payloads and count, their lanes counted, not
-    // written: the same cuts, tables and lengths as `substream_chunks`,
-    // which `frame_level` writes.
+    // The rANS chunks' payloads and count, their lanes estimated, not
+    // coded: the same cuts and tables as `substream_chunks`, which
+    // `frame_level` writes, and lanes within a byte or two of its own.
     let rans_len = |lanes: u8| {
         let symbols = sub.symbols();
         let limit = params.rans_chunk_limit.max(1) as usize;
@@ -636,7 +639,7 @@ pub fn coded_len_under(
             .iter()
             .map(|range| {
                 let values = &symbols[range.clone()];
-                encoded_chunk_len(values, contexts, lanes as usize, params.adaptive_tables).0
+                estimated_chunk_len(values, contexts, lanes as usize, params.adaptive_tables)
             })
             .sum();
         (payloads, segments.len())
@@ -811,11 +814,13 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
-        /// `coded_len_under` counts the rANS lanes instead of writing them;
-        /// its length is still that of the chunks `frame_level` writes,
-        /// under every codec, with and without adaptive tables.
+        /// `coded_len_under` estimates the rANS lanes instead of writing
+        /// them: its length is that of the chunks `frame_level` writes
+        /// under the byte codecs, and within a byte a lane of each rANS
+        /// chunk under the rANS codecs (whichever codec `Rans` then
+        /// takes), with and without adaptive tables.
         #[test]
-        fn the_coded_length_is_the_framed_one(
+        fn the_coded_length_is_near_the_framed_one(
             values in proptest::collection::vec((any::<u8>(), -3000i32..3000), 0..600),
             skew in 1i32..3000,
             codec_choice in 0u8..6,
@@ -852,7 +857,21 @@ mod tests {
                 .iter()
                 .map(|c| c.stored.len() + CHUNK_ENTRY_LEN)
                 .sum();
-            prop_assert_eq!(coded_len(&sub, substream::EDGE, &params), framed);
+            let lanes = match codec {
+                ChunkCodec::RansAlways { lanes } | ChunkCodec::Rans { lanes } => lanes as usize,
+                ChunkCodec::Stored | ChunkCodec::Deflate(_) => 0,
+            };
+            let rans_chunks =
+                rans_segments(sub.symbols(), contexts, lanes, rans_chunk_limit as usize).len();
+            let coded = coded_len(&sub, substream::EDGE, &params);
+            prop_assert!(
+                coded.abs_diff(framed) <= rans_chunks * lanes,
+                "coded {} bytes, framed {}, {} rANS chunks of {} lanes",
+                coded,
+                framed,
+                rans_chunks,
+                lanes
+            );
         }
     }
 }
