@@ -8,7 +8,7 @@ use alloc::vec::Vec;
 use crate::limits::CHUNK_ENTRY_LEN;
 use crate::limits::rans::{
     ADAPTIVE_BITS, ADAPTIVE_FLAG, ADAPTIVE_RATE_MIN, ADAPTIVE_START, ADAPTIVE_STATES,
-    ADAPTIVE_TOKENS, PROB_BITS, PROB_SCALE, RAW_BITS_STEP, STATE_LOW, TOKENS,
+    ADAPTIVE_TOKENS, MAX_LANES, PROB_BITS, PROB_SCALE, RAW_BITS_STEP, STATE_LOW, TOKENS,
 };
 use crate::rans::{adaptive_shift, normalise, token_of};
 
@@ -150,7 +150,7 @@ const FIRST_RATE: u8 = 7;
 /// The rates tried, from [`FIRST_RATE`] one step at a time towards the
 /// cheaper side while the cost falls (about three trials a context instead
 /// of one per rate: each is a pass over the context's values).
-fn best_rate(cost: impl Fn(u8) -> f64) -> (f64, u8) {
+fn best_rate(mut cost: impl FnMut(u8) -> f64) -> (f64, u8) {
     let rates = ADAPTIVE_RATE_MIN..=ADAPTIVE_RATE_MIN + 7;
     let mut best = (cost(FIRST_RATE), FIRST_RATE);
     let slower = (cost(FIRST_RATE + 1), FIRST_RATE + 1);
@@ -321,19 +321,27 @@ fn choose_models(
     for (ctx, (table, lanes_tokens)) in priced.into_iter().zip(&lanes_tokens).enumerate() {
         let tokens = table.counts.len();
         if may_adapt(tokens) {
-            let (bits, rate) =
-                best_rate(|rate| adaptive_bits(lanes_tokens, tokens, rate, |_, _| {}));
+            // Each rate's bits per lane, kept as the rates are tried.
+            let mut tried = [[0f64; MAX_LANES as usize]; 8];
+            let (bits, rate) = best_rate(|rate| {
+                let row = &mut tried[(rate - ADAPTIVE_RATE_MIN) as usize];
+                adaptive_bits(lanes_tokens, tokens, rate, |lane, bits| {
+                    // (At most `MAX_LANES` lanes: the header's limit.)
+                    if let Some(slot) = row.get_mut(lane) {
+                        *slot = bits;
+                    }
+                })
+            });
             let values: usize = lanes_tokens.iter().map(Vec::len).sum();
             if bits + ADAPTIVE_MIN_GAIN * values as f64 <= table.cost {
                 out.push(adaptive_byte(tokens, rate));
                 models.push(Model::Adaptive { tokens, rate });
                 if let Some(lane_bits) = lane_bits.as_deref_mut() {
                     // (Lanes past the values have no bits to add.)
-                    adaptive_bits(lanes_tokens, tokens, rate, |lane, bits| {
-                        if let Some(sum) = lane_bits.get_mut(lane) {
-                            *sum += bits;
-                        }
-                    });
+                    let row = &tried[(rate - ADAPTIVE_RATE_MIN) as usize];
+                    for (sum, bits) in lane_bits.iter_mut().zip(row) {
+                        *sum += bits;
+                    }
                 }
                 continue;
             }
