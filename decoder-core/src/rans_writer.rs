@@ -362,13 +362,20 @@ fn choose_models(
             }
         }
         if let Some(lane_bits) = lane_bits.as_deref_mut() {
+            // Each token's bits under the table, then each lane's tokens.
+            let token_bits = freq.map(|f| {
+                if f == 0 {
+                    0.0
+                } else {
+                    PROB_BITS as f64 - libm_log2(f as f64)
+                }
+            });
             for (lane, bits) in lane_bits.iter_mut().enumerate() {
                 let counts = &lane_histograms[lane * contexts + ctx];
                 *bits += counts
                     .iter()
-                    .zip(&freq)
-                    .filter(|(n, _)| **n > 0)
-                    .map(|(&n, &f)| n as f64 * (PROB_BITS as f64 - libm_log2(f as f64)))
+                    .zip(&token_bits)
+                    .map(|(&n, &b)| n as f64 * b)
                     .sum::<f64>();
             }
         }

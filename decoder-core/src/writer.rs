@@ -600,9 +600,8 @@ fn rans_or_deflate<T>(rans: (T, usize), mut deflate_at: impl FnMut(u8) -> (T, us
 /// contexts are `plain`: its chunk payloads and directory entries. Lets an
 /// encoder compare alternatives (the plane policies of SPEC §7.4) by their
 /// cost: exact under the byte codecs, and under rANS each lane of a chunk
-/// estimated from its values' bits ([`estimated_chunk_len`]; measured on
-/// the reference encoder's streams, exact with one lane and within 3 bytes
-/// a chunk with four).
+/// estimated from its values' bits, within a byte of its length
+/// ([`estimated_chunk_len`]).
 pub fn coded_len(sub: &SubstreamWriter, id: u8, params: &StreamParams) -> usize {
     coded_len_in(sub, id, DeficitContexts::Plain, params)
 }
@@ -630,7 +629,7 @@ pub fn coded_len_under(
     let contexts = context::count(id, deficits, records, params.schedule);
     // The rANS chunks' payloads and count, their lanes estimated, not
     // coded: the same cuts and tables as `substream_chunks`, which
-    // `frame_level` writes, and lanes within a byte or two of its own.
+    // `frame_level` writes, and each lane within a byte of its own.
     let rans_len = |lanes: u8| {
         let symbols = sub.symbols();
         let limit = params.rans_chunk_limit.max(1) as usize;
