@@ -213,9 +213,16 @@ fn unfolded(s: &State, p: u32, c: u32, target: [f64; 3], k: &CheckScratch) -> bo
 /// Whether every triangle around `v` not containing `other` keeps a
 /// non-degenerate normal within 90° of its old one when `v` moves to `target`.
 /// A triangle that was degenerate (no normal: coincident or collinear
-/// corners, as coarse quantization and sliver-ridden input make them) is
-/// held to the normal of `v`'s whole fan instead; without that, one such
-/// triangle refused every collapse of its corners for good.
+/// corners, as coarse quantization and sliver-ridden input make them) may
+/// stay degenerate, since the collapse makes it no worse; if it gains a
+/// normal, that is held to the normal of `v`'s whole fan. Requiring a normal
+/// of it refused every collapse of its corners but the one that removes
+/// it: on the Stanford dragon at 14 bits (19,010 triangles with two corners
+/// on one grid point) 30,000-35,000 requests were refused at every step,
+/// and checking them again was half of the simplification's time; the
+/// zero-length edges themselves could not collapse when a neighbouring
+/// triangle was degenerate too (encoder/BENCHMARKS.md, "Triangles that stay
+/// without a normal").
 fn keeps_orientation(s: &State, v: u32, other: u32, target: [f64; 3], fan: &Fan) -> bool {
     let t = &s.table;
     let pv = s.geometry(v);
@@ -229,7 +236,14 @@ fn keeps_orientation(s: &State, v: u32, other: u32, target: [f64; 3], fan: &Fan)
         let (d1, d2) = (sub(q1, pv), sub(q2, pv));
         let mut old = cross(d1, d2);
         let old_scale = dot(d1, d1) + dot(d2, d2);
+        let (e1, e2) = (sub(q1, target), sub(q2, target));
+        let new = cross(e1, e2);
+        let scale = dot(e1, e1) + dot(e2, e2);
+        let has_normal = dot(new, new) > 1e-24 * scale * scale;
         if dot(old, old) <= 1e-24 * old_scale * old_scale {
+            if !has_normal {
+                return true;
+            }
             old = *fan_normal.get_or_insert_with(|| {
                 fan.corners.iter().fold([0.0; 3], |n, &c| {
                     let (a, b) = (s.geometry(t.v(next(c))), s.geometry(t.v(prev(c))));
@@ -238,10 +252,7 @@ fn keeps_orientation(s: &State, v: u32, other: u32, target: [f64; 3], fan: &Fan)
                 })
             });
         }
-        let (e1, e2) = (sub(q1, target), sub(q2, target));
-        let new = cross(e1, e2);
-        let scale = dot(e1, e1) + dot(e2, e2);
-        dot(old, new) > 0.0 && dot(new, new) > 1e-24 * scale * scale
+        dot(old, new) > 0.0 && has_normal
     })
 }
 
@@ -348,5 +359,45 @@ mod tests {
             valid > 1000 && rescued >= 10,
             "{valid} valid, {rescued} rescued"
         );
+    }
+
+    /// A 5 × 5 raster (vertex `5 row + column` at (column, row)) whose
+    /// vertex 18 lies on vertex 13: triangle (12, 13, 18) has no normal.
+    fn raster_with_a_zero_length_edge() -> State {
+        let mut mesh = jittered_plane(5);
+        for p in &mut mesh.positions {
+            *p = [p[0].round(), p[1].round(), 0.0];
+        }
+        mesh.positions[18] = mesh.positions[13];
+        let q = quantize_with(
+            &mesh,
+            14,
+            Units::Linear,
+            Quantization::Uniform,
+            Lattice::Ignore,
+        );
+        let options = SimplifyOptions {
+            constrained: true,
+            ..SimplifyOptions::default()
+        };
+        State::new(&q, &options)
+    }
+
+    /// Collapsing 12 into 11 leaves (12, 13, 18) as it was, without a
+    /// normal: allowed, where requiring a normal refused it (and every other
+    /// collapse of 12 that does not remove that triangle). A triangle that
+    /// has a normal must still keep one: collapsing 13 into 12 at 13's
+    /// place squashes (12, 18, 17) onto the line from 13 to 17.
+    #[test]
+    fn a_triangle_without_a_normal_may_stay_so() {
+        let s = raster_with_a_zero_length_edge();
+        let mut k = CheckScratch::default();
+        let at = |v: usize| s.to_metric(s.positions[v]);
+        assert!(check_collapse(&s, 11, 12, at(11), &mut k).is_ok());
+        assert!(check_collapse(&s, 7, 12, at(7), &mut k).is_ok());
+        assert_eq!(check_collapse(&s, 12, 13, at(13), &mut k), Err(()));
+        // The zero-length edge itself, and a collapse far from it.
+        assert!(check_collapse(&s, 13, 18, at(13), &mut k).is_ok());
+        assert!(check_collapse(&s, 0, 1, at(0), &mut k).is_ok());
     }
 }

@@ -427,6 +427,42 @@ mod tests {
         );
     }
 
+    /// Steps a sphere of 10,242 vertices quantized to `bits` takes down to
+    /// 64 vertices in constrained mode, and the vertices it is left with.
+    fn sphere_steps(bits: u8) -> (usize, usize) {
+        let q = quantize(&crate::input::icosphere(5), bits, Units::Linear);
+        let options = SimplifyOptions {
+            target_vertices: 64,
+            constrained: true,
+            ..SimplifyOptions::default()
+        };
+        let s = simplify(&q, &options, |_| {});
+        (s.steps.len(), s.alive_count)
+    }
+
+    /// Quantized coarsely, a sphere has triangles with two corners on one
+    /// grid point (1,092 of 20,480 at 6 bits, 13,092 at 5, 18,548 at 4).
+    /// Such a triangle may stay without a normal
+    /// (`check::keeps_orientation`): when every collapse of its corners had
+    /// to give it one, the 5-bit sphere stopped after 2 steps and the 4-bit
+    /// one found no collapse at all.
+    #[test]
+    fn a_coarsely_quantized_sphere_simplifies_like_a_fine_one() {
+        let (fine, left) = sphere_steps(14);
+        assert_eq!(left, 64);
+        for bits in [4, 5, 6] {
+            let (steps, left) = sphere_steps(bits);
+            assert_eq!(
+                left, 64,
+                "{bits} bits: {left} vertices left after {steps} steps"
+            );
+            assert!(
+                steps * 4 <= fine * 5,
+                "{bits} bits: {steps} steps, 14 bits: {fine}"
+            );
+        }
+    }
+
     #[test]
     fn renumbering_keeps_the_collapses() {
         // Compaction happens at every halving; a mesh small enough that the

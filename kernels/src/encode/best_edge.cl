@@ -62,7 +62,8 @@ Eval evaluate(Topo t, __global const float *quadric, __global const Params *P, u
 }
 
 /* The WGSL kernel's test, stricter than the CPU's: a triangle that had no
- * normal (zero area) refuses, where the CPU holds it to the fan's normal. */
+ * normal (zero area) refuses, where the CPU lets it stay without one or
+ * holds the normal it gains to the fan's normal. */
 bool keeps_orientation(Topo t, uint v, uint other, float3 target, uint3 origin) {
     float3 pv = rel(t, v, origin);
     uint first = fan_first(t, v);

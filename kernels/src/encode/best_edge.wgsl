@@ -98,8 +98,9 @@ fn evaluate(v: u32, u: u32) -> Eval {
 // within 90 degrees of its old one when v moves to t (all in p's frame).
 // Slightly stricter than the CPU (f32), so the CPU's own check at apply
 // time rarely disagrees. A triangle that had no normal (zero area) refuses
-// here, where the CPU holds it to the fan's normal: on such input the GPU
-// backends offer fewer collapses than the CPU makes.
+// here, where the CPU lets it stay without one or holds the normal it gains
+// to the fan's normal: on such input the GPU backends offer fewer collapses
+// than the CPU makes.
 fn keeps_orientation(v: u32, other: u32, t: vec3<f32>, origin: vec3<u32>) -> bool {
     let pv = rel(v, origin);
     let first = fan_first(v);
