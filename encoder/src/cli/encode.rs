@@ -153,8 +153,9 @@ pub fn run(a: Args) -> CliResult {
     let stats = encoded.input;
     if encoded.rounds == 0 && n > SEED_VERTICES {
         // Seen on a DEM in degrees quantized with one step for degrees and
-        // metres: x and y fell on a handful of steps, every triangle was
-        // degenerate and no collapse passed its checks.
+        // metres, until a triangle without a normal was allowed to keep none
+        // (`simplify::check`): x and y fell on a handful of steps, every
+        // triangle was degenerate and no collapse passed its checks.
         let hint = if degrees_unconverted && options.quantization == Quantization::Uniform {
             "with --quantization uniform, x and y in degrees fall on a few steps of the height's \
              scale and every triangle degenerates: pass --geographic, or use --quantization per-axis"
