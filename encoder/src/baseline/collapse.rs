@@ -3,7 +3,8 @@
 
 use super::state::Simplifier;
 use crate::corner_table::{NONE, next, prev};
-use crate::quadric::{Quadric, cross, dot, sub};
+use crate::quadric::{Quadric, cross, sub};
+use crate::simplify::triangle_keeps_orientation;
 
 /// Most neighbours a vertex may end up with (boundary vertices count one
 /// extra), so valences fit the stream's byte-sized fields.
@@ -140,24 +141,26 @@ impl Simplifier<'_> {
 
     /// Whether every triangle around `v` that survives (does not contain
     /// `other`) keeps a non-degenerate normal within 90° of its old one when
-    /// `v` moves to `p`.
+    /// `v` moves to `p`, or stays without one: the parallel simplifier's
+    /// rule (`simplify::check`).
     fn keeps_orientation(&self, v: u32, other: u32, p: [f64; 3], fan: &[u32]) -> bool {
         let t = &self.table;
+        let pv = self.positions[v as usize];
+        let fan_normal = || {
+            fan.iter().fold([0.0; 3], |n, &c| {
+                let a = self.positions[t.v(next(c)) as usize];
+                let b = self.positions[t.v(prev(c)) as usize];
+                let x = cross(sub(a, pv), sub(b, pv));
+                [n[0] + x[0], n[1] + x[1], n[2] + x[2]]
+            })
+        };
         fan.iter().all(|&c| {
             let (n1, n2) = (t.v(next(c)), t.v(prev(c)));
             if n1 == other || n2 == other {
                 return true;
             }
-            let q1 = self.positions[n1 as usize];
-            let q2 = self.positions[n2 as usize];
-            let old = cross(
-                sub(q1, self.positions[v as usize]),
-                sub(q2, self.positions[v as usize]),
-            );
-            let (e1, e2) = (sub(q1, p), sub(q2, p));
-            let new = cross(e1, e2);
-            let scale = dot(e1, e1) + dot(e2, e2);
-            dot(old, new) > 0.0 && dot(new, new) > 1e-24 * scale * scale
+            let corners = [pv, self.positions[n1 as usize], self.positions[n2 as usize]];
+            triangle_keeps_orientation(corners, p, fan_normal)
         })
     }
 

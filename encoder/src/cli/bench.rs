@@ -30,7 +30,7 @@ struct Input {
     units: Units,
 }
 
-const INPUTS: [Input; 4] = [
+const INPUTS: [Input; 5] = [
     Input {
         name: "armadillo",
         file: "armadillo.off",
@@ -44,6 +44,11 @@ const INPUTS: [Input; 4] = [
     Input {
         name: "refined_elephant",
         file: "refined_elephant.off",
+        units: Units::Linear,
+    },
+    Input {
+        name: "dragon",
+        file: "dragon_vrip.ply",
         units: Units::Linear,
     },
     Input {

@@ -232,28 +232,42 @@ fn keeps_orientation(s: &State, v: u32, other: u32, target: [f64; 3], fan: &Fan)
         if n1 == other || n2 == other {
             return true;
         }
-        let (q1, q2) = (s.geometry(n1), s.geometry(n2));
-        let (d1, d2) = (sub(q1, pv), sub(q2, pv));
-        let mut old = cross(d1, d2);
-        let old_scale = dot(d1, d1) + dot(d2, d2);
-        let (e1, e2) = (sub(q1, target), sub(q2, target));
-        let new = cross(e1, e2);
-        let scale = dot(e1, e1) + dot(e2, e2);
-        let has_normal = dot(new, new) > 1e-24 * scale * scale;
-        if dot(old, old) <= 1e-24 * old_scale * old_scale {
-            if !has_normal {
-                return true;
-            }
-            old = *fan_normal.get_or_insert_with(|| {
+        let corners = [pv, s.geometry(n1), s.geometry(n2)];
+        triangle_keeps_orientation(corners, target, || {
+            *fan_normal.get_or_insert_with(|| {
                 fan.corners.iter().fold([0.0; 3], |n, &c| {
                     let (a, b) = (s.geometry(t.v(next(c))), s.geometry(t.v(prev(c))));
                     let x = cross(sub(a, pv), sub(b, pv));
                     [n[0] + x[0], n[1] + x[1], n[2] + x[2]]
                 })
-            });
-        }
-        dot(old, new) > 0.0 && has_normal
+            })
+        })
     })
+}
+
+/// The rule of [`keeps_orientation`] for one triangle `[v, n1, n2]` whose
+/// `v` moves to `target`; `fan_normal` gives the normal of `v`'s fan, asked
+/// for only when the triangle had none. Shared with the sequential baseline
+/// (`baseline::collapse`), so that both simplifiers refuse the same folds.
+pub(crate) fn triangle_keeps_orientation(
+    [pv, q1, q2]: [[f64; 3]; 3],
+    target: [f64; 3],
+    fan_normal: impl FnOnce() -> [f64; 3],
+) -> bool {
+    let (d1, d2) = (sub(q1, pv), sub(q2, pv));
+    let mut old = cross(d1, d2);
+    let old_scale = dot(d1, d1) + dot(d2, d2);
+    let (e1, e2) = (sub(q1, target), sub(q2, target));
+    let new = cross(e1, e2);
+    let scale = dot(e1, e1) + dot(e2, e2);
+    let has_normal = dot(new, new) > 1e-24 * scale * scale;
+    if dot(old, old) <= 1e-24 * old_scale * old_scale {
+        if !has_normal {
+            return true;
+        }
+        old = fan_normal();
+    }
+    dot(old, new) > 0.0 && has_normal
 }
 
 #[cfg(test)]

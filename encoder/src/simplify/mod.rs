@@ -54,6 +54,7 @@ mod tracking;
 mod winners;
 
 pub use backend::{Backend, GpuError};
+pub(crate) use check::triangle_keeps_orientation;
 pub use state::{Collapse, MAX_VALENCE, NO_SPLIT, Simplification, SimplifyOptions};
 
 use crate::input::MeshStats;
