@@ -58,7 +58,7 @@ fn real_meshes_roundtrip_exactly() {
 /// the position of another already in the file and about 8,700 after
 /// 14-bit quantization, so that about 13,000 triangles have two corners in
 /// one place. Those triangles stay without a normal through the collapses
-/// around them; when a collapse had to give them one, 30,000 or more
+/// around them; when a collapse had to give them one, 25,000 or more
 /// requests were refused at every step and the stream took 115 rounds
 /// (encoder/BENCHMARKS.md, "Triangles that stay without a normal").
 #[test]

@@ -215,14 +215,13 @@ fn unfolded(s: &State, p: u32, c: u32, target: [f64; 3], k: &CheckScratch) -> bo
 /// A triangle that was degenerate (no normal: coincident or collinear
 /// corners, as coarse quantization and sliver-ridden input make them) may
 /// stay degenerate, since the collapse makes it no worse; if it gains a
-/// normal, that is held to the normal of `v`'s whole fan. Requiring a normal
-/// of it refused every collapse of its corners but the one that removes
-/// it: on the Stanford dragon at 14 bits (19,010 triangles with two corners
-/// on one grid point) 30,000-35,000 requests were refused at every step,
-/// and checking them again was half of the simplification's time; the
-/// zero-length edges themselves could not collapse when a neighbouring
-/// triangle was degenerate too (encoder/BENCHMARKS.md, "Triangles that stay
-/// without a normal").
+/// normal, that is held to the normal of `v`'s whole fan. Requiring it to
+/// gain one refused, for as long as the triangle stood, every collapse that
+/// moved a corner whose two other corners share a grid point. On the
+/// Stanford dragon at 14 bits (about 13,000 such triangles) 25,000-57,000
+/// requests were refused at every step, checking them again took half of
+/// the simplification's time, and the stream had 17 more rounds
+/// (encoder/BENCHMARKS.md, "Triangles that stay without a normal").
 fn keeps_orientation(s: &State, v: u32, other: u32, target: [f64; 3], fan: &Fan) -> bool {
     let t = &s.table;
     let pv = s.geometry(v);
