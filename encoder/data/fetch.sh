@@ -65,13 +65,20 @@ if (( need_cgal )); then
     touch "$real/cgal/.complete"
 fi
 
-# (c) matplotlib's sample DEM from its PyPI wheel.
-if [[ ! -s "$real/jacksboro_fault_dem.npz" ]]; then
+# (c) matplotlib's sample DEMs from its PyPI wheel: jacksboro_fault_dem.npz
+# (scalar dx, dy, xmin, ...) and topobathy.npz (topography and bathymetry
+# with 1-D longitude and latitude arrays, the latitudes unevenly spaced).
+mpl_files=(jacksboro_fault_dem.npz topobathy.npz)
+need_mpl=0
+for f in "${mpl_files[@]}"; do [[ -s "$real/$f" ]] || need_mpl=1; done
+if (( need_mpl )); then
     echo "fetching matplotlib wheel from PyPI" >&2
     pip download matplotlib --no-deps --only-binary=:all: -d "$tmp/pip" --quiet
-    unzip -q -o -j "$tmp"/pip/matplotlib-*.whl \
-        'matplotlib/mpl-data/sample_data/jacksboro_fault_dem.npz' -d "$tmp/mpl"
-    mv "$tmp/mpl/jacksboro_fault_dem.npz" "$real/jacksboro_fault_dem.npz"
+    for f in "${mpl_files[@]}"; do
+        unzip -q -o -j "$tmp"/pip/matplotlib-*.whl \
+            "matplotlib/mpl-data/sample_data/$f" -d "$tmp/mpl"
+        mv "$tmp/mpl/$f" "$real/$f"
+    done
 fi
 
 # (d) glTF and STL files written from (a) and (b) by glTF-Transform (npm
@@ -107,7 +114,7 @@ if (( need_dragon )); then
 fi
 
 echo "files in $real:"
-for f in bunny.ply armadillo.off bunny00.off refined_elephant.off jacksboro_fault_dem.npz \
+for f in bunny.ply armadillo.off bunny00.off refined_elephant.off "${mpl_files[@]}" \
     "${third_party[@]}" "${dragon_files[@]}"; do
     printf '  %-26s %10s bytes\n' "$f" "$(wc -c < "$real/$f")"
 done

@@ -530,6 +530,7 @@ mod tests {
             origin: [0.0; 2],
             spacing: [1.0; 2],
             nodata: None,
+            coordinates: None,
         })
         .triangles;
         let n = side * side + 7;

@@ -140,6 +140,7 @@ mod tests {
             origin: [0.0, 0.0],
             spacing: [10.0, 10.0],
             nodata: None,
+            coordinates: None,
         };
         crate::input::grid_to_mesh(&grid)
     }

@@ -23,5 +23,6 @@ pub fn bumpy_grid(w: usize, h: usize, seed: u64) -> Mesh {
         origin: [0.0, 0.0],
         spacing: [10.0, 10.0],
         nodata: None,
+        coordinates: None,
     })
 }

@@ -175,3 +175,28 @@ fn garbage_grids_give_typed_errors() {
     let out = splitstream(&["grid", mesh.to_str().unwrap(), "--height", "700", "-o", o]);
     one_line_error(&out);
 }
+
+/// matplotlib's topobathy.npz lists latitudes that are not evenly spaced:
+/// the tiles need one spacing, so the grid is refused with one line.
+#[test]
+fn unevenly_spaced_rows_are_refused() {
+    let input = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("data/real/topobathy.npz");
+    if !input.exists() {
+        eprintln!("skipped topobathy.npz: run encoder/data/fetch.sh");
+        return;
+    }
+    let output = std::env::temp_dir().join("grid-cli-topobathy.ply");
+    let out = splitstream(&[
+        "grid",
+        input.to_str().unwrap(),
+        "--height",
+        "1000",
+        "-o",
+        output.to_str().unwrap(),
+    ]);
+    let message = one_line_error(&out);
+    assert!(
+        message.contains("not evenly spaced") && message.contains("regular grid"),
+        "{message}"
+    );
+}

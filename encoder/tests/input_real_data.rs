@@ -142,6 +142,29 @@ fn matplotlib_jacksboro_dem() {
     assert!(lo[2] >= 200.0 && hi[2] <= 1100.0, "{lo:?} {hi:?}");
 }
 
+#[test]
+fn matplotlib_topobathy() {
+    // 91 rows x 120 columns of float32 heights and depths (metres) with
+    // 1-D `longitude` (234-238 degrees, steps of 1/30) and `latitude`
+    // arrays; the latitudes' steps shrink northward (rows evenly spaced on
+    // a Mercator map), so each row keeps its own.
+    let Some(s) = check("topobathy.npz", 10_920, 2 * 90 * 119) else {
+        return;
+    };
+    assert_eq!((s.components, s.boundary_loops), (1, 1));
+    let mesh = load("topobathy.npz").unwrap();
+    let (lo, hi) = mesh.bounding_box().unwrap();
+    assert_eq!([lo[0], hi[0]], [234.01669311523438, 237.9833984375]);
+    assert_eq!([lo[1], hi[1]], [48.0163688659668, 49.98418045043945]);
+    assert_eq!([lo[2], hi[2]], [-1437.0, 2205.0]);
+    let mut ys: Vec<f64> = mesh.positions.iter().map(|p| p[1]).collect();
+    ys.sort_by(f64::total_cmp);
+    ys.dedup();
+    assert_eq!(ys.len(), 91);
+    let (south, north) = (ys[1] - ys[0], ys[90] - ys[89]);
+    assert!(south > north * 1.03, "row steps {south} .. {north}");
+}
+
 /// Triangles as position triples, each rotated to start at its smallest
 /// position (keeping its orientation), sorted: a mesh's surface without its
 /// vertex numbering.

@@ -83,7 +83,7 @@ proptest! {
         for h in holes {
             elevations[h % (rows * cols)] = f64::NAN;
         }
-        let grid = Grid { rows, cols, elevations, origin: [0.0, 0.0], spacing: [10.0, 10.0], nodata: None };
+        let grid = Grid { rows, cols, elevations, origin: [0.0, 0.0], spacing: [10.0, 10.0], nodata: None, coordinates: None };
         let mesh = grid_to_mesh(&grid);
         prop_assume!(mesh.triangles.len() >= 2 && check_mesh(&mesh).is_ok());
         roundtrip_check::assert_roundtrip(&mesh, &options(constrained, levels, admit, lock, codec, records));

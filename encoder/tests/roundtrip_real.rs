@@ -21,6 +21,7 @@ fn real_meshes_roundtrip_exactly() {
         ("bunny00.off", Units::Linear),
         ("refined_elephant.off", Units::Linear),
         ("jacksboro_fault_dem.npz", Units::Geographic),
+        ("topobathy.npz", Units::Geographic),
         ("bunny.glb", Units::Linear),
         ("armadillo.gltf", Units::Linear),
         ("refined_elephant.stl", Units::Linear),

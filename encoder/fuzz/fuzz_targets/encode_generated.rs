@@ -60,6 +60,7 @@ fn raster(b: &mut Bytes<'_>) -> Mesh {
         origin: [0.0, 0.0],
         spacing: [1.0, if b.flag() { 1.0 } else { -2.5 }],
         nodata: None,
+        coordinates: None,
     })
 }
 

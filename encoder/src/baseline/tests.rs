@@ -18,6 +18,7 @@ pub fn grid(n: u32, height: impl Fn(f64, f64) -> f64) -> Mesh {
         origin: [0.0, 0.0],
         spacing: [step, step],
         nodata: None,
+        coordinates: None,
     })
 }
 

@@ -53,7 +53,10 @@ pub struct Args {
     /// as repaired or as triangulated.
     #[arg(long)]
     pub permutation: Option<PathBuf>,
-    /// .npz only: the array with the elevations.
+    /// .npz only: the array with the elevations (default: the first 2-D
+    /// array not named as coordinates). Scalars dx, dy, xmin, ymin (xmax,
+    /// ymax) or coordinate arrays x/lon/longitude and y/lat/latitude (1-D,
+    /// or 2-D as np.meshgrid writes them) place the samples.
     #[arg(long)]
     pub npz_array: Option<String>,
     /// Multiply z by this (e.g. to match x/y units).
@@ -226,16 +229,17 @@ pub fn lattice_axes(on_lattice: [bool; 3]) -> String {
     names.join(", ")
 }
 
-/// Degrees-sized x/y extents inside lon/lat ranges next to a z range in
-/// the hundreds: a geographic grid whose errors would be meaningless in
-/// raw units.
+/// Degrees-sized x/y extents inside lon/lat ranges (longitudes from -180
+/// to 180 or from 0 to 360, as matplotlib's topobathy.npz has them) next to
+/// a z range in the hundreds: a geographic grid whose errors would be
+/// meaningless in raw units.
 fn looks_geographic(mesh: &Mesh) -> bool {
     let Some((lo, hi)) = mesh.bounding_box() else {
         return false;
     };
     let xy = (hi[0] - lo[0]).max(hi[1] - lo[1]);
     lo[0] >= -180.0
-        && hi[0] <= 180.0
+        && hi[0] <= 360.0
         && lo[1] >= -90.0
         && hi[1] <= 90.0
         && xy < 5.0

@@ -123,6 +123,14 @@ pub fn run(args: Args) -> CliResult {
         z_scale: args.z_scale,
     };
     let mut grid = read_grid(&args.input, &options).map_err(|e| e.to_string())?;
+    if grid.coordinates.is_some() {
+        // The tiles are squares of samples at one spacing.
+        return Err(format!(
+            "{}: the samples are not evenly spaced (the file lists their coordinates); \
+             the tile simplifier needs a regular grid",
+            args.input.display()
+        ));
+    }
     if args.geographic {
         to_metres(&mut grid);
     }
@@ -320,6 +328,7 @@ fn bench(grid: &Grid, params: &Params, side: usize) -> CliResult {
                 origin: tile.origin,
                 spacing: grid.spacing,
                 nodata: None,
+                coordinates: None,
             });
             let q = quantize(&full, 14, Units::Linear);
             let checked =

@@ -27,6 +27,12 @@ pub struct Grid {
     pub spacing: [f64; 2],
     /// Samples equal to this value are missing (NaN and infinities always are).
     pub nodata: Option<f64>,
+    /// The x of every column and the y of every row (in the order of
+    /// `elevations`), for a grid whose file lists them unevenly spaced (a
+    /// `.npz` with a `latitude` array in Mercator rows); `origin` and
+    /// `spacing` then hold the first sample and the mean step. `None`: the
+    /// samples sit at `origin + index × spacing`.
+    pub coordinates: Option<[Vec<f64>; 2]>,
 }
 
 impl Grid {
@@ -50,6 +56,7 @@ impl Grid {
             origin: south_west,
             spacing,
             nodata,
+            coordinates: None,
         };
         if rows.checked_mul(cols)? != grid.elevations.len() {
             return None;
@@ -58,8 +65,12 @@ impl Grid {
         Some(grid)
     }
 
-    /// Reverses the row order of the samples (without touching origin/spacing).
-    fn reverse_rows_in_place(&mut self) {
+    /// Reverses the row order of the samples and of the rows' listed y
+    /// (without touching origin/spacing).
+    pub(crate) fn reverse_rows_in_place(&mut self) {
+        if let Some([_, ys]) = &mut self.coordinates {
+            ys.reverse();
+        }
         let (rows, cols) = (self.rows, self.cols);
         if cols == 0 {
             return;
@@ -107,16 +118,29 @@ pub fn grid_to_mesh(grid: &Grid) -> Mesh {
 
     let [x0, y0] = grid.origin;
     let [dx, dy] = grid.spacing;
-    // With one spacing negative the x/y axes are mirrored, so the winding
+    let x_at = |c: usize| match &grid.coordinates {
+        Some([xs, _]) => xs[c],
+        None => x0 + c as f64 * dx,
+    };
+    let y_at = |r: usize| match &grid.coordinates {
+        Some([_, ys]) => ys[r],
+        None => y0 + r as f64 * dy,
+    };
+    // With one axis decreasing the x/y axes are mirrored, so the winding
     // that is counter-clockwise in (col, row) space becomes clockwise.
-    let mirrored = (dx < 0.0) != (dy < 0.0);
+    let decreasing = |first: f64, last: f64, step: f64| match &grid.coordinates {
+        Some(_) => last < first,
+        None => step < 0.0,
+    };
+    let mirrored = decreasing(x_at(0), x_at(cols.saturating_sub(1)), dx)
+        != decreasing(y_at(0), y_at(rows.saturating_sub(1)), dy);
 
     let all_valid = (0..n).all(|i| grid.is_valid(i));
     let mut positions = Vec::with_capacity(n);
     for r in 0..rows {
-        let y = y0 + r as f64 * dy;
+        let y = y_at(r);
         for c in 0..cols {
-            positions.push([x0 + c as f64 * dx, y, grid.elevations[r * cols + c]]);
+            positions.push([x_at(c), y, grid.elevations[r * cols + c]]);
         }
     }
 
@@ -201,6 +225,7 @@ mod tests {
             origin: [10.0, 20.0],
             spacing,
             nodata: None,
+            coordinates: None,
         }
     }
 
@@ -267,6 +292,7 @@ mod tests {
             origin: [0.0, 0.0],
             spacing: [1.0, 1.0],
             nodata: None,
+            coordinates: None,
         };
         let m = grid_to_mesh(&g);
         assert_eq!(m.triangles.len(), 2);

@@ -14,6 +14,7 @@ mod geotiff;
 mod gltf;
 mod grid;
 mod npy;
+mod npz_axes;
 mod obj;
 mod off;
 mod ply;
@@ -128,9 +129,12 @@ fn grid_mesh(file: &str, grid: Grid) -> Result<Mesh, InputError> {
     Err(InputError::malformed(file, message))
 }
 
+/// `options.grid_spacing`, where given, places the samples on that regular
+/// grid instead of where the file put them (listed coordinates included).
 fn apply_spacing(mut grid: Grid, options: &ReadOptions) -> Grid {
     if let Some((dx, dy)) = options.grid_spacing {
         grid.spacing = [dx, dy];
+        grid.coordinates = None;
     }
     grid
 }

@@ -11,6 +11,12 @@
 //! says that rows run southward (matplotlib's own examples place row `r` at
 //! `linspace(ymin, ymax, nrows)[r]`). Without `ymax`, `ymin` is taken
 //! literally as the southern edge.
+//!
+//! Without those scalars, 1-D (or np.meshgrid's 2-D) coordinate arrays
+//! named `x`/`lon`/`longitude` and `y`/`lat`/`latitude` (`npz_axes`) place
+//! the columns and rows, as matplotlib's `topobathy.npz` does; unevenly
+//! spaced ones are kept value by value ([`Grid::coordinates`]). Without
+//! any, the heights array is the first 2-D array not named as coordinates.
 
 use std::fs::File;
 use std::io::{BufReader, Read};
@@ -20,6 +26,7 @@ use npyz::npz::NpzArchive;
 use npyz::{DType, NpyFile, Order, TypeChar};
 
 use super::grid::Grid;
+use super::npz_axes::{self, Axis, X_NAMES, Y_NAMES};
 use super::{InputError, check_vertex_count};
 
 /// numpy's own bound on a header's length (`_MAX_HEADER_SIZE` since numpy
@@ -225,7 +232,15 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
         }
         None => {
             let mut found = None;
-            for n in &names {
+            // A 2-D `x` or `lat` beside the heights (np.meshgrid's) holds
+            // coordinates, not heights.
+            let coordinate = |n: &str| {
+                X_NAMES
+                    .iter()
+                    .chain(&Y_NAMES)
+                    .any(|c| n.eq_ignore_ascii_case(c))
+            };
+            for n in names.iter().filter(|n| !coordinate(n)) {
                 let npy = archive.by_name(n).map_err(bad)?;
                 if npy.is_some_and(|a| a.shape().len() == 2) {
                     found = Some(n.clone());
@@ -236,7 +251,7 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
                 InputError::malformed(
                     file,
                     format!(
-                        "no two-dimensional array in the archive (arrays: {})",
+                        "no two-dimensional array of heights in the archive (arrays: {}; coordinate arrays are named as in x, lon, latitude, ...)",
                         names.join(", ")
                     ),
                 )
@@ -267,6 +282,13 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
     let ymin = scalar("ymin")?;
     let xmax = scalar("xmax")?;
     let ymax = scalar("ymax")?;
+    if [dx, dy, xmin, ymin, xmax, ymax].iter().all(Option::is_none) {
+        let x = coordinate_axis(&mut archive, &names, &name, file, rows, cols, true)?;
+        let y = coordinate_axis(&mut archive, &names, &name, file, rows, cols, false)?;
+        if x.is_some() || y.is_some() {
+            return Ok(listed_grid(rows, cols, values, x, y));
+        }
+    }
 
     let dx = dx.unwrap_or(1.0);
     let dy = dy.or(dx.into()).unwrap_or(1.0);
@@ -294,6 +316,7 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
             origin: [x0, y0],
             spacing: [dx, dy],
             nodata: None,
+            coordinates: None,
         },
         // Rows run south from ymin (jacksboro), or no ymax: ymin is the south edge.
         Some(_) => north_first_grid(
@@ -307,6 +330,110 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
         None => north_first_grid(file, rows, cols, values, [x0, y0], [dx, dy])?,
     };
     Ok(grid)
+}
+
+/// The axis that a coordinate array named as in [`X_NAMES`] (`along_x`) or
+/// [`Y_NAMES`] gives the grid, if the archive has one: 1-D with a value per
+/// column (row), or 2-D of the grid's shape and the same in every row
+/// (column), as `np.meshgrid` writes them.
+fn coordinate_axis<R: Read + std::io::Seek>(
+    archive: &mut NpzArchive<R>,
+    names: &[String],
+    raster: &str,
+    file: &str,
+    rows: usize,
+    cols: usize,
+    along_x: bool,
+) -> Result<Option<Axis>, InputError> {
+    let wanted: &[&str] = if along_x { &X_NAMES } else { &Y_NAMES };
+    let Some(name) = npz_axes::find(names, wanted, raster) else {
+        return Ok(None);
+    };
+    let (count, what) = if along_x {
+        (cols, "columns")
+    } else {
+        (rows, "rows")
+    };
+    let bad = |e: std::io::Error| InputError::malformed(file, format!("invalid .npz: {e}"));
+    let Some(npy) = archive.by_name(name).map_err(bad)? else {
+        return Ok(None);
+    };
+    let label = format!("coordinate array '{name}'");
+    let values = match npy.shape() {
+        [n] if *n == count as u64 => read_values(npy, file, &label)?,
+        &[r, c] if (r, c) == (rows as u64, cols as u64) => {
+            let all = read_values(npy, file, &label)?;
+            let line: Vec<f64> = if along_x {
+                all[..cols].to_vec()
+            } else {
+                all.iter().step_by(cols).copied().collect()
+            };
+            let varies = (0..rows * cols).any(|i| {
+                let (r, c) = (i / cols, i % cols);
+                all[i].to_bits() != if along_x { line[c] } else { line[r] }.to_bits()
+            });
+            if varies {
+                return Err(InputError::unsupported(
+                    file,
+                    format!(
+                        "{label} is not the same in every {}: a curvilinear grid",
+                        if along_x { "row" } else { "column" }
+                    ),
+                ));
+            }
+            line
+        }
+        shape => {
+            return Err(InputError::malformed(
+                file,
+                format!(
+                    "{label} has shape {shape:?}: a value per {} ({count}) or the grid's \
+                     shape ({rows}, {cols}) was expected",
+                    &what[..what.len() - 1]
+                ),
+            ));
+        }
+    };
+    npz_axes::axis(file, name, values, count, what).map(Some)
+}
+
+/// The grid of `values` (rows in file order) at the coordinates `x` and `y`
+/// list; an axis without a list keeps the unlisted default (unit spacing,
+/// row 0 the northern edge, the south-west sample at 0). Rows are stored
+/// south to north as [`Grid`] prefers.
+fn listed_grid(
+    rows: usize,
+    cols: usize,
+    values: Vec<f64>,
+    x: Option<Axis>,
+    y: Option<Axis>,
+) -> Grid {
+    let x = x.unwrap_or(Axis::Regular {
+        first: 0.0,
+        step: 1.0,
+    });
+    let y = y.unwrap_or(Axis::Regular {
+        first: rows.saturating_sub(1) as f64,
+        step: -1.0,
+    });
+    let (x0, dx) = x.first_and_step();
+    let (y0, dy) = y.first_and_step();
+    let listed = matches!(x, Axis::Listed(_)) || matches!(y, Axis::Listed(_));
+    let mut grid = Grid {
+        rows,
+        cols,
+        elevations: values,
+        origin: [x0, y0],
+        spacing: [dx, dy],
+        nodata: None,
+        coordinates: listed.then(|| [x.values(cols), y.values(rows)]),
+    };
+    if dy < 0.0 {
+        grid.reverse_rows_in_place();
+        grid.origin[1] = y0 + rows.saturating_sub(1) as f64 * dy;
+        grid.spacing[1] = -dy;
+    }
+    grid
 }
 
 #[cfg(test)]
@@ -544,5 +671,92 @@ mod tests {
         truncated.truncate(bytes.len() / 2);
         let f4 = TempFile::new("trunc.npz", &truncated);
         assert!(read_npz(&f4.0, "trunc.npz", None).is_err());
+    }
+
+    fn f8(shape: &str, values: &[f64]) -> Vec<u8> {
+        npy_bytes("<f8", false, shape, &le(values, f64::to_le_bytes))
+    }
+
+    /// Heights of 2 rows × 3 columns, 1 to 6 in file order.
+    fn heights() -> Vec<u8> {
+        f8("(2, 3)", &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0])
+    }
+
+    /// `longitude` and `latitude` arrays (topobathy.npz's layout): evenly
+    /// spaced ones set origin and spacing; rows whose latitude falls run
+    /// south as in image order, and rows whose latitude rises run north.
+    #[test]
+    fn npz_coordinate_arrays_place_the_samples() {
+        for (lat, south_first) in [([36.5, 36.0], false), ([36.0, 36.5], true)] {
+            let bytes = npz(&[
+                ("topo", heights()),
+                ("longitude", f8("(3,)", &[234.0, 234.25, 234.5])),
+                ("latitude", f8("(2,)", &lat)),
+            ]);
+            let f = TempFile::new("topo.npz", &bytes);
+            let g = read_npz(&f.0, "topo.npz", None).unwrap();
+            assert_eq!((g.origin, g.spacing), ([234.0, 36.0], [0.25, 0.5]));
+            assert_eq!(g.coordinates, None);
+            let south_row = if south_first {
+                [1.0, 2.0, 3.0]
+            } else {
+                [4.0, 5.0, 6.0]
+            };
+            assert_eq!(g.elevations[..3], south_row);
+            let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+            check_mesh(&m).unwrap();
+            let z_at_36 = if south_first { 1.0 } else { 4.0 };
+            assert!(
+                m.positions.contains(&[234.0, 36.0, z_at_36]),
+                "{:?}",
+                m.positions
+            );
+        }
+    }
+
+    /// Unevenly spaced latitudes (Mercator rows) are kept sample by sample;
+    /// 2-D `x` and `y` as np.meshgrid writes them are read like 1-D ones.
+    #[test]
+    fn npz_uneven_and_meshgrid_coordinates() {
+        let bytes = npz(&[
+            ("x", f8("(2, 3)", &[0.0, 10.0, 20.0, 0.0, 10.0, 20.0])),
+            ("y", f8("(2, 3)", &[5.0, 5.0, 5.0, 1.0, 1.0, 1.0])),
+            ("z", heights()),
+        ]);
+        let f = TempFile::new("grid.npz", &bytes);
+        let g = read_npz(&f.0, "grid.npz", None).unwrap();
+        assert_eq!((g.origin, g.spacing), ([0.0, 1.0], [10.0, 4.0]));
+        let uneven = npz(&[
+            ("elevation", heights()),
+            ("lat", f8("(2,)", &[48.0, 48.5])),
+            ("lon", f8("(3,)", &[0.0, 1.0, 3.0])),
+        ]);
+        let f = TempFile::new("uneven.npz", &uneven);
+        let g = read_npz(&f.0, "uneven.npz", None).unwrap();
+        assert_eq!(g.coordinates, Some([vec![0.0, 1.0, 3.0], vec![48.0, 48.5]]));
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        check_mesh(&m).unwrap();
+        assert!(m.positions.contains(&[3.0, 48.5, 6.0]), "{:?}", m.positions);
+        // --grid-spacing places the samples on its own regular grid.
+        let spaced = ReadOptions {
+            grid_spacing: Some((2.0, 2.0)),
+            ..ReadOptions::default()
+        };
+        let m = read_mesh(&f.0, &spaced).unwrap();
+        assert!(m.positions.contains(&[4.0, 50.0, 6.0]), "{:?}", m.positions);
+    }
+
+    #[test]
+    fn npz_bad_coordinate_arrays_are_named() {
+        let err = |extra: (&str, Vec<u8>)| {
+            let f = TempFile::new("bad.npz", &npz(&[("elevation", heights()), extra]));
+            read_npz(&f.0, "bad.npz", None).unwrap_err().to_string()
+        };
+        let msg = err(("latitude", f8("(3,)", &[1.0, 2.0, 3.0])));
+        assert!(msg.contains("'latitude' has shape [3]"), "{msg}");
+        let msg = err(("x", f8("(3,)", &[1.0, 3.0, 2.0])));
+        assert!(msg.contains("'x' is not monotonic"), "{msg}");
+        let msg = err(("x", f8("(2, 3)", &[0.0, 1.0, 2.0, 0.0, 1.0, 2.5])));
+        assert!(msg.contains("not the same in every row"), "{msg}");
     }
 }

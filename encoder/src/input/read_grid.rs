@@ -28,9 +28,7 @@ pub fn read_grid(path: &Path, options: &ReadOptions) -> Result<Grid, InputError>
             });
         }
     };
-    if let Some((dx, dy)) = options.grid_spacing {
-        grid.spacing = [dx, dy];
-    }
+    grid = super::apply_spacing(grid, options);
     if options.z_scale != 1.0 {
         for z in &mut grid.elevations {
             *z *= options.z_scale;

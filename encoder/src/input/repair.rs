@@ -416,6 +416,7 @@ mod tests {
             origin: [0.0, 0.0],
             spacing: [1.0, 1.0],
             nodata: None,
+            coordinates: None,
         })
     }
 

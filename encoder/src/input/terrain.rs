@@ -146,6 +146,7 @@ pub fn fractal_terrain(side: usize, seed: u64) -> Mesh {
         origin: [0.0, 0.0],
         spacing: [spacing, spacing],
         nodata: None,
+        coordinates: None,
     })
 }
 

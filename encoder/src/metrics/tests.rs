@@ -12,6 +12,7 @@ fn grid(n: u32, z: f64) -> Mesh {
         origin: [0.0, 0.0],
         spacing: [1.0, 1.0],
         nodata: None,
+        coordinates: None,
     })
 }
 

@@ -395,6 +395,7 @@ mod tests {
             origin: [0.0, 0.0],
             spacing: [1.0, 1.0],
             nodata: None,
+            coordinates: None,
         };
         let mesh = grid_to_mesh(&grid);
         let q = quantize_with(
