@@ -113,9 +113,41 @@ if (( need_dragon )); then
     done
 fi
 
+# (f) The Jacksboro DEM as GDAL writes GeoTIFFs (gdal_translate, Debian
+# package gdal-bin), from an ESRI grid written here with ten samples set
+# to nodata: the GeoTIFF reader's third-party files. Skipped with a note
+# where GDAL is not installed (.ci/run installs it).
+gdal_files=(plain.tif deflate_tiled.tif lzw_float32.tif zstd_float64.tif cog.tif
+    packbits_epsg4326.tif three_bands.tif)
+if [[ ! -e "$real/gdal/.complete" ]]; then
+    if ! command -v gdal_translate >/dev/null; then
+        echo "note: gdal_translate not found (Debian: gdal-bin): GeoTIFFs written by GDAL skipped" >&2
+    else
+        echo "writing GeoTIFFs with GDAL $(gdal_translate --version | head -n 1)" >&2
+        mkdir -p "$tmp/gdal"
+        python3 "$here/jacksboro_asc.py" "$real/jacksboro_fault_dem.npz" "$tmp/gdal/jacksboro.asc"
+        translate() { gdal_translate -q -of "$1" "${@:3}" "$tmp/gdal/jacksboro.asc" "$tmp/gdal/$2"; }
+        translate GTiff plain.tif
+        translate GTiff deflate_tiled.tif -co TILED=YES -co BLOCKXSIZE=128 -co BLOCKYSIZE=128 \
+            -co COMPRESS=DEFLATE -co PREDICTOR=2
+        translate GTiff lzw_float32.tif -ot Float32 -co COMPRESS=LZW -co PREDICTOR=3
+        translate GTiff zstd_float64.tif -ot Float64 -co COMPRESS=ZSTD -co PREDICTOR=3
+        translate COG cog.tif -co COMPRESS=DEFLATE
+        translate GTiff packbits_epsg4326.tif -co COMPRESS=PACKBITS -a_srs EPSG:4326
+        translate GTiff three_bands.tif -co INTERLEAVE=PIXEL -b 1 -b 1 -b 1
+        for f in "${gdal_files[@]}"; do
+            [[ -s "$tmp/gdal/$f" ]] || { echo "error: GDAL did not write $f" >&2; exit 1; }
+        done
+        rm -rf "$real/gdal"
+        mv "$tmp/gdal" "$real/gdal"
+        touch "$real/gdal/.complete"
+    fi
+fi
+
 echo "files in $real:"
 for f in bunny.ply armadillo.off bunny00.off refined_elephant.off "${mpl_files[@]}" \
     "${third_party[@]}" "${dragon_files[@]}"; do
     printf '  %-26s %10s bytes\n' "$f" "$(wc -c < "$real/$f")"
 done
 printf '  %-26s %10s files\n' "cgal/" "$(find "$real/cgal" -type f ! -name .complete | wc -l)"
+[[ -d "$real/gdal" ]] && printf '  %-26s %10s files\n' "gdal/" "$(find "$real/gdal" -type f ! -name .complete | wc -l)"

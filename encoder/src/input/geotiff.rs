@@ -1,4 +1,6 @@
-//! GeoTIFF elevation rasters via the `tiff` crate.
+//! GeoTIFF elevation rasters via the `tiff` crate (uncompressed, PackBits,
+//! LZW, DEFLATE and ZSTD, with their predictors; strips or tiles; the first
+//! image of a cloud-optimized GeoTIFF, its full resolution).
 //!
 //! Only the first band is used (every other sample of chunky multi-band
 //! images is skipped; planar images are read plane 0 only). Georeferencing
