@@ -118,12 +118,12 @@ fi
 # to nodata: the GeoTIFF reader's third-party files. Skipped with a note
 # where GDAL is not installed (.ci/run installs it).
 gdal_files=(plain.tif deflate_tiled.tif lzw_float32.tif zstd_float64.tif cog.tif
-    packbits_epsg4326.tif three_bands.tif)
+    packbits_epsg4326.tif three_bands.tif aaigrid.asc)
 if [[ ! -e "$real/gdal/.complete" ]]; then
     if ! command -v gdal_translate >/dev/null; then
         echo "note: gdal_translate not found (Debian: gdal-bin): GeoTIFFs written by GDAL skipped" >&2
     else
-        echo "writing GeoTIFFs with GDAL $(gdal_translate --version | head -n 1)" >&2
+        echo "writing GeoTIFFs with $(gdal_translate --version | head -n 1)" >&2
         mkdir -p "$tmp/gdal"
         python3 "$here/jacksboro_asc.py" "$real/jacksboro_fault_dem.npz" "$tmp/gdal/jacksboro.asc"
         translate() { gdal_translate -q -of "$1" "${@:3}" "$tmp/gdal/jacksboro.asc" "$tmp/gdal/$2"; }
@@ -135,9 +135,11 @@ if [[ ! -e "$real/gdal/.complete" ]]; then
         translate COG cog.tif -co COMPRESS=DEFLATE
         translate GTiff packbits_epsg4326.tif -co COMPRESS=PACKBITS -a_srs EPSG:4326
         translate GTiff three_bands.tif -co INTERLEAVE=PIXEL -b 1 -b 1 -b 1
+        translate AAIGrid aaigrid.asc
         for f in "${gdal_files[@]}"; do
             [[ -s "$tmp/gdal/$f" ]] || { echo "error: GDAL did not write $f" >&2; exit 1; }
         done
+        rm -f "$tmp/gdal/"*.aux.xml
         rm -rf "$real/gdal"
         mv "$tmp/gdal" "$real/gdal"
         touch "$real/gdal/.complete"

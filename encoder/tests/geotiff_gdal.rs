@@ -2,7 +2,8 @@
 //! encoder/data/real/gdal/ by encoder/data/fetch.sh): the Jacksboro DEM
 //! stripped and tiled, uncompressed and under DEFLATE, LZW, ZSTD and
 //! PackBits with their predictors, as int16, float32 and float64, as a
-//! cloud-optimized GeoTIFF with overviews, and with three bands. Each must
+//! cloud-optimized GeoTIFF with overviews, and with three bands; and
+//! GDAL's ESRI grid of it. Each must
 //! read as the ESRI grid GDAL converted it from: the same samples at the same
 //! positions, the ten nodata samples missing. Without the folder this test
 //! says so and passes.
@@ -12,7 +13,7 @@ use std::path::Path;
 use splitstream_encoder::Mesh;
 use splitstream_encoder::input::{ReadOptions, check_mesh, read_mesh};
 
-const FILES: [&str; 7] = [
+const FILES: [&str; 8] = [
     "plain.tif",
     "deflate_tiled.tif",
     "lzw_float32.tif",
@@ -20,6 +21,8 @@ const FILES: [&str; 7] = [
     "cog.tif",
     "packbits_epsg4326.tif",
     "three_bands.tif",
+    // GDAL's own ESRI grid writer: corners, cellsize to 12 decimals.
+    "aaigrid.asc",
 ];
 
 fn read(dir: &Path, file: &str) -> Mesh {
