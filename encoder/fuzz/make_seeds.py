@@ -124,11 +124,28 @@ def npz():
     return out.getvalue()
 
 
+def f8_npy(shape, values):
+    header = "{'descr': '<f8', 'fortran_order': False, 'shape': %s, }" % (shape,)
+    header += " " * (-(10 + len(header) + 1) % 64) + "\n"
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header.encode() + b"".join(
+        struct.pack("<d", v) for v in values)
+
+
+def npz_coordinates():
+    """The grid with 1-D longitude (even) and latitude (uneven) arrays."""
+    out = io.BytesIO()
+    with zipfile.ZipFile(out, "w") as z:
+        z.writestr("topo.npy", npy())
+        z.writestr("longitude.npy", f8_npy((4,), [234.0, 234.5, 235.0, 235.5]))
+        z.writestr("latitude.npy", f8_npy((3,), [49.0, 48.6, 48.0]))
+    return out.getvalue()
+
+
 SEEDS = {
     "ply-ascii": ("ply", ply_ascii), "ply-binary": ("ply", ply_binary), "obj": ("obj", obj),
     "off": ("off", off), "gltf": ("gltf", gltf), "glb": ("glb", glb), "stl-binary": ("stl", stl_binary),
     "stl-ascii": ("stl", stl_ascii), "tif": ("tif", tiff), "asc": ("asc", asc), "npy": ("npy", npy),
-    "npz": ("npz", npz),
+    "npz": ("npz", npz), "npz-coordinates": ("npz", npz_coordinates),
 }
 
 if __name__ == "__main__":

@@ -316,14 +316,10 @@ mod tests {
         }
     }
 
-    /// `check_placed` takes the first placement wherever `check_walked`
-    /// does, and otherwise another one only where that one passes
-    /// `check_walked` itself; on this plane that saves some collapses.
-    #[test]
-    fn a_folding_placement_gives_way_to_an_equal_one() {
-        let mesh = jittered_plane(24);
+    /// The simplifier's state of `mesh` at 14 bits in constrained mode.
+    fn constrained_state(mesh: &Mesh) -> (State, SimplifyOptions) {
         let q = quantize_with(
-            &mesh,
+            mesh,
             14,
             Units::Linear,
             Quantization::Uniform,
@@ -333,7 +329,15 @@ mod tests {
             constrained: true,
             ..SimplifyOptions::default()
         };
-        let mut s = State::new(&q, &options);
+        (State::new(&q, &options), options)
+    }
+
+    /// `check_placed` takes the first placement wherever `check_walked`
+    /// does, and otherwise another one only where that one passes
+    /// `check_walked` itself; on this plane that saves some collapses.
+    #[test]
+    fn a_folding_placement_gives_way_to_an_equal_one() {
+        let (mut s, options) = constrained_state(&jittered_plane(24));
         s.quadrics = s.fan_quadrics(options.boundary_weight).expect("manifold");
         let scale = Scale {
             cell: 0.0,
@@ -382,18 +386,7 @@ mod tests {
             *p = [p[0].round(), p[1].round(), 0.0];
         }
         mesh.positions[18] = mesh.positions[13];
-        let q = quantize_with(
-            &mesh,
-            14,
-            Units::Linear,
-            Quantization::Uniform,
-            Lattice::Ignore,
-        );
-        let options = SimplifyOptions {
-            constrained: true,
-            ..SimplifyOptions::default()
-        };
-        State::new(&q, &options)
+        constrained_state(&mesh).0
     }
 
     /// Collapsing 12 into 11 leaves (12, 13, 18) as it was, without a
