@@ -61,9 +61,9 @@ Eval evaluate(Topo t, __global const float *quadric, __global const Params *P, u
     return out;
 }
 
-/* The WGSL kernel's test, stricter than the CPU's: a triangle that had no
- * normal (zero area) refuses, where the CPU lets it stay without one or
- * holds the normal it gains to the fan's normal. */
+/* The WGSL kernel's test, stricter than the CPU's: a triangle without a
+ * normal (zero area) may stay so, as on the CPU, but refuses to gain one,
+ * where the CPU holds the normal it gains to the fan's normal. */
 bool keeps_orientation(Topo t, uint v, uint other, float3 target, uint3 origin) {
     float3 pv = rel(t, v, origin);
     uint first = fan_first(t, v);
@@ -72,12 +72,17 @@ bool keeps_orientation(Topo t, uint v, uint other, float3 target, uint3 origin) 
         uint n1 = cv(t, next_c(k)), n2 = cv(t, prev_c(k));
         if (n1 != other && n2 != other) {
             float3 q1 = rel(t, n1, origin), q2 = rel(t, n2, origin);
-            float3 old = cross(q1 - pv, q2 - pv);
+            float3 d1 = q1 - pv, d2 = q2 - pv;
+            float3 old = cross(d1, d2);
+            float os = dot(d1, d1) + dot(d2, d2);
             float3 e1 = q1 - target, e2 = q2 - target;
             float3 nw = cross(e1, e2);
             float s = dot(e1, e1) + dot(e2, e2);
             float nn = dot(nw, nw);
-            if (dot(old, nw) <= 1e-5f * sqrt(dot(old, old) * nn) || nn <= 1e-10f * s * s) return false;
+            bool stays_flat = dot(old, old) <= 1e-10f * os * os && nn <= 1e-10f * s * s;
+            if (!stays_flat
+                && (dot(old, nw) <= 1e-5f * sqrt(dot(old, old) * nn) || nn <= 1e-10f * s * s))
+                return false;
         }
         k = fan_step(t, k, first);
     }

@@ -97,10 +97,11 @@ fn evaluate(v: u32, u: u32) -> Eval {
 // Every triangle around v not holding `other` keeps a non-degenerate normal
 // within 90 degrees of its old one when v moves to t (all in p's frame).
 // Slightly stricter than the CPU (f32), so the CPU's own check at apply
-// time rarely disagrees. A triangle that had no normal (zero area) refuses
-// here, where the CPU lets it stay without one or holds the normal it gains
-// to the fan's normal: on such input the GPU backends offer fewer collapses
-// than the CPU makes.
+// time rarely disagrees. A triangle that had no normal (zero area) may stay
+// so, as on the CPU (coarsely quantized scans have thousands: refusing them
+// stalled the steps), but refuses to gain one, where the CPU holds the
+// normal it gains to the fan's normal: on such input the GPU backends offer
+// somewhat fewer collapses than the CPU makes.
 fn keeps_orientation(v: u32, other: u32, t: vec3<f32>, origin: vec3<u32>) -> bool {
     let pv = rel(v, origin);
     let first = fan_first(v);
@@ -111,13 +112,18 @@ fn keeps_orientation(v: u32, other: u32, t: vec3<f32>, origin: vec3<u32>) -> boo
         if n1 != other && n2 != other {
             let q1 = rel(n1, origin);
             let q2 = rel(n2, origin);
-            let old = cross(q1 - pv, q2 - pv);
+            let d1 = q1 - pv;
+            let d2 = q2 - pv;
+            let old = cross(d1, d2);
+            let os = dot(d1, d1) + dot(d2, d2);
             let e1 = q1 - t;
             let e2 = q2 - t;
             let moved = cross(e1, e2);
             let s = dot(e1, e1) + dot(e2, e2);
             let nn = dot(moved, moved);
-            if dot(old, moved) <= 1e-5 * sqrt(dot(old, old) * nn) || nn <= 1e-10 * s * s {
+            let stays_flat = dot(old, old) <= 1e-10 * os * os && nn <= 1e-10 * s * s;
+            if !stays_flat
+                && (dot(old, moved) <= 1e-5 * sqrt(dot(old, old) * nn) || nn <= 1e-10 * s * s) {
                 return false;
             }
         }
