@@ -100,8 +100,9 @@ impl Grid {
 /// the result passes [`super::check_mesh`].
 ///
 /// # Panics
-/// If `elevations.len() != rows * cols` or there are more than `u32::MAX + 1`
-/// samples; the file readers check both before calling.
+/// If `elevations.len() != rows * cols`, if `coordinates` does not list
+/// `cols` x and `rows` y, or if there are more than `u32::MAX + 1` samples;
+/// the file readers check all three before calling.
 pub fn grid_to_mesh(grid: &Grid) -> Mesh {
     let (rows, cols) = (grid.rows, grid.cols);
     let n = rows.checked_mul(cols).expect("grid size overflows usize");
@@ -116,6 +117,14 @@ pub fn grid_to_mesh(grid: &Grid) -> Mesh {
         "grid too large for 32-bit indices"
     );
 
+    if let Some([xs, ys]) = &grid.coordinates {
+        assert!(
+            xs.len() == cols && ys.len() == rows,
+            "grid lists {} x and {} y for {cols} columns and {rows} rows",
+            xs.len(),
+            ys.len()
+        );
+    }
     let [x0, y0] = grid.origin;
     let [dx, dy] = grid.spacing;
     let x_at = |c: usize| match &grid.coordinates {

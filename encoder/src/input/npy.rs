@@ -349,6 +349,10 @@ fn coordinate_axis<R: Read + std::io::Seek>(
     let Some(name) = npz_axes::find(names, wanted, raster) else {
         return Ok(None);
     };
+    if rows == 0 || cols == 0 {
+        // No sample to place: the grid is refused for having no cell.
+        return Ok(None);
+    }
     let (count, what) = if along_x {
         (cols, "columns")
     } else {
@@ -758,5 +762,28 @@ mod tests {
         assert!(msg.contains("'x' is not monotonic"), "{msg}");
         let msg = err(("x", f8("(2, 3)", &[0.0, 1.0, 2.0, 0.0, 1.0, 2.5])));
         assert!(msg.contains("not the same in every row"), "{msg}");
+    }
+
+    /// Found in reviewing the coordinate arrays: a raster without rows or
+    /// columns beside coordinate arrays as empty as it (a 1-D `y` of no
+    /// value, a 2-D `y` of no column) is refused for having no cell, not a
+    /// panic (an index into no values, a `step_by(0)`).
+    #[test]
+    fn npz_empty_raster_beside_coordinates_fails_cleanly() {
+        for (shape, y) in [("(0, 3)", f8("(0,)", &[])), ("(2, 0)", f8("(2, 0)", &[]))] {
+            let bytes = npz(&[("z", f8(shape, &[])), ("y", y)]);
+            let f = TempFile::new("empty.npz", &bytes);
+            let msg = read_mesh(&f.0, &ReadOptions::default())
+                .unwrap_err()
+                .to_string();
+            assert!(msg.contains("no cell"), "{shape}: {msg}");
+        }
+        assert_eq!(
+            npz_axes::axis("f", "y", vec![], 0, "rows").unwrap(),
+            Axis::Regular {
+                first: 0.0,
+                step: 1.0
+            }
+        );
     }
 }

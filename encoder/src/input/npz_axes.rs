@@ -98,7 +98,7 @@ pub(super) fn axis(
     }
     if count < 2 {
         return Ok(Axis::Regular {
-            first: values[0],
+            first: values.first().copied().unwrap_or(0.0),
             step: 1.0,
         });
     }
