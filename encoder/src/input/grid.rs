@@ -137,12 +137,10 @@ pub fn grid_to_mesh(grid: &Grid) -> Mesh {
     };
     // With one axis decreasing the x/y axes are mirrored, so the winding
     // that is counter-clockwise in (col, row) space becomes clockwise.
-    let decreasing = |first: f64, last: f64, step: f64| match &grid.coordinates {
-        Some(_) => last < first,
-        None => step < 0.0,
+    let mirrored = match &grid.coordinates {
+        Some([xs, ys]) => (xs.last() < xs.first()) != (ys.last() < ys.first()),
+        None => (dx < 0.0) != (dy < 0.0),
     };
-    let mirrored = decreasing(x_at(0), x_at(cols.saturating_sub(1)), dx)
-        != decreasing(y_at(0), y_at(rows.saturating_sub(1)), dy);
 
     let all_valid = (0..n).all(|i| grid.is_valid(i));
     let mut positions = Vec::with_capacity(n);
@@ -252,6 +250,35 @@ mod tests {
         }
         let m = grid_to_mesh(&grid(3, 2, [1.0, 2.0]));
         assert_eq!(m.positions[5], [11.0, 24.0, 5.0]);
+    }
+
+    /// Listed coordinates, unevenly spaced and either way round, give the
+    /// same counter-clockwise triangles; an empty grid lists nothing.
+    #[test]
+    fn listed_coordinates_are_ccw_either_way() {
+        let (xs, ys) = (vec![0.0, 1.0, 3.0, 7.0, 8.0], vec![0.0, 2.0, 3.0, 5.0]);
+        let reversed = |v: &Vec<f64>| v.iter().rev().copied().collect::<Vec<_>>();
+        for (x, y) in [
+            (xs.clone(), ys.clone()),
+            (reversed(&xs), ys.clone()),
+            (xs.clone(), reversed(&ys)),
+            (reversed(&xs), reversed(&ys)),
+        ] {
+            let g = Grid {
+                coordinates: Some([x.clone(), y.clone()]),
+                ..grid(4, 5, [1.0, 1.0])
+            };
+            let m = grid_to_mesh(&g);
+            for &t in &m.triangles {
+                assert!(signed_area(&m, t) > 0.0, "{x:?} {y:?}");
+            }
+            assert_eq!(m.positions[6], [x[1], y[1], 6.0]);
+        }
+        let empty = Grid {
+            coordinates: Some([vec![], vec![]]),
+            ..grid(0, 0, [1.0, 1.0])
+        };
+        assert!(grid_to_mesh(&empty).triangles.is_empty());
     }
 
     #[test]
