@@ -424,6 +424,67 @@ fn gpu_bench_can_leave_out_the_decoder_table() {
     assert!(err.contains("--sides: 1"), "{err}");
 }
 
+/// A closed torus of `rings` x `sides` vertices, as OFF text.
+fn torus_off(rings: usize, sides: usize) -> String {
+    let mut s = format!("OFF\n{} {} 0\n", rings * sides, 2 * rings * sides);
+    for i in 0..rings {
+        let u = i as f64 / rings as f64 * std::f64::consts::TAU;
+        for j in 0..sides {
+            let v = j as f64 / sides as f64 * std::f64::consts::TAU;
+            // A little unevenness, so the collapses do not all tie.
+            let r = 1.0 + 0.05 * ((3 * i + 5 * j) % 7) as f64 / 7.0;
+            let (x, y) = ((3.0 + r * v.cos()) * u.cos(), (3.0 + r * v.cos()) * u.sin());
+            s.push_str(&format!("{x} {y} {}\n", r * v.sin()));
+        }
+    }
+    let at = |i: usize, j: usize| (i % rings) * sides + j % sides;
+    for i in 0..rings {
+        for j in 0..sides {
+            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
+            s.push_str(&format!("3 {a} {b} {c}\n3 {a} {c} {d}\n"));
+        }
+    }
+    s
+}
+
+#[test]
+fn bench_dumps_the_quality_rows_meshes_and_says_where_the_farthest_samples_lie() {
+    // The bench reads its inputs by name from `--data`: a torus stands in
+    // for armadillo.
+    let data = temp("armadillo.off", &torus_off(32, 16));
+    let data = data.parent().unwrap();
+    let dump = data.join("bench-dump");
+    let out = succeeded(&splitstream(&[
+        "bench",
+        "--data",
+        data.to_str().unwrap(),
+        "--only",
+        "armadillo",
+        "--skip-throughput",
+        "--dump",
+        dump.to_str().unwrap(),
+    ]));
+    assert!(out.contains("| armadillo | 25.00 % (128 v) |"), "{out}");
+    assert!(out.contains("### The largest distances"), "{out}");
+    let rows: Vec<&str> = out
+        .lines()
+        .filter(|l| {
+            l.starts_with("| armadillo | 25.00 % |") || l.starts_with("| armadillo | 6.25 % |")
+        })
+        .collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    for row in rows {
+        assert!(row.contains(") on the "), "{row}");
+    }
+    for percent in ["25", "6.25"] {
+        for mesh in ["reference", "parallel", "sequential"] {
+            let ply = dump.join(format!("armadillo-{percent}-{mesh}.ply"));
+            let bytes = std::fs::read(&ply).unwrap_or_else(|e| panic!("{}: {e}", ply.display()));
+            assert!(bytes.starts_with(b"ply\n"), "{}", ply.display());
+        }
+    }
+}
+
 #[test]
 fn verify_prints_the_state_hash_after_the_last_round() {
     let (_, stream) = encoded_raster("for-verify.sps");

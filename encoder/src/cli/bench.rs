@@ -12,7 +12,7 @@ use splitstream_encoder::Mesh;
 use splitstream_encoder::baseline::{BaselineOptions, simplify_sequential};
 use splitstream_encoder::emit::{EncodeOptions, encode, lanes_for};
 use splitstream_encoder::input::{ReadOptions, check_mesh, fractal_terrain, read_mesh};
-use splitstream_encoder::metrics::surface_distance;
+use splitstream_encoder::metrics::{DistanceReport, surface_distance};
 use splitstream_encoder::quantize::{Quantization, QuantizedMesh, Units, quantize};
 use splitstream_encoder::simplify::{
     Backend, Checked, Simplification, SimplifyOptions, simplify_on,
@@ -20,6 +20,7 @@ use splitstream_encoder::simplify::{
 use splitstream_encoder::spatial_order::spatially_ordered;
 
 use super::info::{field_sizes, is_geometry};
+use super::output::write_mesh;
 use super::{BackendArg, CliResult};
 
 const SAMPLES: usize = 200_000;
@@ -83,6 +84,13 @@ pub struct Settings {
     /// Where the parallel simplifier's data-parallel passes run.
     #[arg(long, value_enum, default_value_t = BackendArg::Cpu)]
     pub backend: BackendArg,
+    /// Also write each quality row's meshes to this folder as PLY, in the
+    /// frame the distances are measured in (the quantized input in metric
+    /// units, origin at the quantization origin): `INPUT-PERCENT-reference`,
+    /// `-parallel` and `-sequential`, to look at where the farthest samples
+    /// lie.
+    #[arg(long, value_name = "DIR")]
+    pub dump: Option<std::path::PathBuf>,
 }
 
 pub fn run(settings: &Settings) -> CliResult {
@@ -156,10 +164,30 @@ pub fn run(settings: &Settings) -> CliResult {
             "| input | target | parallel Hausdorff | sequential Hausdorff | ratio | parallel RMS | sequential RMS | ratio | parallel s | sequential s | speed-up |"
         );
         println!("|---|---|---|---|---|---|---|---|---|---|---|");
+        if let Some(dir) = &settings.dump {
+            std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        }
+        let mut farthest = Vec::new();
         for (input, mesh) in &loaded {
             for fraction in [0.25, 0.0625] {
-                quality_row(input, mesh, fraction, &simplify_options, backend)?;
+                let row = QualityRow {
+                    input,
+                    mesh,
+                    fraction,
+                    dump: settings.dump.as_deref(),
+                };
+                farthest.push(quality_row(&row, &simplify_options, backend)?);
             }
+        }
+        println!(
+            "\n### The largest distances: 99.9th percentile of the samples (% of the diagonal) and the farthest sample (metric frame, origin at the quantization origin; on which surface)\n"
+        );
+        println!(
+            "| input | target | parallel 99.9 % | sequential 99.9 % | ratio | parallel farthest | sequential farthest |"
+        );
+        println!("|---|---|---|---|---|---|---|");
+        for line in farthest {
+            println!("{line}");
         }
         println!("\n## Vertices kept at the same maximum quadric error\n");
         println!(
@@ -305,13 +333,27 @@ fn checked(q: &QuantizedMesh) -> Result<Checked<'_>, String> {
     Checked::new(q).map_err(|e| e.to_string())
 }
 
-fn quality_row(
-    input: &Input,
-    mesh: &Mesh,
+/// One row of the quality table: which input, how far down, where to dump.
+struct QualityRow<'a> {
+    input: &'a Input,
+    mesh: &'a Mesh,
     fraction: f64,
+    dump: Option<&'a Path>,
+}
+
+/// Prints the row of the quality table and returns the row of the
+/// largest-distances table.
+fn quality_row(
+    row: &QualityRow<'_>,
     options: OptionsFor<'_>,
     backend: Backend,
-) -> CliResult {
+) -> Result<String, String> {
+    let QualityRow {
+        input,
+        mesh,
+        fraction,
+        dump,
+    } = *row;
     let q = quantized(input, mesh)?;
     let metric = QuantizedMesh {
         origin: [0.0; 3],
@@ -332,6 +374,23 @@ fn quality_row(
             ..BaselineOptions::default()
         },
     );
+    if let Some(dir) = dump {
+        let stem = format!(
+            "{}-{}",
+            input.name.replace(' ', "_"),
+            format!("{:.2}", 100.0 * fraction)
+                .trim_end_matches('0')
+                .trim_end_matches('.')
+        );
+        for (name, m) in [
+            ("reference", &reference),
+            ("parallel", &parallel),
+            ("sequential", &sequential.mesh),
+        ] {
+            let path = dir.join(format!("{stem}-{name}.ply"));
+            write_mesh(&path, &m.positions, &m.triangles)?;
+        }
+    }
     let dp = surface_distance(&reference, &parallel, SAMPLES, 7);
     let ds = surface_distance(&reference, &sequential.mesh, SAMPLES, 7);
     let pct = |x: f64, d: f64| 100.0 * x / d;
@@ -350,7 +409,33 @@ fn quality_row(
         sequential.seconds,
         sequential.seconds / parallel_seconds
     );
-    Ok(())
+    Ok(format!(
+        "| {} | {:.2} % | {:.4} | {:.4} | {:.2} | {} | {} |",
+        input.name,
+        100.0 * fraction,
+        pct(dp.p999, dp.diagonal),
+        pct(ds.p999, ds.diagonal),
+        dp.p999 / ds.p999,
+        farthest_cell(&dp),
+        farthest_cell(&ds),
+    ))
+}
+
+/// The farthest sample of a comparison against the reference (`a`): its
+/// point, and whether it lies on the simplified surface (the simplified
+/// mesh strays from the input there) or on the reference (the simplified
+/// mesh lost input surface there).
+fn farthest_cell(d: &DistanceReport) -> String {
+    match d.farthest {
+        Some(f) => format!(
+            "({:.4}, {:.4}, {:.4}) on the {}",
+            f.point[0],
+            f.point[1],
+            f.point[2],
+            if f.on_a { "input" } else { "simplified" }
+        ),
+        None => "none".into(),
+    }
 }
 
 fn equal_error_row(

@@ -27,6 +27,22 @@ pub struct DistanceReport {
     pub mean: f64,
     /// Bounding-box diagonal of `a`, so callers can report fractions.
     pub diagonal: f64,
+    /// The distance that 99.9 % of the samples of both directions do not
+    /// exceed (nearest rank). The Hausdorff distance is one sample's, so a
+    /// single spike decides it; this one moves only when many do.
+    pub p999: f64,
+    /// Where the Hausdorff distance was found; `None` without samples.
+    pub farthest: Option<Farthest>,
+}
+
+/// The sample at the largest distance ([`DistanceReport::hausdorff`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Farthest {
+    /// The sample point, in the meshes' own coordinates.
+    pub point: [f64; 3],
+    /// Which surface the sample lies on: `true` for `a` (its distance is to
+    /// `b`), `false` for `b`.
+    pub on_a: bool,
 }
 
 /// Symmetric sampled distance between surfaces `a` and `b`.
@@ -52,23 +68,49 @@ pub fn surface_distance(a: &Mesh, b: &Mesh, samples_per_mesh: usize, seed: u64) 
             )
         },
     );
-    let mut distances = one_way(&on_a.points(), &bvh_b);
-    distances.extend(one_way(&on_b.points(), &bvh_a));
+    let (points_a, points_b) = (on_a.points(), on_b.points());
+    let mut distances = one_way(&points_a, &bvh_b);
+    distances.extend(one_way(&points_b, &bvh_a));
     let count = distances.len();
     // Sequential sums, so the result does not depend on thread scheduling.
     let (mut max, mut sum, mut sum2) = (0.0f64, 0.0, 0.0);
-    for d in distances {
-        max = max.max(d);
+    let mut farthest = None;
+    for (i, &d) in distances.iter().enumerate() {
+        // The first sample at the largest distance (`>`; an infinite one
+        // too, where the other side has no triangles).
+        if farthest.is_none() || d > max {
+            max = max.max(d);
+            farthest = Some(i);
+        }
         sum += d;
         sum2 += d * d;
     }
     let n = count.max(1) as f64;
+    let farthest = farthest.map(|i| Farthest {
+        point: points_a
+            .get(i)
+            .copied()
+            .unwrap_or_else(|| points_b[i - points_a.len()]),
+        on_a: i < points_a.len(),
+    });
     DistanceReport {
         hausdorff: max,
         rms: (sum2 / n).sqrt(),
         mean: sum / n,
         diagonal: a.diagonal(),
+        p999: percentile(&mut distances, 0.999),
+        farthest,
     }
+}
+
+/// The nearest-rank `q` quantile of `values` (0 when there are none);
+/// reorders them.
+fn percentile(values: &mut [f64], q: f64) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let rank = ((q * values.len() as f64).ceil() as usize).clamp(1, values.len());
+    *values.select_nth_unstable_by(rank - 1, f64::total_cmp).1
 }
 
 /// Distance from every sample to the surface in `bvh`, in sample order.

@@ -68,6 +68,41 @@ fn hausdorff_sees_a_one_sided_bump() {
 }
 
 #[test]
+fn the_farthest_sample_is_the_bump_and_the_percentile_ignores_it() {
+    let a = grid(5, 0.0);
+    let mut b = a.clone();
+    b.positions[12][2] = 1.0;
+    let r = surface_distance(&a, &b, 1000, 5);
+    // Vertex 12 of the 5 x 5 grid is its centre, (2, 2), lifted to 1; it
+    // lies on `b`, so the sample is on the second surface.
+    let far = r.farthest.expect("samples");
+    assert_eq!(far.point, [2.0, 2.0, 1.0]);
+    assert!(!far.on_a);
+    // Swapped, the same point lies on the first surface.
+    assert!(surface_distance(&b, &a, 1000, 5).farthest.unwrap().on_a);
+    // The bump's slopes reach a quarter of the grid: far more than 0.1 %
+    // of the samples lie on them, so the percentile is below the spike but
+    // above 0.
+    assert!(r.p999 > 0.0 && r.p999 < r.hausdorff, "{r:?}");
+}
+
+#[test]
+fn the_percentile_of_an_offset_plane_is_its_offset() {
+    let r = surface_distance(&grid(10, 0.0), &grid(10, 0.5), 5000, 1);
+    assert!((r.p999 - 0.5).abs() < 1e-12, "{r:?}");
+}
+
+#[test]
+fn nearest_rank_percentiles() {
+    let mut v: Vec<f64> = (1..=1000).rev().map(f64::from).collect();
+    assert_eq!(percentile(&mut v, 0.999), 999.0);
+    assert_eq!(percentile(&mut v, 1.0), 1000.0);
+    assert_eq!(percentile(&mut v, 0.0), 1.0);
+    assert_eq!(percentile(&mut [7.0], 0.999), 7.0);
+    assert_eq!(percentile(&mut [], 0.999), 0.0);
+}
+
+#[test]
 fn deterministic_for_a_seed() {
     let a = grid(6, 0.0);
     let mut b = a.clone();
@@ -81,8 +116,12 @@ fn deterministic_for_a_seed() {
 fn empty_meshes() {
     let m = grid(3, 0.0);
     let empty = Mesh::default();
-    assert_eq!(surface_distance(&empty, &empty, 10, 0).hausdorff, 0.0);
-    assert_eq!(surface_distance(&m, &empty, 10, 0).hausdorff, f64::INFINITY);
+    let none = surface_distance(&empty, &empty, 10, 0);
+    assert_eq!((none.hausdorff, none.p999, none.farthest), (0.0, 0.0, None));
+    let one_sided = surface_distance(&m, &empty, 10, 0);
+    assert_eq!(one_sided.hausdorff, f64::INFINITY);
+    assert_eq!(one_sided.p999, f64::INFINITY);
+    assert!(one_sided.farthest.unwrap().on_a);
 }
 
 /// Speed of 1M samples per side between a 1M-vertex, 2M-triangle terrain
