@@ -27,6 +27,7 @@ const RASTER_PIXEL_IS_POINT: u16 = 2;
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
     let f = File::open(path).map_err(|e| InputError::io(file, e))?;
+    let file_len = f.metadata().map_err(|e| InputError::io(file, e))?.len();
     let bad = |e: tiff::TiffError| match e {
         tiff::TiffError::UnsupportedError(u) => InputError::unsupported(file, format!("TIFF {u}")),
         e => InputError::malformed(file, format!("invalid TIFF: {e}")),
@@ -71,6 +72,22 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
         }
         None => false,
     };
+    // An ASCII value's length is the file's word: the tiff crate allocates
+    // it whole before reading (4 GB of address space for a 162-byte file
+    // that claims them), and above its buffer limit (BigTIFF counts) it
+    // prints a debug line of its own beside our error, which fuzzing found.
+    // A value cannot be longer than the file that holds it.
+    if let Some(entry) = decoder.image_ifd().find_entry(Tag::GdalNodata)
+        && entry.count() > file_len
+    {
+        return Err(InputError::malformed(
+            file,
+            format!(
+                "GDAL_NODATA claims {} bytes, more than the file's {file_len}",
+                entry.count()
+            ),
+        ));
+    }
     let nodata = match decoder.find_tag(Tag::GdalNodata).map_err(bad)? {
         Some(v) => {
             let text = v.into_string().map_err(bad)?;
@@ -217,6 +234,83 @@ mod tests {
             assert!(m.positions.contains(&[1005.0, 4990.0, 1.0]));
             check_mesh(&m).unwrap();
         }
+    }
+
+    /// A 2 x 2 float TIFF whose GDAL_NODATA entry claims `count` bytes at
+    /// offset 100 (past the end): BigTIFF when `big`, for counts beyond
+    /// 32 bits.
+    fn nodata_claiming(count: u64, big: bool) -> Vec<u8> {
+        let data: Vec<u8> = [1.0f32, 2.0, 3.0, 4.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let start = if big { 16 } else { 8 };
+        // (tag, type, count, value): 3 SHORT, 4 LONG, 16 LONG8, 2 ASCII.
+        let offsets = if big { 16 } else { 4 };
+        let entries: [(u16, u16, u64, u64); 11] = [
+            (256, 3, 1, 2),
+            (257, 3, 1, 2),
+            (258, 3, 1, 32),
+            (259, 3, 1, 1),
+            (262, 3, 1, 1),
+            (273, offsets, 1, start),
+            (277, 3, 1, 1),
+            (278, 3, 1, 2),
+            (279, offsets, 1, data.len() as u64),
+            (339, 3, 1, 3),
+            (42113, 2, count, 100),
+        ];
+        let mut out = Vec::new();
+        if big {
+            out.extend(b"II+\0\x08\0\0\0");
+            out.extend((start + data.len() as u64).to_le_bytes());
+        } else {
+            out.extend(b"II*\0");
+            out.extend((start as u32 + data.len() as u32).to_le_bytes());
+        }
+        out.extend(&data);
+        if big {
+            out.extend((entries.len() as u64).to_le_bytes());
+        } else {
+            out.extend((entries.len() as u16).to_le_bytes());
+        }
+        for (tag, kind, count, value) in entries {
+            out.extend(tag.to_le_bytes());
+            out.extend(kind.to_le_bytes());
+            if big {
+                out.extend(count.to_le_bytes());
+                out.extend(value.to_le_bytes());
+            } else {
+                out.extend((count as u32).to_le_bytes());
+                out.extend((value as u32).to_le_bytes());
+            }
+        }
+        out.extend(if big { &[0u8; 8][..] } else { &[0u8; 4][..] });
+        out
+    }
+
+    #[test]
+    fn a_nodata_string_longer_than_the_file_is_refused_before_it_is_read() {
+        // Classic TIFF claiming nearly 4 GB (allocated whole before), and a
+        // BigTIFF claiming a terabyte (the tiff crate's own debug print).
+        for (count, big) in [(0xFFFF_FFF0, false), (1 << 40, true)] {
+            let bytes = nodata_claiming(count, big);
+            let f = TempFile::new("huge-nodata.tif", &bytes);
+            let err = read(&f.0, "huge-nodata.tif").unwrap_err().to_string();
+            assert!(
+                err.contains(&format!(
+                    "GDAL_NODATA claims {count} bytes, more than the file's {}",
+                    bytes.len()
+                )),
+                "{err}"
+            );
+        }
+        // The same layout with a count that fits reads past the end: the
+        // tiff crate's own error, not this one.
+        let bytes = nodata_claiming(8, false);
+        let f = TempFile::new("short-nodata.tif", &bytes);
+        let err = read(&f.0, "short-nodata.tif").unwrap_err().to_string();
+        assert!(!err.contains("claims"), "{err}");
     }
 
     #[test]
