@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.10 decoder, in Python, written from
+"""A second splitstream 3.11 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
@@ -13,7 +13,10 @@ header flag bit 1, was added with the SPEC sections that define it, and
 "Positions first", 3.8's tie rules of record orders 2 and 3 with
 `off` of SPEC §7.4 `before`, 3.9's adaptive rANS tables with SPEC
 §5.5.2 and §5.5.4, and 3.10's flag contexts `split-history` with SPEC
-§5.1, §5.5.5, §6.1 and §7.5.) It speaks the conformance protocol (a stream
+§5.1, §5.5.5, §6.1 and §7.5, and 3.11's `compact` level framing, header
+flag bit 2, with SPEC §5.1.1: parse_fixed and parse_compact read a level
+header up to its CRC check into the same fields, and decode_level applies
+the rules after it to either.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -562,7 +565,7 @@ class Decoder:
         if crc32(s[0:92]) != u32(s, 92):
             raise Fail("checksum-mismatch")
         flags = u16(s, 10)
-        if flags & 0xFFFC:  # bit 1: schedule (3.6)
+        if flags & 0xFFF8:  # bit 1: schedule (3.6), bit 2: framing (3.11)
             raise Fail("malformed")
         if not (1 <= s[12] <= 31):
             raise Fail("malformed")
@@ -589,6 +592,7 @@ class Decoder:
                 raise Fail("malformed")
         self.constrained = flags & 1
         self.every = (flags >> 1) & 1  # schedule: 0 split-valences, 1 every-vertex (3.6)
+        self.compact = (flags >> 2) & 1  # framing: 0 fixed, 1 compact (3.11), SPEC §5.1.1
         self.bits = s[12]
         self.lane_count = s[13]
         L = u16(s, 14)
@@ -651,13 +655,18 @@ class Decoder:
                  3 * 8 * ((V + 63) // 64), 7 * round8(max(M, RANS_SLOT_BYTES))]
         return sum(round8(x) for x in sizes)
 
-    def decode_level(self, li, lvl, entry):
+    def parse_fixed(self, li, lvl):
+        """SPEC §5.1: the fixed level header, up to and including its CRC
+        check. Returns its fields as parse_compact does: R, N, the policy
+        bytes, SV and ST (level 0), the split counts, the directory entries
+        (id, codec, reserved, raw_len, stored_len, crc) and payload_start."""
         ln = len(lvl)
         H = 20 if li == 0 else 12
         if ln < H:
             raise Fail("truncated")
         R = u32(lvl, 0)
         N = u32(lvl, 4)
+        SV = ST = None
         if li == 0:
             SV = u32(lvl, 12)
             ST = u32(lvl, 16)
@@ -666,19 +675,87 @@ class Decoder:
             raise Fail("truncated")
         if crc32(lvl[0:payload_start - 4]) != u32(lvl, payload_start - 4):
             raise Fail("checksum-mismatch")
-        if lvl[8] > 5:
+        # past the CRC check every field lies within the level: reading them
+        # all now fails nothing
+        policies = tuple(lvl[8:12])
+        split_counts = [u32(lvl, H + 4 * r) for r in range(R)]
+        dir_off = H + 4 * R
+        entries = []
+        for i in range(N):
+            o = dir_off + 16 * i
+            entries.append((lvl[o], lvl[o + 1], u16(lvl, o + 2),
+                            u32(lvl, o + 4), u32(lvl, o + 8), u32(lvl, o + 12)))
+        return R, N, policies, SV, ST, split_counts, entries, payload_start
+
+    def parse_compact(self, li, lvl):
+        """Compact framing (3.11), SPEC §5.1.1: the level header read field by
+        field from a cursor, up to and including its CRC check; the same
+        fields as parse_fixed (a compact entry has no reserved field: 0)."""
+        ln = len(lvl)
+        at = [0]
+
+        def next_byte():
+            if ln < at[0] + 1:
+                raise Fail("truncated")
+            at[0] += 1
+            return lvl[at[0] - 1]
+
+        def varint():  # §5.4's rules: at most 5 bytes, 32 bits, minimal
+            return leb128(next_byte)
+
+        R = varint()
+        N = varint()
+        if ln < at[0] + 4:
+            raise Fail("truncated")
+        policies = tuple(lvl[at[0]:at[0] + 4])  # plane, wing, contexts, record order
+        at[0] += 4
+        SV = ST = None
+        if li == 0:
+            SV = varint()
+            ST = varint()
+        # every step reads at least one byte: a count above what the level
+        # holds ends in `truncated`
+        split_counts = [varint() for _r in range(R)]
+        entries = []
+        for _i in range(N):
+            b = next_byte()  # id_codec: id in bits 0-3, codec in bits 4-7
+            raw_len = varint()
+            stored_len = varint()
+            if ln < at[0] + 4:
+                raise Fail("truncated")
+            crc = u32(lvl, at[0])
+            at[0] += 4
+            entries.append((b & 0x0F, b >> 4, 0, raw_len, stored_len, crc))
+        payload_start = at[0] + 4
+        if ln < payload_start:
+            raise Fail("truncated")
+        if crc32(lvl[0:at[0]]) != u32(lvl, at[0]):
+            raise Fail("checksum-mismatch")
+        return R, N, policies, SV, ST, split_counts, entries, payload_start
+
+    def decode_level(self, li, lvl, entry):
+        ln = len(lvl)
+        if self.compact:  # compact framing (3.11), SPEC §5.1.1
+            hdr = self.parse_compact(li, lvl)
+        else:  # fixed framing, SPEC §5.1
+            hdr = self.parse_fixed(li, lvl)
+        R, N, policies, SV, ST, split_counts, dir_entries, payload_start = hdr
+        # SPEC §5.1 (and §5.1.1): every rule after the CRC check, in order,
+        # whatever the framing
+        plane_policy, wing_policy, contexts, record_order = policies
+        if plane_policy > 5:
             raise Fail("malformed")
-        if lvl[9] > 2:  # wing policy (3.2)
+        if wing_policy > 2:  # wing policy (3.2)
             raise Fail("malformed")
-        if lvl[10] > 2:  # contexts (3.3; 2 since 3.10)
+        if contexts > 2:  # contexts (3.3; 2 since 3.10)
             raise Fail("malformed")
-        if lvl[10] == 1 and self.every:  # no split-valence symbols (3.6)
+        if contexts == 1 and self.every:  # no split-valence symbols (3.6)
             raise Fail("malformed")
-        if lvl[10] == 2 and not self.every:  # split-history: every-vertex only (3.10)
+        if contexts == 2 and not self.every:  # split-history: every-vertex only (3.10)
             raise Fail("malformed")
-        if lvl[11] > 3:  # record order (3.7; 2 and 3 since 3.8)
+        if record_order > 3:  # record order (3.7; 2 and 3 since 3.8)
             raise Fail("malformed")
-        if lvl[11] >= 1 and (not self.constrained or lvl[8] != 5):
+        if record_order >= 1 and (not self.constrained or plane_policy != 5):
             raise Fail("malformed")  # positions-first: constrained mode, plane policy height
         if li == 0 and (SV == 0 or ST == 0):
             raise Fail("malformed")
@@ -686,16 +763,8 @@ class Decoder:
         prev_id = 0
         prev_rans = False
         total = payload_start
-        dir_off = H + 4 * R
         chunks = {}
-        for i in range(N):
-            o = dir_off + 16 * i
-            sid = lvl[o]
-            codec = lvl[o + 1]
-            res = u16(lvl, o + 2)
-            raw_len = u32(lvl, o + 4)
-            stored_len = u32(lvl, o + 8)
-            crc = u32(lvl, o + 12)
+        for sid, codec, res, raw_len, stored_len, crc in dir_entries:
             if res != 0:
                 raise Fail("malformed")
             if sid not in allowed:
@@ -723,7 +792,6 @@ class Decoder:
             raise Fail("malformed")
         if R != entry["rounds"]:
             raise Fail("count-mismatch")
-        split_counts = [u32(lvl, H + 4 * r) for r in range(R)]
         for sc in split_counts:
             if sc == 0:
                 raise Fail("malformed")
@@ -735,21 +803,21 @@ class Decoder:
         subs = {}
         for sid in range(1, 11):
             lst = [(c, rl, crc, bytes(lvl[off:off + sl])) for (c, rl, crc, off, sl) in chunks.get(sid, [])]
-            nctx = (NCTX_EVERY if self.every else NCTX_VALENCE if lvl[10] == 1 else NCTX)[sid]
-            if self.every and lvl[10] == 2 and sid == 1:  # split-history flags (3.10)
+            nctx = (NCTX_EVERY if self.every else NCTX_VALENCE if contexts == 1 else NCTX)[sid]
+            if self.every and contexts == 2 and sid == 1:  # split-history flags (3.10)
                 nctx = 8
-            if lvl[11] >= 1:  # positions first (3.7, 3.8)
+            if record_order >= 1:  # positions first (3.7, 3.8)
                 nctx = NCTX_PF.get(sid, nctx)
             subs[sid] = Sub(sid, lst, self.lane_count, nctx)
         self.subs = subs
-        self.policy = lvl[8]
-        self.wing_policy = lvl[9]
-        self.deficit_contexts = lvl[10]
+        self.policy = plane_policy
+        self.wing_policy = wing_policy
+        self.deficit_contexts = contexts
         # SPEC §6.1 (3.10): the split-history bits, all 0 when a level starts.
         self.split = set()
         # 0 wings-first, 1 positions-first (3.7), 2 positions-first-rising,
         # 3 positions-first-falling (3.8)
-        self.record_order = lvl[11]
+        self.record_order = record_order
         self.T_l = entry["T"]
         if li == 0:
             self.read_base(SV, ST)

@@ -241,8 +241,9 @@ fn pieces(stream: &[u8], broken: bool, hashes: &mut Vec<u64>) -> Result<(), Erro
             &mut inflater,
             header.lane_count,
         );
-        for r in 0..rounds {
-            let declared = level_header.split_count(r);
+        let mut splits = level_header.split_counts();
+        for _ in 0..rounds {
+            let declared = splits.next().unwrap_or(0);
             let source = StreamSource::new(&mut subs, header.position_mode);
             let result = if broken {
                 state.run_round(declared, &mut SwapPositions(source), &mut ring)

@@ -316,6 +316,7 @@ fn open_level<'d, 'l, 'ws>(
         info,
         header,
         round: 0,
+        splits: header.split_counts(),
         mode: decoder.header.position_mode,
         state: &mut decoder.state,
         subs,
@@ -336,6 +337,8 @@ pub struct LevelDecoder<'d, 'l, 'ws> {
     info: LevelInfo,
     header: LevelHeader<'l>,
     round: u32,
+    /// The split counts of the rounds not yet decoded (SPEC §5.1).
+    splits: crate::SplitCounts<'l>,
     mode: crate::header::PositionMode,
     state: &'d mut MeshState<'ws>,
     subs: Substreams<'l, 'd>,
@@ -374,7 +377,7 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
                 }
             };
         }
-        let declared = self.header.split_count(self.round);
+        let declared = self.splits.next().unwrap_or(0);
         let mut source = Observed {
             source: StreamSource::new(&mut self.subs, self.mode),
             observer,
@@ -467,7 +470,7 @@ impl<'d, 'l, 'ws> LevelDecoder<'d, 'l, 'ws> {
         if self.done || self.round == self.header.round_count {
             return Ok(None);
         }
-        let declared = self.header.split_count(self.round);
+        let declared = self.splits.next().unwrap_or(0);
         let mut source = StreamSource::new(&mut self.subs, self.mode);
         let result = self
             .state

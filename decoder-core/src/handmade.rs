@@ -13,7 +13,7 @@ use alloc::vec::Vec;
 
 use crate::Error;
 use crate::context::{self, DeficitContexts};
-use crate::header::{PositionMode, Schedule};
+use crate::header::{Framing, PositionMode, Schedule};
 use crate::limits::LEAF;
 use crate::owned::decode_all;
 use crate::predict::PlanePolicy;
@@ -37,6 +37,9 @@ pub fn params(codec: ChunkCodec) -> StreamParams {
         rans_chunk_limit: 4,
         schedule: Schedule::SplitValences,
         adaptive_tables: false,
+        // The hand-made vectors keep the framing they were made with
+        // (3.0's); the encoder's vectors cover the compact one.
+        framing: Framing::Fixed,
     }
 }
 

@@ -43,6 +43,29 @@ impl Schedule {
     }
 }
 
+/// How every level header of a stream is laid out (SPEC §3.2 header flag
+/// bit 2, §5.1; format 3.11).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Framing {
+    /// Fixed-width fields: `u32` counts, 16-byte directory entries (3.0).
+    #[default]
+    Fixed,
+    /// 3.11: the counts and lengths as varints, a directory entry's id and
+    /// codec in one byte (SPEC §5.1.1): 7 to 10 bytes an entry instead of
+    /// 16, one or two bytes a round instead of 4.
+    Compact,
+}
+
+impl Framing {
+    /// The name `splitstream info` and the SPEC use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Framing::Fixed => "fixed",
+            Framing::Compact => "compact",
+        }
+    }
+}
+
 /// The parsed header (SPEC §3.2).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Header {
@@ -50,6 +73,8 @@ pub struct Header {
     pub position_mode: PositionMode,
     /// Which vertices split in which round (header flag bit 1, 3.6).
     pub schedule: Schedule,
+    /// How the level headers are laid out (header flag bit 2, 3.11).
+    pub framing: Framing,
     /// Quantization bits per axis: coordinates lie in `0 .. 2^bits`.
     pub bits: u8,
     /// Entries in the level table; entry 0 is the base mesh.
@@ -78,6 +103,7 @@ impl Header {
             max_chunk_len: self.max_chunk_len,
             schedule: self.schedule,
             position_mode: self.position_mode,
+            framing: self.framing,
         }
     }
 
@@ -101,7 +127,7 @@ impl Header {
             return Err(Error::ChecksumMismatch(ChecksumScope::Header));
         }
         let flags = u16_at(bytes, 10)?;
-        if flags & !3 != 0 {
+        if flags & !7 != 0 {
             return Err(Error::InvalidHeader("reserved flag bits set"));
         }
         let position_mode = if flags & 1 == 0 {
@@ -113,6 +139,11 @@ impl Header {
             Schedule::SplitValences
         } else {
             Schedule::EveryVertex
+        };
+        let framing = if flags & 4 == 0 {
+            Framing::Fixed
+        } else {
+            Framing::Compact
         };
         let bits = u8_at(bytes, 12)?;
         if !(MIN_BITS..=MAX_BITS).contains(&bits) {
@@ -158,6 +189,7 @@ impl Header {
             version_minor: minor,
             position_mode,
             schedule,
+            framing,
             bits,
             lane_count,
             level_count,
@@ -186,7 +218,11 @@ impl Header {
             Schedule::SplitValences => 0,
             Schedule::EveryVertex => 2,
         };
-        let flags = mode | schedule;
+        let framing: u16 = match self.framing {
+            Framing::Fixed => 0,
+            Framing::Compact => 4,
+        };
+        let flags = mode | schedule | framing;
         out[10..12].copy_from_slice(&flags.to_le_bytes());
         out[12] = self.bits;
         out[13] = self.lane_count;

@@ -1,9 +1,10 @@
 //! A level's own header: rounds, the plane and wing policies, the deficit
-//! contexts, split counts and the chunk directory (SPEC §5.1, §5.2).
+//! contexts, split counts and the chunk directory (SPEC §5.1, §5.2), in
+//! the `fixed` framing or (3.11) the `compact` one (SPEC §5.1.1).
 
 use crate::bytes::{crc32, u8_at, u16_at, u32_at};
 use crate::context::DeficitContexts;
-use crate::header::{PositionMode, Schedule};
+use crate::header::{Framing, PositionMode, Schedule};
 use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
 use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
@@ -23,24 +24,26 @@ const fn split_counts_at(is_base: bool) -> usize {
 
 /// What a level header is checked against that the stream header says
 /// (SPEC §5.1): the largest stored or deflate chunk, the schedule (the
-/// flags' table count, the deficit contexts allowed) and the position mode
-/// (where `positions-first` is allowed). [`crate::Header::level_rules`]
-/// gives a stream's.
+/// flags' table count, the deficit contexts allowed), the position mode
+/// (where `positions-first` is allowed) and the framing (how the header is
+/// laid out, 3.11). [`crate::Header::level_rules`] gives a stream's.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct LevelRules {
     pub max_chunk_len: u32,
     pub schedule: Schedule,
     pub position_mode: PositionMode,
+    pub framing: Framing,
 }
 
 impl LevelRules {
-    /// Rules for unit tests that frame levels by hand: 64 KiB chunks,
-    /// split valences, constrained mode.
+    /// Rules for unit tests that frame levels with the writer's defaults:
+    /// 64 KiB chunks, split valences, constrained mode, compact framing.
     #[cfg(test)]
     pub(crate) const TEST: LevelRules = LevelRules {
         max_chunk_len: 1 << 16,
         schedule: Schedule::SplitValences,
         position_mode: PositionMode::Constrained,
+        framing: Framing::Compact,
     };
 }
 
@@ -88,6 +91,8 @@ pub struct LevelHeader<'l> {
     /// start from (SPEC §5.1, §6.3); `(0, 0)` for other levels.
     pub seed_vertices: u32,
     pub seed_triangles: u32,
+    /// How the split counts and the directory are coded (3.11).
+    pub framing: Framing,
     split_counts: &'l [u8],
     directory: &'l [u8],
     pub chunk_count: u32,
@@ -100,43 +105,17 @@ impl<'l> LevelHeader<'l> {
     /// stream whose header sets `rules` (SPEC §3.2).
     /// `is_base` selects which substream ids are allowed.
     pub fn parse(level: &'l [u8], is_base: bool, rules: LevelRules) -> Result<Self, Error> {
-        let LevelRules {
-            max_chunk_len,
-            schedule,
-            position_mode: mode,
-        } = rules;
-        let round_count = u32_at(level, 0)?;
-        let chunk_count = u32_at(level, 4)?;
-        let counts_at = split_counts_at(is_base);
-        if level.len() < counts_at {
-            return Err(Error::Truncated);
-        }
-        let (seed_vertices, seed_triangles) = if is_base {
-            (u32_at(level, SEED_AT)?, u32_at(level, SEED_AT + 4)?)
-        } else {
-            (0, 0)
+        let fields = match rules.framing {
+            Framing::Fixed => Fields::fixed(level, is_base)?,
+            Framing::Compact => Fields::compact(level, is_base)?,
         };
-        let plane_byte = u8_at(level, PLANE_AT)?;
-        let wing_byte = u8_at(level, PLANE_AT + 1)?;
-        let deficit_byte = u8_at(level, PLANE_AT + 2)?;
-        let record_byte = u8_at(level, PLANE_AT + 3)?;
-        let splits_len = (round_count as usize)
-            .checked_mul(4)
-            .ok_or(Error::Truncated)?;
-        let dir_len = (chunk_count as usize)
-            .checked_mul(CHUNK_ENTRY_LEN)
-            .ok_or(Error::Truncated)?;
-        let dir_start = counts_at.checked_add(splits_len).ok_or(Error::Truncated)?;
-        let crc_at = dir_start.checked_add(dir_len).ok_or(Error::Truncated)?;
-        let payload_start = crc_at.checked_add(4).ok_or(Error::Truncated)?;
-        if level.len() < payload_start {
-            return Err(Error::Truncated);
-        }
+        let crc_at = fields.crc_at;
         if crc32(&level[..crc_at]) != u32_at(level, crc_at)? {
             return Err(Error::ChecksumMismatch(ChecksumScope::LevelHeader));
         }
+        let [plane_byte, wing_byte, deficit_byte, record_byte] = fields.policies;
         let header = LevelHeader {
-            round_count,
+            round_count: fields.round_count,
             plane_policy: PlanePolicy::from_byte(plane_byte).unwrap_or(PlanePolicy::Off),
             plane_byte,
             wing_policy: WingPolicy::from_byte(wing_byte).unwrap_or(WingPolicy::Ranks),
@@ -147,16 +126,17 @@ impl<'l> LevelHeader<'l> {
             record_order: RecordOrder::from_byte(record_byte).unwrap_or_default(),
             ties: Ties::from_record_byte(record_byte).unwrap_or_default(),
             record_byte,
-            mode,
-            schedule,
-            seed_vertices,
-            seed_triangles,
-            split_counts: &level[counts_at..dir_start],
-            directory: &level[dir_start..crc_at],
-            chunk_count,
-            payload_start,
+            mode: rules.position_mode,
+            schedule: rules.schedule,
+            seed_vertices: fields.seed[0],
+            seed_triangles: fields.seed[1],
+            framing: rules.framing,
+            split_counts: &level[fields.counts_at..fields.dir_start],
+            directory: &level[fields.dir_start..crc_at],
+            chunk_count: fields.chunk_count,
+            payload_start: crc_at + 4,
         };
-        header.validate(level.len(), is_base, max_chunk_len)?;
+        header.validate(level.len(), is_base, rules.max_chunk_len)?;
         Ok(header)
     }
 
@@ -204,8 +184,8 @@ impl<'l> LevelHeader<'l> {
         let mut previous_id = 0u8;
         let mut previous_rans = false;
         let mut payload = self.payload_start as u64;
-        for k in 0..self.chunk_count {
-            let e = self.chunk(k)?;
+        for e in self.chunks() {
+            let e = e?;
             if !allowed.contains(&e.substream) {
                 return Err(Error::InvalidLevelHeader(
                     "substream id not allowed in this level",
@@ -249,23 +229,222 @@ impl<'l> LevelHeader<'l> {
         Ok(())
     }
 
-    /// Declared split count of round `r` (SPEC §5.1).
-    pub fn split_count(&self, r: u32) -> u32 {
-        u32_at(self.split_counts, r as usize * 4).unwrap_or(0)
+    /// The declared split counts of the rounds, in order (SPEC §5.1,
+    /// §5.1.1): under the compact framing a round's count is found only by
+    /// reading the ones before it, so a decoder keeps this iterator.
+    pub fn split_counts(&self) -> SplitCounts<'l> {
+        SplitCounts {
+            cursor: Cursor::new(self.split_counts),
+            framing: self.framing,
+        }
     }
 
-    /// Directory entry `k` (SPEC §5.2).
-    pub fn chunk(&self, k: u32) -> Result<ChunkEntry, Error> {
-        let at = k as usize * CHUNK_ENTRY_LEN;
-        if u16_at(self.directory, at + 2)? != 0 {
-            return Err(Error::InvalidLevelHeader("reserved field not zero"));
-        }
-        Ok(ChunkEntry {
-            substream: u8_at(self.directory, at)?,
-            codec: u8_at(self.directory, at + 1)?,
-            raw_len: u32_at(self.directory, at + 4)?,
-            stored_len: u32_at(self.directory, at + 8)?,
-            crc: u32_at(self.directory, at + 12)?,
+    /// The directory entries in order (SPEC §5.1, §5.1.1).
+    pub fn chunks(&self) -> impl Iterator<Item = Result<ChunkEntry, Error>> + 'l {
+        let header = *self;
+        let mut at = 0;
+        (0..self.chunk_count).map(move |_| {
+            let (e, next) = header.entry_at(at)?;
+            at = next;
+            Ok(e)
         })
+    }
+
+    /// Directory entry `k` (SPEC §5.1): reads the `k` entries before it
+    /// under the compact framing; decoders walk [`Self::entry_at`] instead.
+    pub fn chunk(&self, k: u32) -> Result<ChunkEntry, Error> {
+        self.chunks()
+            .nth(k as usize)
+            .unwrap_or(Err(Error::Truncated))
+    }
+
+    /// The directory entry that starts `at` bytes into the directory, and
+    /// where the next one starts (SPEC §5.1, §5.1.1).
+    pub fn entry_at(&self, at: usize) -> Result<(ChunkEntry, usize), Error> {
+        let mut c = Cursor {
+            bytes: self.directory,
+            at,
+        };
+        let e = match self.framing {
+            Framing::Fixed => {
+                if u16_at(self.directory, at + 2)? != 0 {
+                    return Err(Error::InvalidLevelHeader("reserved field not zero"));
+                }
+                c.at += CHUNK_ENTRY_LEN;
+                ChunkEntry {
+                    substream: u8_at(self.directory, at)?,
+                    codec: u8_at(self.directory, at + 1)?,
+                    raw_len: u32_at(self.directory, at + 4)?,
+                    stored_len: u32_at(self.directory, at + 8)?,
+                    crc: u32_at(self.directory, at + 12)?,
+                }
+            }
+            Framing::Compact => {
+                let id_codec = c.byte()?;
+                ChunkEntry {
+                    substream: id_codec & 0x0F,
+                    codec: id_codec >> 4,
+                    raw_len: c.varint()?,
+                    stored_len: c.varint()?,
+                    crc: c.u32()?,
+                }
+            }
+        };
+        Ok((e, c.at))
+    }
+}
+
+/// Where a level header's parts lie, found before its CRC is checked.
+struct Fields {
+    round_count: u32,
+    chunk_count: u32,
+    policies: [u8; 4],
+    seed: [u32; 2],
+    counts_at: usize,
+    dir_start: usize,
+    crc_at: usize,
+}
+
+impl Fields {
+    /// The fixed framing (SPEC §5.1): every part at an offset computed from
+    /// the two counts.
+    fn fixed(level: &[u8], is_base: bool) -> Result<Fields, Error> {
+        let round_count = u32_at(level, 0)?;
+        let chunk_count = u32_at(level, 4)?;
+        let counts_at = split_counts_at(is_base);
+        if level.len() < counts_at {
+            return Err(Error::Truncated);
+        }
+        let seed = if is_base {
+            [u32_at(level, SEED_AT)?, u32_at(level, SEED_AT + 4)?]
+        } else {
+            [0, 0]
+        };
+        let policies = core::array::from_fn(|i| level[PLANE_AT + i]);
+        let splits_len = (round_count as usize)
+            .checked_mul(4)
+            .ok_or(Error::Truncated)?;
+        let dir_len = (chunk_count as usize)
+            .checked_mul(CHUNK_ENTRY_LEN)
+            .ok_or(Error::Truncated)?;
+        let dir_start = counts_at.checked_add(splits_len).ok_or(Error::Truncated)?;
+        let crc_at = dir_start.checked_add(dir_len).ok_or(Error::Truncated)?;
+        if level.len() < crc_at.checked_add(4).ok_or(Error::Truncated)? {
+            return Err(Error::Truncated);
+        }
+        Ok(Fields {
+            round_count,
+            chunk_count,
+            policies,
+            seed,
+            counts_at,
+            dir_start,
+            crc_at,
+        })
+    }
+
+    /// The compact framing (SPEC §5.1.1, 3.11): read field by field, each
+    /// step at least one byte, so a count larger than the level ends in
+    /// `Truncated` after at most the level's length in steps.
+    fn compact(level: &[u8], is_base: bool) -> Result<Fields, Error> {
+        let mut c = Cursor::new(level);
+        let round_count = c.varint()?;
+        let chunk_count = c.varint()?;
+        let policies = [c.byte()?, c.byte()?, c.byte()?, c.byte()?];
+        let seed = if is_base {
+            [c.varint()?, c.varint()?]
+        } else {
+            [0, 0]
+        };
+        let counts_at = c.at;
+        for _ in 0..round_count {
+            c.varint()?;
+        }
+        let dir_start = c.at;
+        for _ in 0..chunk_count {
+            c.byte()?;
+            c.varint()?;
+            c.varint()?;
+            c.u32()?;
+        }
+        let crc_at = c.at;
+        c.u32()?;
+        Ok(Fields {
+            round_count,
+            chunk_count,
+            policies,
+            seed,
+            counts_at,
+            dir_start,
+            crc_at,
+        })
+    }
+}
+
+/// A reading position in a level header's bytes (SPEC §5.1.1).
+#[derive(Clone, Copy, Debug)]
+struct Cursor<'l> {
+    bytes: &'l [u8],
+    at: usize,
+}
+
+impl<'l> Cursor<'l> {
+    fn new(bytes: &'l [u8]) -> Self {
+        Cursor { bytes, at: 0 }
+    }
+
+    fn byte(&mut self) -> Result<u8, Error> {
+        let b = u8_at(self.bytes, self.at)?;
+        self.at += 1;
+        Ok(b)
+    }
+
+    fn u32(&mut self) -> Result<u32, Error> {
+        let v = u32_at(self.bytes, self.at)?;
+        self.at += 4;
+        Ok(v)
+    }
+
+    /// `varint()` of SPEC §5.1.1: §5.4's rules (5 bytes, 32 bits, minimal).
+    fn varint(&mut self) -> Result<u32, Error> {
+        let mut v = 0u32;
+        for i in 0..5 {
+            let b = self.byte()?;
+            if i == 4 && b > 0x0F {
+                return Err(Error::InvalidLevelHeader("varint over 32 bits"));
+            }
+            v |= u32::from(b & 0x7F) << (7 * i);
+            if b & 0x80 == 0 {
+                if b == 0 && i > 0 {
+                    return Err(Error::InvalidLevelHeader("varint not minimal"));
+                }
+                return Ok(v);
+            }
+        }
+        // Unreachable: the fifth byte is at most 0x0F, so it ends the value.
+        Err(Error::InvalidLevelHeader("varint over 32 bits"))
+    }
+}
+
+/// The split counts of a level's rounds, in order
+/// ([`LevelHeader::split_counts`]); 0 past the last (a validated header
+/// has none).
+#[derive(Clone, Copy, Debug)]
+pub struct SplitCounts<'l> {
+    cursor: Cursor<'l>,
+    framing: Framing,
+}
+
+impl Iterator for SplitCounts<'_> {
+    type Item = u32;
+
+    fn next(&mut self) -> Option<u32> {
+        if self.cursor.at >= self.cursor.bytes.len() {
+            return None;
+        }
+        match self.framing {
+            Framing::Fixed => self.cursor.u32().ok(),
+            Framing::Compact => self.cursor.varint().ok(),
+        }
     }
 }

@@ -175,8 +175,7 @@ impl<'h> LevelTable<'h> {
             self.get(k - 1).vertex_count as u64
         };
         let mut added = 0u64;
-        for r in 0..header.round_count {
-            let s = header.split_count(r);
+        for s in header.split_counts() {
             if s == 0 {
                 return Err(Error::InvalidLevelHeader("a round without splits"));
             }

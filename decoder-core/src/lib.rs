@@ -64,10 +64,10 @@ pub use corner_refs::CornerRefs;
 pub use decoder::{Decoder, LevelDecoder, RoundInfo, SplitObserver, declared_layout, layout_for};
 pub use error::{ChecksumScope, Error};
 pub use hash::Fnv1a;
-pub use header::{Header, PositionMode, Schedule};
+pub use header::{Framing, Header, PositionMode, Schedule};
 pub use inflate::Inflater;
 pub use layout::Layout;
-pub use level_header::{ChunkEntry, LevelHeader, LevelRules};
+pub use level_header::{ChunkEntry, LevelHeader, LevelRules, SplitCounts};
 pub use level_table::{LevelInfo, LevelTable, head_len, level_within_error, write_level_table};
 pub use positions_first::{RecordOrder, Ties};
 pub use predict::{

@@ -8,7 +8,10 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 /// stream; 3.5 added a check and no feature, so no stream is written with
 /// minor version 5 (the writer uses the constants below).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 10;
+pub const VERSION_MINOR: u8 = 11;
+/// The minor version written when the header selects the `compact` level
+/// framing (SPEC §3.2 flag bit 2, §5.1.1): 3.10 decoders reject the flag.
+pub const VERSION_MINOR_COMPACT: u8 = 11;
 /// The minor version written when a level uses the contexts
 /// `split-history` (SPEC §5.1, §5.5.5): 3.9 decoders reject its contexts
 /// byte.

@@ -15,7 +15,7 @@ use crate::rans::{adaptive_shift, normalise, token_of};
 /// A value and the context it is coded in.
 pub type Symbol = (u8, u32);
 
-fn push_varint(out: &mut Vec<u8>, mut v: u32) {
+pub(crate) fn push_varint(out: &mut Vec<u8>, mut v: u32) {
     loop {
         let low = (v & 0x7F) as u8;
         v >>= 7;

@@ -21,6 +21,10 @@ struct Reader<'b> {
     id: u8,
     next_chunk: u32,
     end_chunk: u32,
+    /// Where the next chunk's directory entry starts in the directory
+    /// (read on from the last one: SPEC §5.1.1), and its payload in the
+    /// level.
+    entry_at: usize,
     payload_at: usize,
     /// Byte codecs: the current chunk's raw bytes.
     buf: &'b mut [u8],
@@ -50,6 +54,7 @@ impl Reader<'_> {
             id,
             next_chunk: 0,
             end_chunk: 0,
+            entry_at: 0,
             payload_at: 0,
             buf: &mut [],
             chunk: None,
@@ -90,48 +95,51 @@ impl<'l, 'b> Substreams<'l, 'b> {
         inflater: &'b mut Inflater,
         lane_count: u8,
     ) -> Self {
-        let mut i = 0u8;
-        let mut readers = buffers.map(|buf| {
-            let id = first_id + i;
+        // Chunks are ordered by substream id (validated), so each substream's
+        // chunks form one run of the directory and one run of the payload;
+        // its first entry, where that starts and whether it is rANS (a
+        // substream's chunks are all rANS or none, SPEC §5.1) are found in
+        // one pass over the directory.
+        let mut first: [Option<(u32, usize, usize)>; SLOTS] = [None; SLOTS];
+        let mut ends = [0u32; SLOTS];
+        let mut rans = [false; SLOTS];
+        let (mut payload, mut at) = (header.payload_start, 0);
+        for k in 0..header.chunk_count {
+            // The directory was validated when the header was parsed.
+            let Ok((e, next)) = header.entry_at(at) else {
+                break;
+            };
+            let slot = e.substream.wrapping_sub(first_id) as usize;
+            if slot < SLOTS {
+                first[slot].get_or_insert((k, at, payload));
+                ends[slot] = k + 1;
+                rans[slot] |= e.codec == codec::RANS;
+            }
+            payload += e.stored_len as usize;
+            at = next;
+        }
+        let mut i = 0;
+        let readers = buffers.map(|buf| {
+            let slot = i;
             i += 1;
-            // The level header was validated: a substream's chunks are all
-            // rANS or all byte codecs (SPEC §5.1).
-            let rans = (0..header.chunk_count).any(|k| {
-                header
-                    .chunk(k)
-                    .is_ok_and(|e| e.substream == id && e.codec == codec::RANS)
-            });
-            let (buf, chunk) = if rans {
+            let (buf, chunk) = if rans[slot] {
                 let words = bytemuck::try_cast_slice_mut::<u8, u32>(buf).unwrap_or(&mut []);
                 (&mut [][..], ChunkDecoder::new(words, lane_count as usize))
             } else {
                 (buf, None)
             };
+            let (next_chunk, entry_at, payload_at) = first[slot].unwrap_or_default();
             Reader {
                 buf,
                 chunk,
-                rans,
-                ..Reader::idle(id)
+                rans: rans[slot],
+                next_chunk,
+                end_chunk: ends[slot],
+                entry_at,
+                payload_at,
+                ..Reader::idle(first_id + slot as u8)
             }
         });
-        // Chunks are ordered by substream id (validated), so each substream's
-        // chunks form one run of the directory and one run of the payload.
-        let mut payload = header.payload_start;
-        let mut first_seen = [false; SLOTS];
-        for k in 0..header.chunk_count {
-            // The directory was validated when the header was parsed.
-            let Ok(e) = header.chunk(k) else { break };
-            let slot = e.substream.wrapping_sub(first_id) as usize;
-            if let Some(r) = readers.get_mut(slot) {
-                if !first_seen[slot] {
-                    first_seen[slot] = true;
-                    r.next_chunk = k;
-                    r.payload_at = payload;
-                }
-                r.end_chunk = k + 1;
-            }
-            payload += e.stored_len as usize;
-        }
         Substreams {
             level,
             header,
@@ -193,7 +201,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
         if r.next_chunk >= r.end_chunk {
             return Err(Error::RecordCountMismatch(r.id));
         }
-        let e = self.header.chunk(r.next_chunk)?;
+        let (e, next_entry) = self.header.entry_at(r.entry_at)?;
         let stored = self
             .level
             .get(r.payload_at..r.payload_at + e.stored_len as usize)
@@ -218,6 +226,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
             }
         }
         r.next_chunk += 1;
+        r.entry_at = next_entry;
         r.payload_at += e.stored_len as usize;
         r.len = raw;
         r.pos = 0;
@@ -577,6 +586,7 @@ mod tests {
             ..LevelPayload::default()
         };
         let params = StreamParams {
+            framing: crate::header::Framing::Compact,
             position_mode: PositionMode::Optimal,
             bits: 14,
             origin: [0.0; 3],
@@ -661,6 +671,7 @@ mod tests {
             ..LevelPayload::default()
         };
         let params = StreamParams {
+            framing: crate::header::Framing::Compact,
             position_mode: PositionMode::Constrained,
             bits: 14,
             origin: [0.0; 3],
@@ -723,14 +734,23 @@ mod tests {
         }
         let at = start + at.index(bytes.len() - start);
         bytes[at] ^= x | 1;
+        // Each entry ends with its CRC, in either framing; the directory
+        // ends where the header's CRC starts.
+        let mut ends = Vec::new();
+        let mut next = 0;
+        for _ in 0..header.chunk_count {
+            let (e, after) = header.entry_at(next).expect("entry");
+            ends.push((e, after));
+            next = after;
+        }
+        let directory_at = header.payload_start - 4 - next;
         let mut offset = start;
-        for k in 0..header.chunk_count {
-            let e = header.chunk(k).expect("entry");
+        for (e, entry_end) in ends {
             let end = offset + e.stored_len as usize;
             if (offset..end).contains(&at) {
                 let crc = crate::bytes::crc32(&bytes[offset..end]);
-                let entry_at = header.payload_start - 4 - 16 * (header.chunk_count - k) as usize;
-                bytes[entry_at + 12..entry_at + 16].copy_from_slice(&crc.to_le_bytes());
+                let crc_at = directory_at + entry_end - 4;
+                bytes[crc_at..crc_at + 4].copy_from_slice(&crc.to_le_bytes());
             }
             offset = end;
         }

@@ -6,19 +6,19 @@ use alloc::vec::Vec;
 
 use crate::bytes::crc32;
 use crate::context::{self, DeficitContexts};
-use crate::header::{Header, PositionMode, Schedule};
+use crate::header::{Framing, Header, PositionMode, Schedule};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
     CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_ADAPTIVE, VERSION_MINOR_BASELINE,
-    VERSION_MINOR_DEFICITS, VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_RECORDS,
-    VERSION_MINOR_SCHEDULE, VERSION_MINOR_SPLIT_HISTORY, VERSION_MINOR_TIES, VERSION_MINOR_WINGS,
-    codec, substream,
+    VERSION_MINOR_COMPACT, VERSION_MINOR_DEFICITS, VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS,
+    VERSION_MINOR_RECORDS, VERSION_MINOR_SCHEDULE, VERSION_MINOR_SPLIT_HISTORY, VERSION_MINOR_TIES,
+    VERSION_MINOR_WINGS, codec, substream,
 };
 use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
 use crate::rans_segments::rans_segments;
-use crate::rans_writer::{Symbol, encode_chunk_with, estimated_chunk_len};
+use crate::rans_writer::{Symbol, encode_chunk_with, estimated_chunk_len, push_varint};
 use crate::wing_order::WingPolicy;
 
 /// A growing substream: bytes, bits (least significant first) or varints
@@ -206,6 +206,10 @@ pub struct StreamParams {
     /// that is smaller (SPEC §5.5.2, format 3.9). Without, the stream stays
     /// readable by 3.8 decoders.
     pub adaptive_tables: bool,
+    /// How the level headers are laid out (SPEC §3.2 header flag bit 2,
+    /// §5.1.1, format 3.11). `Fixed` keeps the stream readable by 3.10
+    /// decoders.
+    pub framing: Framing,
 }
 
 impl Default for StreamParams {
@@ -223,6 +227,7 @@ impl Default for StreamParams {
             rans_chunk_limit: DEFAULT_RANS_CHUNK_LIMIT,
             schedule: Schedule::default(),
             adaptive_tables: true,
+            framing: Framing::Compact,
         }
     }
 }
@@ -369,14 +374,16 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.10 where a level's flags use the contexts
+    // SPEC §1: 3.11 where the level headers are compact, 3.10 where a level's flags use the contexts
     // `split-history`, 3.9 where a rANS chunk has an adaptive table, 3.8 where a positions-first level breaks ties by a
     // diagonal, 3.7 where a level reads its records positions first, 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
     // `max_chunk_len`) is used, 3.3 where a 3.3 feature (the deficit
     // contexts `valence`) is, 3.2 where a 3.2 feature (a wing policy other
     // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
     // is; every other stream stays readable by 3.0 decoders.
-    let version_minor = if levels
+    let version_minor = if params.framing == Framing::Compact {
+        VERSION_MINOR_COMPACT
+    } else if levels
         .iter()
         .any(|l| l.deficits == DeficitContexts::SplitHistory)
     {
@@ -410,6 +417,7 @@ pub fn assemble_stream(
         version_minor,
         position_mode: params.position_mode,
         schedule: params.schedule,
+        framing: params.framing,
         bits: params.bits,
         lane_count: params.codec.lane_count(),
         level_count,
@@ -459,7 +467,7 @@ pub fn frame_level_with(
     params: &StreamParams,
     map: ChunkMap<'_>,
 ) -> FramedLevel {
-    let mut directory = Vec::new();
+    let mut directory: Vec<(u8, u8, u32, u32, u32)> = Vec::new();
     let mut payload = Vec::new();
     let (mut largest_byte_chunk, mut largest_rans_chunk) = (0u32, 0u32);
     let mut adaptive = false;
@@ -476,13 +484,14 @@ pub fn frame_level_with(
         let contexts = context::count(id, level.deficits, level.records, params.schedule);
         let chunks = substream_chunks(sub, contexts, params, map);
         for chunk in chunks {
-            let mut entry = [0u8; CHUNK_ENTRY_LEN];
-            entry[0] = id;
-            entry[1] = chunk.codec;
-            entry[4..8].copy_from_slice(&chunk.raw_len.to_le_bytes());
-            entry[8..12].copy_from_slice(&(chunk.stored.len() as u32).to_le_bytes());
-            entry[12..16].copy_from_slice(&crc32(&chunk.stored).to_le_bytes());
-            directory.push(entry);
+            let stored_len = chunk.stored.len() as u32;
+            directory.push((
+                id,
+                chunk.codec,
+                chunk.raw_len,
+                stored_len,
+                crc32(&chunk.stored),
+            ));
             let largest = if chunk.codec == codec::RANS {
                 &mut largest_rans_chunk
             } else {
@@ -494,8 +503,18 @@ pub fn frame_level_with(
         }
     }
     let mut out = Vec::new();
-    out.extend_from_slice(&(level.round_splits.len() as u32).to_le_bytes());
-    out.extend_from_slice(&(directory.len() as u32).to_le_bytes());
+    let compact = params.framing == Framing::Compact;
+    // A count or length: a u32 under the fixed framing (SPEC §5.1), a
+    // varint under the compact one (§5.1.1).
+    let count = |out: &mut Vec<u8>, v: u32| {
+        if compact {
+            push_varint(out, v);
+        } else {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+    };
+    count(&mut out, level.round_splits.len() as u32);
+    count(&mut out, directory.len() as u32);
     out.extend_from_slice(&[
         level.plane.to_byte(),
         level.wings.to_byte(),
@@ -503,14 +522,21 @@ pub fn frame_level_with(
         level.records.to_byte(level.ties),
     ]);
     if let Some(seed) = seed {
-        out.extend_from_slice(&seed.vertices.to_le_bytes());
-        out.extend_from_slice(&seed.triangles.to_le_bytes());
+        count(&mut out, seed.vertices);
+        count(&mut out, seed.triangles);
     }
-    for s in &level.round_splits {
-        out.extend_from_slice(&s.to_le_bytes());
+    for &s in &level.round_splits {
+        count(&mut out, s);
     }
-    for e in &directory {
-        out.extend_from_slice(e);
+    for &(id, codec, raw_len, stored_len, crc) in &directory {
+        if compact {
+            out.push(id | codec << 4);
+        } else {
+            out.extend_from_slice(&[id, codec, 0, 0]);
+        }
+        count(&mut out, raw_len);
+        count(&mut out, stored_len);
+        out.extend_from_slice(&crc.to_le_bytes());
     }
     let crc = crc32(&out);
     out.extend_from_slice(&crc.to_le_bytes());

@@ -32,6 +32,7 @@ const T: u32 = 690_662_050;
 /// never reached: only the base fits in the test's workspace).
 fn huge_stream() -> Vec<u8> {
     let params = StreamParams {
+        framing: splitstream_decoder_core::Framing::Compact,
         position_mode: PositionMode::Optimal,
         bits: 8,
         origin: [0.0; 3],

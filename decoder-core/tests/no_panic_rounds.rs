@@ -86,6 +86,7 @@ fn many_rounds(w: u32, rounds: u32) -> Vec<u8> {
         geometric_error: 0.0,
     };
     let params = StreamParams {
+        framing: splitstream_decoder_core::Framing::Compact,
         position_mode: PositionMode::Optimal,
         bits: 16,
         origin: [0.0; 3],

@@ -107,6 +107,7 @@ proptest! {
             geometric_error: 0.0,
         };
         let params = StreamParams {
+        framing: splitstream_decoder_core::Framing::Compact,
             position_mode: if constrained { PositionMode::Constrained } else { PositionMode::Optimal },
             bits: 8,
             origin: [0.0; 3],

@@ -15,6 +15,8 @@ fn params() -> StreamParams {
         codec: ChunkCodec::Stored,
         chunk_limit: 4,
         rans_chunk_limit: 4,
+        // Appendix A shows the fixed framing's bytes.
+        framing: splitstream_decoder_core::Framing::Fixed,
         ..StreamParams::default()
     }
 }

@@ -502,6 +502,56 @@ fn verify_prints_the_state_hash_after_the_last_round() {
 /// `every-vertex` (format 3.6) and `split-valences` keeps the minor
 /// version older decoders read. `transcode` goes either way and keeps the
 /// mesh.
+/// The compact level framing (format 3.11, the default) and the fixed one
+/// decode to the same mesh; compact is smaller by what its level headers
+/// save and nothing else (the payloads are the same bytes), `info` names
+/// it, and `transcode` converts either way.
+#[test]
+fn both_framings_decode_to_the_same_mesh_and_compact_is_smaller() {
+    let (input, compact) = encoded_raster("framing-compact.sps");
+    let fixed = input.with_file_name("framing-fixed.sps");
+    let (i, c, f) = (
+        input.to_str().unwrap(),
+        compact.to_str().unwrap(),
+        fixed.to_str().unwrap(),
+    );
+    succeeded(&splitstream(&["encode", i, "-o", f, "--framing", "fixed"]));
+    let bytes = |p: &PathBuf| std::fs::read(p).unwrap();
+    let header = |p: &PathBuf| splitstream_decoder_core::Header::parse(&bytes(p)).unwrap();
+    use splitstream_decoder_core::Framing;
+    assert_eq!(header(&compact).framing, Framing::Compact);
+    assert_eq!(header(&compact).version_minor, 11);
+    assert_eq!(header(&fixed).framing, Framing::Fixed);
+    assert!(header(&fixed).version_minor < 11);
+    let (lc, lf) = (bytes(&compact).len(), bytes(&fixed).len());
+    assert!(lc < lf, "compact {lc} bytes, fixed {lf}");
+    assert!(succeeded(&splitstream(&["info", c])).contains("compact framing"));
+    let doc: serde_json::Value =
+        serde_json::from_str(&succeeded(&splitstream(&["info", f, "--json"]))).unwrap();
+    assert_eq!(doc["framing"], "fixed", "{doc}");
+    let mesh = |p: &PathBuf| {
+        let m = splitstream_decoder_core::owned::decode_all(&bytes(p), false).unwrap();
+        (m.positions, m.triangles)
+    };
+    assert_eq!(mesh(&compact), mesh(&fixed));
+    // Transcoded to the other framing, each is the other's bytes.
+    let to_fixed = input.with_file_name("framing-to-fixed.sps");
+    let to_compact = input.with_file_name("framing-to-compact.sps");
+    let (tf, tc) = (to_fixed.to_str().unwrap(), to_compact.to_str().unwrap());
+    succeeded(&splitstream(&[
+        "transcode",
+        c,
+        "-o",
+        tf,
+        "--framing",
+        "fixed",
+    ]));
+    succeeded(&splitstream(&["transcode", f, "-o", tc]));
+    assert_eq!(mesh(&to_fixed), mesh(&compact));
+    assert_eq!(bytes(&to_compact).len(), lc);
+    assert_eq!(bytes(&to_fixed).len(), lf);
+}
+
 #[test]
 fn both_schedules_decode_to_the_same_mesh() {
     let (input, every) = encoded_raster("schedule-every.sps");
@@ -518,16 +568,19 @@ fn both_schedules_decode_to_the_same_mesh() {
         s,
         "--schedule",
         "split-valences",
-        // Static tables: no 3.9 feature, so older decoders read it.
+        // Static tables and the fixed framing: no 3.9 or 3.11 feature, so
+        // older decoders read it.
         "--tables",
         "static",
+        "--framing",
+        "fixed",
     ]));
     let header =
         |p: &PathBuf| splitstream_decoder_core::Header::parse(&std::fs::read(p).unwrap()).unwrap();
     use splitstream_decoder_core::Schedule;
     assert_eq!(header(&every).schedule, Schedule::EveryVertex);
-    // 3.6, or 3.9 where a chunk has an adaptive table (SPEC §1).
-    assert!(matches!(header(&every).version_minor, 6 | 9));
+    // 3.11: the compact framing, the default (SPEC §1).
+    assert_eq!(header(&every).version_minor, 11);
     assert_eq!(header(&split).schedule, Schedule::SplitValences);
     assert!(header(&split).version_minor < 6);
     assert!(succeeded(&splitstream(&["info", e])).contains("schedule: every-vertex"));

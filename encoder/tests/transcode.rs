@@ -372,6 +372,7 @@ fn encode_and_transcode_options_share_their_coding() {
         ties: Some(splitstream_decoder_core::Ties::Falling),
         schedule: splitstream_decoder_core::Schedule::SplitValences,
         adaptive_tables: false,
+        framing: splitstream_decoder_core::Framing::Fixed,
     };
     let options = EncodeOptions {
         bits: 11,

@@ -223,11 +223,11 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "reserved-header-flag",
         "malformed",
-        "Header flag bit 2 (reserved) set.",
+        "Header flag bit 3 (reserved; bit 2 is the framing since 3.11) set.",
         &["reserved"],
         {
             let mut b = subject.clone();
-            b[10] |= 4;
+            b[10] |= 8;
             fix_header_crc(&mut b);
             b
         },

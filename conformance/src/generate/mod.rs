@@ -2,6 +2,7 @@
 //! manifest entry come from here, deterministically (same bytes on every
 //! run and machine). Run it with `conformance/generate.sh`.
 
+mod compact;
 mod invalid;
 mod malformed;
 mod meshes;
@@ -18,7 +19,7 @@ use splitstream_decoder_core::limits::codec;
 use splitstream_decoder_core::owned::{OwnedWorkspace, decode_all};
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{
-    Fnv1a, Header, LevelHeader, LevelTable, PositionMode, RecordOrder, Schedule,
+    Fnv1a, Framing, Header, LevelHeader, LevelTable, PositionMode, RecordOrder, Schedule,
 };
 use splitstream_encoder::Mesh;
 use splitstream_encoder::emit::{EncodeOptions, encode};
@@ -98,12 +99,16 @@ fn encoded(mesh: &Mesh, options: EncodeOptions) -> Vec<u8> {
 /// the vectors named `position-constrained` ask for constrained mode, and
 /// those named `every-vertex-…` for the schedule `every-vertex`
 /// ([`every_vertex`]); records are read wings first (format 3.7's
-/// `positions-first` has vectors of its own, `positions_first.rs`).
+/// `positions-first` has vectors of its own, `positions_first.rs`); level
+/// headers in the fixed framing, which the vectors were written in and
+/// whose offsets the invalid vectors patch (format 3.11's compact framing
+/// has vectors of its own, `compact.rs`).
 fn opts() -> EncodeOptions {
     EncodeOptions {
         position_mode: PositionMode::Optimal,
         schedule: Schedule::SplitValences,
         records: Some(RecordOrder::WingsFirst),
+        framing: Framing::Fixed,
         ..EncodeOptions::default()
     }
 }
@@ -132,6 +137,7 @@ pub fn generate(real_data: &Path) -> Result<Generated, String> {
     invalid_vectors(&mut specs);
     malformed::malformed_vectors(&mut specs);
     reach::reach_vectors(&mut specs);
+    compact::compact_vectors(&mut specs);
     let mut files = BTreeMap::new();
     let mut vectors = Vec::new();
     for spec in specs.0 {

@@ -60,8 +60,8 @@ pub fn unframe(stream: &[u8]) -> Unframed {
         // Slots 0..7: ids 1..=7 (rounds); 7..10: ids 8..=10 (seed).
         let mut substreams = vec![Vec::new(); 10];
         let mut at = lh.payload_start;
-        for c in 0..lh.chunk_count {
-            let e = lh.chunk(c).expect("a valid chunk");
+        for e in lh.chunks() {
+            let e = e.expect("a valid chunk");
             let stored = &bytes[at..at + e.stored_len as usize];
             let mut raw = vec![0u8; e.raw_len as usize];
             assert_ne!(
@@ -84,7 +84,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
         let seed = (k == 0).then_some((lh.seed_vertices, lh.seed_triangles, seed_substreams));
         levels.push(Level {
             seed,
-            round_splits: (0..lh.round_count).map(|r| lh.split_count(r)).collect(),
+            round_splits: lh.split_counts().collect(),
             plane: lh.plane_policy,
             wings: lh.wing_policy,
             deficits: lh.deficit_contexts,
@@ -111,6 +111,7 @@ pub fn unframe(stream: &[u8]) -> Unframed {
             rans_chunk_limit: header.max_chunk_len,
             schedule: header.schedule,
             adaptive_tables: false,
+            framing: header.framing,
         },
         levels,
     }
@@ -160,7 +161,7 @@ fn u32_at(s: &[u8], at: usize) -> u32 {
     u32::from_le_bytes(s[at..at + 4].try_into().expect("4 bytes"))
 }
 
-fn level_count(s: &[u8]) -> u16 {
+pub fn level_count(s: &[u8]) -> u16 {
     u16::from_le_bytes([s[14], s[15]])
 }
 
@@ -398,7 +399,7 @@ fn set_stored_payload(entry: &mut [u8], payload: &[u8]) {
 
 /// Appends `level` to `out` as level `k`, setting its table entry's offset
 /// and length (the table CRC is the caller's).
-fn append_level(out: &mut Vec<u8>, k: u16, level: &[u8]) {
+pub fn append_level(out: &mut Vec<u8>, k: u16, level: &[u8]) {
     let entry = table_entry(k);
     let offset = out.len() as u64;
     out[entry..entry + 8].copy_from_slice(&offset.to_le_bytes());

@@ -35,10 +35,10 @@ use splitstream_decoder_core::writer::{
     write_stream_seeded,
 };
 use splitstream_decoder_core::{
-    Decoder, DeficitContexts, Error, FANS_AHEAD_FROM_VERTICES, Inflater, Layout, MeshState, Plane,
-    PlanePolicy, PositionMode, RecordOrder, RecordSource, Ring, Schedule, SplitFan, SplitRecord,
-    Target, WingPolicy, arc_means, constrained_positions, context, height_prediction, predict,
-    wing_order, workspace_len,
+    Decoder, DeficitContexts, Error, FANS_AHEAD_FROM_VERTICES, Framing, Inflater, Layout,
+    MeshState, Plane, PlanePolicy, PositionMode, RecordOrder, RecordSource, Ring, Schedule,
+    SplitFan, SplitRecord, Target, WingPolicy, arc_means, constrained_positions, context,
+    height_prediction, predict, wing_order, workspace_len,
 };
 
 /// A byte string read as a sequence of choices; zeros once exhausted.
@@ -621,6 +621,13 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         schedule,
         // Adaptive tables where the writer finds them smaller (format 3.9).
         adaptive_tables: true,
+        // Both framings (format 3.11), by the bit count again (no choice of
+        // its own, as above).
+        framing: if (bits / 2).is_multiple_of(2) {
+            Framing::Compact
+        } else {
+            Framing::Fixed
+        },
     };
     let refinement_levels = 4 - choices.below(4);
     // With 31 bits, the base mesh is scaled towards the top of the grid.

@@ -3,7 +3,7 @@
 
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{
-    DeficitContexts, PlanePolicy, RecordOrder, Schedule, Ties, WingPolicy,
+    DeficitContexts, Framing, PlanePolicy, RecordOrder, Schedule, Ties, WingPolicy,
 };
 
 use super::{
@@ -18,6 +18,16 @@ pub enum TablesArg {
     Adaptive,
     /// A frequency table for every context (3.8 decoders read the stream).
     Static,
+}
+
+/// `--framing`: how the level headers are laid out (SPEC §5.1.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FramingArg {
+    /// Varint counts and lengths (format 3.11): 7–10 bytes a chunk and
+    /// 1–2 a round instead of 16 and 4.
+    Compact,
+    /// Fixed-width fields (3.10 decoders read the stream).
+    Fixed,
 }
 
 #[derive(clap::Args)]
@@ -48,6 +58,12 @@ pub struct CodingArgs {
     /// (SPEC §5.5.2).
     #[arg(long, value_enum, default_value_t = TablesArg::Adaptive)]
     pub tables: TablesArg,
+    /// How each level header is laid out: `compact`, its counts and
+    /// lengths as varints (format 3.11; about 500 bytes less a 5-level
+    /// stream, a tenth of a small terrain tile), or `fixed`, 32-bit fields
+    /// (3.10 decoders read the stream) (SPEC §5.1.1).
+    #[arg(long, value_enum, default_value_t = FramingArg::Compact)]
+    pub framing: FramingArg,
     /// Which axis of each position residual the split's plane predicts, or
     /// `height`: z from the surface of the split vertex's fan (terrain,
     /// format 3.1) (SPEC §7.4); `auto` picks the cheapest per level.
@@ -112,6 +128,10 @@ impl CodingArgs {
             chunk_limit: self.chunk_size,
             rans_chunk_limit: self.rans_chunk,
             adaptive_tables: self.tables == TablesArg::Adaptive,
+            framing: match self.framing {
+                FramingArg::Compact => Framing::Compact,
+                FramingArg::Fixed => Framing::Fixed,
+            },
             plane: self.plane(),
             wings: self.wings(),
             deficits: self.deficits(),

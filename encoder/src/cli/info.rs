@@ -338,6 +338,7 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
             "lane_count": header.lane_count,
             "position_mode": mode,
             "schedule": header.schedule.name(),
+            "framing": header.framing.name(),
             "bits": header.bits,
             "origin": header.origin,
             "scale": header.scale,
@@ -414,7 +415,11 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
         "  positions: {} bits/axis, {mode} placement, origin {:?}, step {:?}",
         header.bits, header.origin, header.scale
     );
-    println!("  schedule: {} (SPEC §3.2)", header.schedule.name());
+    println!(
+        "  schedule: {}; level headers: {} framing (SPEC §3.2, §5.1)",
+        header.schedule.name(),
+        header.framing.name()
+    );
     println!(
         "  decoder memory: {} bytes ({:.1} bytes/vertex), stored and deflate chunks up to {} bytes",
         header.workspace_bytes,

@@ -12,6 +12,7 @@ mod replay;
 mod transcode;
 mod wings;
 
+use splitstream_decoder_core::Framing;
 use splitstream_decoder_core::limits::rans::MAX_LANES;
 use splitstream_decoder_core::writer::{ChunkCodec, LevelPayload, StreamParams, assemble_stream};
 use splitstream_decoder_core::{
@@ -66,6 +67,10 @@ pub struct EncodeOptions {
     /// that is smaller (SPEC §5.5.2, format 3.9); without, 3.8 decoders
     /// read the stream.
     pub adaptive_tables: bool,
+    /// How the level headers are laid out (SPEC §3.2 flag bit 2, §5.1.1):
+    /// by default `compact` (format 3.11); `fixed` keeps the stream
+    /// readable by 3.10 decoders.
+    pub framing: Framing,
     pub lock_boundary: bool,
     pub admit_quantile: f64,
     /// Units of the input coordinates, for the error metric.
@@ -119,6 +124,7 @@ impl Default for EncodeOptions {
             chunk_limit: 16 * 1024,
             rans_chunk_limit: splitstream_decoder_core::writer::DEFAULT_RANS_CHUNK_LIMIT,
             adaptive_tables: true,
+            framing: Framing::Compact,
             lock_boundary: false,
             admit_quantile: SimplifyOptions::default().admit_quantile,
             units: Units::Linear,
@@ -144,6 +150,7 @@ impl EncodeOptions {
             chunk_limit: self.chunk_limit,
             rans_chunk_limit: self.rans_chunk_limit,
             adaptive_tables: self.adaptive_tables,
+            framing: self.framing,
             plane: self.plane,
             wings: self.wings,
             deficits: self.deficits,
@@ -160,6 +167,7 @@ impl EncodeOptions {
             chunk_limit,
             rans_chunk_limit,
             adaptive_tables,
+            framing,
             plane,
             wings,
             deficits,
@@ -172,6 +180,7 @@ impl EncodeOptions {
             chunk_limit,
             rans_chunk_limit,
             adaptive_tables,
+            framing,
             plane,
             wings,
             deficits,
@@ -447,6 +456,7 @@ fn encode_checked(
         rans_chunk_limit: options.rans_chunk_limit,
         schedule: options.schedule,
         adaptive_tables: options.adaptive_tables,
+        framing: options.framing,
     };
     let replayed = replay(
         mesh,

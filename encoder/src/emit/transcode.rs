@@ -12,6 +12,7 @@
 //! so that a stream written by an older encoder gets the newest coding
 //! (SPEC §1).
 
+use splitstream_decoder_core::Framing;
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::writer::{ChunkCodec, StreamParams, assemble_stream};
@@ -40,6 +41,10 @@ pub struct TranscodeOptions {
     /// Whether rANS chunks may code a context with an adaptive table where
     /// that is smaller (SPEC §5.5.2, format 3.9).
     pub adaptive_tables: bool,
+    /// How the level headers are laid out (SPEC §3.2 flag bit 2, §5.1.1):
+    /// by default `compact` (format 3.11); `fixed` keeps the stream
+    /// readable by 3.10 decoders.
+    pub framing: Framing,
     /// The plane policy of every level; `None`: chosen per level by size.
     pub plane: Option<PlanePolicy>,
     /// The wing policy of every level; `None`: chosen per level by size.
@@ -130,6 +135,7 @@ pub fn transcode(stream: &[u8], options: &TranscodeOptions) -> Result<Transcoded
         rans_chunk_limit: options.rans_chunk_limit,
         schedule: options.schedule,
         adaptive_tables: options.adaptive_tables,
+        framing: options.framing,
     };
     let simplification = refinement.simplification();
     let replayed = replay(
