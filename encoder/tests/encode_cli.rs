@@ -640,9 +640,12 @@ fn records_read_positions_first_decode_to_the_same_mesh() {
             records,
             "--ties",
             ties,
-            // Static tables: the minor version is the record order's.
+            // Static tables and the fixed framing: the minor version is
+            // the record order's.
             "--tables",
             "static",
+            "--framing",
+            "fixed",
         ]));
         let doc: serde_json::Value =
             serde_json::from_str(&succeeded(&splitstream(&["info", s, "--json"]))).unwrap();

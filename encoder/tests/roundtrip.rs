@@ -107,6 +107,8 @@ fn height_policy_roundtrips_and_sets_the_minor_version() {
                 let options = EncodeOptions {
                     // Static tables: the minor version is the feature's (3.9 adds none here).
                     adaptive_tables: false,
+                    // The fixed framing: the compact one (3.11) would raise it to 11.
+                    framing: splitstream_decoder_core::Framing::Fixed,
                     bits,
                     plane: Some(plane),
                     wings: Some(WingPolicy::Ranks),
@@ -144,6 +146,8 @@ fn every_wing_policy_roundtrips_and_sets_the_minor_version() {
                     let options = EncodeOptions {
                         // Static tables: the minor version is the feature's (3.9 adds none here).
                         adaptive_tables: false,
+                        // The fixed framing: the compact one (3.11) would raise it to 11.
+                        framing: splitstream_decoder_core::Framing::Fixed,
                         bits,
                         plane: Some(PlanePolicy::Dominant),
                         wings: Some(wings),
@@ -194,6 +198,8 @@ fn both_deficit_contexts_roundtrip_and_set_the_minor_version() {
                     let options = EncodeOptions {
                         // Static tables: the minor version is the feature's (3.9 adds none here).
                         adaptive_tables: false,
+                        // The fixed framing: the compact one (3.11) would raise it to 11.
+                        framing: splitstream_decoder_core::Framing::Fixed,
                         bits,
                         plane: Some(PlanePolicy::Dominant),
                         wings: Some(WingPolicy::Ranks),
@@ -247,6 +253,8 @@ fn both_flag_contexts_roundtrip_and_set_the_minor_version() {
                 ] {
                     let options = EncodeOptions {
                         adaptive_tables: false,
+                        // The fixed framing: the compact one (3.11) would mark 11.
+                        framing: splitstream_decoder_core::Framing::Fixed,
                         bits,
                         deficits: Some(flags),
                         records: Some(RecordOrder::WingsFirst),
@@ -398,12 +406,15 @@ fn rans_chunks_beyond_max_chunk_len_set_minor_version_4() {
         let options = EncodeOptions {
             // Static tables: the minor version is the feature's (3.9 adds none here).
             adaptive_tables: false,
+            // The fixed framing: the compact one (3.11) would raise it to 11.
+            framing: splitstream_decoder_core::Framing::Fixed,
             codec,
             chunk_limit,
             position_mode: PositionMode::Constrained,
             schedule: Schedule::SplitValences,
             // Wings first: the minor version of the feature under test
-            // (positions first, 3.7, would raise it to 7).
+            // (positions first, 3.7, would raise it to 7; the compact
+            // framing, 3.11, to 11).
             records: Some(RecordOrder::WingsFirst),
             ..EncodeOptions::default()
         };
@@ -425,6 +436,8 @@ fn rans_chunks_beyond_max_chunk_len_set_minor_version_4() {
     let options = EncodeOptions {
         // Static tables: the minor version is the feature's (3.9 adds none here).
         adaptive_tables: false,
+        // The fixed framing: the compact one (3.11) would raise it to 11.
+        framing: splitstream_decoder_core::Framing::Fixed,
         codec: ChunkCodec::RansAlways { lanes: 4 },
         schedule: Schedule::SplitValences,
         ..EncodeOptions::default()
@@ -458,6 +471,8 @@ fn every_vertex_roundtrips_and_sets_the_minor_version() {
                 let options = EncodeOptions {
                     // Static tables: the minor version is the feature's (3.9 adds none here).
                     adaptive_tables: false,
+                    // The fixed framing: the compact one (3.11) would raise it to 11.
+                    framing: splitstream_decoder_core::Framing::Fixed,
                     bits,
                     codec,
                     position_mode: mode,
@@ -473,6 +488,8 @@ fn every_vertex_roundtrips_and_sets_the_minor_version() {
                 let split = EncodeOptions {
                     // Static tables: the minor version is the feature's (3.9 adds none here).
                     adaptive_tables: false,
+                    // The fixed framing: the compact one (3.11) would raise it to 11.
+                    framing: splitstream_decoder_core::Framing::Fixed,
                     schedule: Schedule::SplitValences,
                     ..options
                 };
@@ -588,6 +605,8 @@ fn positions_first_roundtrips_and_sets_the_minor_version() {
                 let options = EncodeOptions {
                     // Static tables: the minor version is the feature's (3.9 adds none here).
                     adaptive_tables: false,
+                    // The fixed framing: the compact one (3.11) would raise it to 11.
+                    framing: splitstream_decoder_core::Framing::Fixed,
                     records: Some(RecordOrder::PositionsFirst),
                     schedule,
                     codec,
@@ -629,6 +648,8 @@ fn every_tie_rule_roundtrips_and_the_default_is_the_smallest() {
         let options = EncodeOptions {
             // Static tables: the minor version is the feature's (3.9 adds none here).
             adaptive_tables: false,
+            // The fixed framing: the compact one (3.11) would raise it to 11.
+            framing: splitstream_decoder_core::Framing::Fixed,
             records: Some(RecordOrder::PositionsFirst),
             ties: Some(ties),
             ..EncodeOptions::default()
@@ -650,6 +671,8 @@ fn every_tie_rule_roundtrips_and_the_default_is_the_smallest() {
     let options = EncodeOptions {
         // Static tables: the minor version is the feature's (3.9 adds none here).
         adaptive_tables: false,
+        // The fixed framing: the compact one (3.11) would raise it to 11.
+        framing: splitstream_decoder_core::Framing::Fixed,
         records: Some(RecordOrder::PositionsFirst),
         ..EncodeOptions::default()
     };
@@ -774,6 +797,8 @@ fn adaptive_tables_roundtrip_and_set_the_minor_version() {
     for mesh in [common::icosphere(3), common::bumpy_grid(31, 23, 2)] {
         for (lanes, schedule) in [(1, Schedule::EveryVertex), (4, Schedule::SplitValences)] {
             let adaptive = EncodeOptions {
+                // The fixed framing: the compact one (3.11) would mark 11.
+                framing: splitstream_decoder_core::Framing::Fixed,
                 codec: ChunkCodec::Rans { lanes },
                 schedule,
                 ..EncodeOptions::default()
