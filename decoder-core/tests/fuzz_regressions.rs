@@ -85,9 +85,51 @@ fn seed_streams_still_decode() {
 /// `fix_checksums` leaves valid streams unchanged (it follows the format).
 #[test]
 fn fix_checksums_is_the_identity_on_valid_streams() {
+    let mut compact = 0;
     for g in streams::seed_generated() {
         let mut s = g.stream.clone();
         fix_checksums(&mut s);
         assert!(s == g.stream, "{} (seeded: {})", g.base, g.seeded);
+        // Header flag bit 2: the compact framing (3.11).
+        compact += usize::from(g.stream[10] & 4 != 0);
     }
+    assert!(compact > 0, "no seed stream in the compact framing");
+}
+
+/// `fix_checksums` finds every CRC of a compact-framing stream (SPEC
+/// §5.1.1): with each of them broken, it gives the stream back.
+#[test]
+fn fix_checksums_restores_a_compact_streams_crcs() {
+    let g = streams::seed_generated()
+        .into_iter()
+        .find(|g| g.stream[10] & 4 != 0 && g.stream.len() > 300)
+        .expect("a compact seed stream");
+    let header = splitstream_decoder_core::Header::parse(&g.stream).unwrap();
+    let table = splitstream_decoder_core::LevelTable::parse(&g.stream, &header).unwrap();
+    let mut broken = g.stream.clone();
+    for k in 0..header.level_count {
+        let info = table.get(k);
+        let start = info.offset as usize;
+        let level = &g.stream[start..start + info.length as usize];
+        let lh = table.level_header(k, level, header.level_rules()).unwrap();
+        // The level header's CRC, and each chunk's (the last 4 bytes of
+        // its entry), zeroed.
+        let crc_at = start + lh.payload_start - 4;
+        broken[crc_at..crc_at + 4].fill(0);
+        let directory_len = lh.chunks().count();
+        let mut at = 0;
+        let mut ends = Vec::new();
+        for _ in 0..directory_len {
+            let (_, next) = lh.entry_at(at).unwrap();
+            ends.push(next);
+            at = next;
+        }
+        let directory_at = crc_at - at;
+        for end in ends {
+            broken[directory_at + end - 4..directory_at + end].fill(0);
+        }
+    }
+    assert!(broken != g.stream);
+    fix_checksums(&mut broken);
+    assert!(broken == g.stream, "{}", g.base);
 }

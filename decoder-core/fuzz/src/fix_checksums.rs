@@ -7,7 +7,6 @@ pub fn fix_checksums(stream: &mut [u8]) {
     use splitstream_decoder_core::crc32;
     const HEADER_LEN: usize = 96;
     const ENTRY: usize = 32;
-    const CHUNK: usize = 16;
     let rd32 = |b: &[u8], at: usize| -> Option<u32> {
         Some(u32::from_le_bytes(
             b.get(at..at.checked_add(4)?)?.try_into().ok()?,
@@ -19,6 +18,8 @@ pub fn fix_checksums(stream: &mut [u8]) {
     let crc = crc32(&stream[..HEADER_LEN - 4]);
     stream[HEADER_LEN - 4..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
     let level_count = u16::from_le_bytes([stream[14], stream[15]]) as usize;
+    // Header flag bit 2: the compact level framing (SPEC §5.1.1, 3.11).
+    let compact = stream[10] & 4 != 0;
     let table_end = HEADER_LEN + ENTRY * level_count;
     if stream.len() < table_end + 4 {
         return;
@@ -36,31 +37,16 @@ pub fn fix_checksums(stream: &mut [u8]) {
             return;
         }
         let level = &mut stream[offset as usize..end as usize];
-        let (Some(rounds), Some(chunks)) = (rd32(level, 0), rd32(level, 4)) else {
+        let layout = if compact {
+            compact_layout(level, k == 0)
+        } else {
+            fixed_layout(level, k == 0)
+        };
+        let Some((entries, crc_at)) = layout else {
             return;
         };
-        // Split counts start at H = 20 in level 0 (after the plane policy,
-        // reserved bytes and seed counts), 12 elsewhere (SPEC §5.1).
-        let h = if k == 0 { 20 } else { 12 };
-        let Some(dir) = (rounds as usize)
-            .checked_mul(4)
-            .and_then(|s| s.checked_add(h))
-        else {
-            return;
-        };
-        let Some(crc_at) = (chunks as usize)
-            .checked_mul(CHUNK)
-            .and_then(|d| d.checked_add(dir))
-        else {
-            return;
-        };
-        if level.len() < crc_at + 4 {
-            return;
-        }
         let mut payload = crc_at + 4;
-        for c in 0..chunks as usize {
-            let e = dir + CHUNK * c;
-            let stored = rd32(level, e + 8).unwrap_or(0) as usize;
+        for (entry_crc_at, stored) in entries {
             let Some(p_end) = payload.checked_add(stored) else {
                 break;
             };
@@ -68,10 +54,79 @@ pub fn fix_checksums(stream: &mut [u8]) {
                 break;
             }
             let crc = crc32(&level[payload..p_end]);
-            level[e + 12..e + 16].copy_from_slice(&crc.to_le_bytes());
+            level[entry_crc_at..entry_crc_at + 4].copy_from_slice(&crc.to_le_bytes());
             payload = p_end;
         }
         let crc = crc32(&level[..crc_at]);
         level[crc_at..crc_at + 4].copy_from_slice(&crc.to_le_bytes());
     }
+}
+
+/// Where each directory entry's CRC lies and its `stored_len`, and where
+/// the level header's CRC lies, in a fixed-framing level (SPEC §5.1);
+/// `None` where the header runs past the level.
+fn fixed_layout(level: &[u8], is_base: bool) -> Option<(Vec<(usize, usize)>, usize)> {
+    const CHUNK: usize = 16;
+    let rd32 = |at: usize| -> Option<u32> {
+        Some(u32::from_le_bytes(
+            level.get(at..at.checked_add(4)?)?.try_into().ok()?,
+        ))
+    };
+    let (rounds, chunks) = (rd32(0)?, rd32(4)?);
+    // Split counts start at H = 20 in level 0 (after the policy bytes and
+    // seed counts), 12 elsewhere (SPEC §5.1).
+    let h = if is_base { 20 } else { 12 };
+    let dir = (rounds as usize).checked_mul(4)?.checked_add(h)?;
+    let crc_at = (chunks as usize).checked_mul(CHUNK)?.checked_add(dir)?;
+    if level.len() < crc_at.checked_add(4)? {
+        return None;
+    }
+    let entries = (0..chunks as usize)
+        .map(|c| {
+            let e = dir + CHUNK * c;
+            (e + 12, rd32(e + 8).unwrap_or(0) as usize)
+        })
+        .collect();
+    Some((entries, crc_at))
+}
+
+/// [`fixed_layout`] for a compact-framing level (SPEC §5.1.1): its
+/// varints read leniently (any 1 to 5 bytes), since only the CRCs'
+/// places matter here.
+fn compact_layout(level: &[u8], is_base: bool) -> Option<(Vec<(usize, usize)>, usize)> {
+    let mut at = 0usize;
+    let mut varint = |at: &mut usize| -> Option<u32> {
+        let mut v = 0u32;
+        for i in 0..5 {
+            let b = *level.get(*at)?;
+            *at += 1;
+            v |= u32::from(b & 0x7F).checked_shl(7 * i).unwrap_or(0);
+            if b & 0x80 == 0 {
+                break;
+            }
+        }
+        Some(v)
+    };
+    let rounds = varint(&mut at)?;
+    let chunks = varint(&mut at)?;
+    at += 4;
+    if is_base {
+        varint(&mut at)?;
+        varint(&mut at)?;
+    }
+    for _ in 0..rounds {
+        varint(&mut at)?;
+    }
+    let mut entries = Vec::new();
+    for _ in 0..chunks {
+        at += 1;
+        varint(&mut at)?;
+        let stored = varint(&mut at)? as usize;
+        entries.push((at, stored));
+        at += 4;
+    }
+    if level.len() < at.checked_add(4)? {
+        return None;
+    }
+    Some((entries, at))
 }
