@@ -95,7 +95,7 @@ fn fixed_layout(level: &[u8], is_base: bool) -> Option<(Vec<(usize, usize)>, usi
 /// places matter here.
 fn compact_layout(level: &[u8], is_base: bool) -> Option<(Vec<(usize, usize)>, usize)> {
     let mut at = 0usize;
-    let mut varint = |at: &mut usize| -> Option<u32> {
+    let varint = |at: &mut usize| -> Option<u32> {
         let mut v = 0u32;
         for i in 0..5 {
             let b = *level.get(*at)?;

@@ -11,7 +11,7 @@
 use libfuzzer_sys::fuzz_target;
 use splitstream_decoder_core::writer::ChunkCodec;
 use splitstream_decoder_core::{
-    DeficitContexts, PlanePolicy, PositionMode, RecordOrder, Schedule, WingPolicy,
+    DeficitContexts, Framing, PlanePolicy, PositionMode, RecordOrder, Schedule, WingPolicy,
 };
 use splitstream_decoder_core_fuzz::streams::{self, Choices};
 use splitstream_encoder::emit::{TranscodeOptions, positions_first_allowed, transcode};
@@ -44,9 +44,7 @@ fn options(choices: &mut Choices<'_>, input: Schedule, mode: PositionMode) -> Tr
     // could declare it.
     let records = pick(choices.byte(), RecordOrder::ALL.len())
         .map(|i| RecordOrder::ALL[i])
-        .filter(|&r| {
-            r == RecordOrder::WingsFirst || positions_first_allowed(mode, plane, wings)
-        });
+        .filter(|&r| r == RecordOrder::WingsFirst || positions_first_allowed(mode, plane, wings));
     TranscodeOptions {
         codec,
         chunk_limit: [16 * 1024, 1, 7, 64, 255][choices.below(5)],
@@ -64,6 +62,13 @@ fn options(choices: &mut Choices<'_>, input: Schedule, mode: PositionMode) -> Tr
         // read last, so that an input of the earlier corpora, whose bytes
         // ran out before, keeps the default (a zero byte).
         adaptive_tables: choices.byte() & 1 == 0,
+        // The framing (3.11): read after every earlier choice, for the same
+        // reason (a zero byte: compact, the default).
+        framing: if choices.byte() & 1 == 0 {
+            Framing::Compact
+        } else {
+            Framing::Fixed
+        },
     }
 }
 
