@@ -59,7 +59,7 @@ pub struct CodingArgs {
     #[arg(long, value_enum, default_value_t = TablesArg::Adaptive)]
     pub tables: TablesArg,
     /// How each level header is laid out: `compact`, its counts and
-    /// lengths as varints (format 3.11; about 500 bytes less a 5-level
+    /// lengths as varints (format 3.11; 380–900 bytes less a 5-level
     /// stream, a tenth of a small terrain tile), or `fixed`, 32-bit fields
     /// (3.10 decoders read the stream) (SPEC §5.1.1).
     #[arg(long, value_enum, default_value_t = FramingArg::Compact)]
