@@ -8,6 +8,7 @@ use crate::bytes::crc32;
 use crate::context::{self, DeficitContexts};
 use crate::header::{Framing, Header, PositionMode, Schedule};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
+use crate::level_header::ChunkEntry;
 use crate::level_table::{LevelInfo, head_len, write_level_table};
 use crate::limits::{
     CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_ADAPTIVE, VERSION_MINOR_BASELINE,
@@ -467,7 +468,7 @@ pub fn frame_level_with(
     params: &StreamParams,
     map: ChunkMap<'_>,
 ) -> FramedLevel {
-    let mut directory: Vec<(u8, u8, u32, u32, u32)> = Vec::new();
+    let mut directory: Vec<ChunkEntry> = Vec::new();
     let mut payload = Vec::new();
     let (mut largest_byte_chunk, mut largest_rans_chunk) = (0u32, 0u32);
     let mut adaptive = false;
@@ -484,14 +485,13 @@ pub fn frame_level_with(
         let contexts = context::count(id, level.deficits, level.records, params.schedule);
         let chunks = substream_chunks(sub, contexts, params, map);
         for chunk in chunks {
-            let stored_len = chunk.stored.len() as u32;
-            directory.push((
-                id,
-                chunk.codec,
-                chunk.raw_len,
-                stored_len,
-                crc32(&chunk.stored),
-            ));
+            directory.push(ChunkEntry {
+                substream: id,
+                codec: chunk.codec,
+                raw_len: chunk.raw_len,
+                stored_len: chunk.stored.len() as u32,
+                crc: crc32(&chunk.stored),
+            });
             let largest = if chunk.codec == codec::RANS {
                 &mut largest_rans_chunk
             } else {
@@ -528,15 +528,15 @@ pub fn frame_level_with(
     for &s in &level.round_splits {
         count(&mut out, s);
     }
-    for &(id, codec, raw_len, stored_len, crc) in &directory {
+    for e in &directory {
         if compact {
-            out.push(id | codec << 4);
+            out.push(e.substream | e.codec << 4);
         } else {
-            out.extend_from_slice(&[id, codec, 0, 0]);
+            out.extend_from_slice(&[e.substream, e.codec, 0, 0]);
         }
-        count(&mut out, raw_len);
-        count(&mut out, stored_len);
-        out.extend_from_slice(&crc.to_le_bytes());
+        count(&mut out, e.raw_len);
+        count(&mut out, e.stored_len);
+        out.extend_from_slice(&e.crc.to_le_bytes());
     }
     let crc = crc32(&out);
     out.extend_from_slice(&crc.to_le_bytes());
