@@ -694,12 +694,16 @@ impl PositionsFirst {
         let k = self.k;
         let (mut twice_area, mut boundary, mut crossings) = (0i64, 0i64, 0);
         let (mut turn, mut upper) = (0, 0);
+        // The wedges from the last entry's on, each entry loaded once and
+        // carried to the next wedge (loading both ends of every wedge, and
+        // wrapping the second, cost about 8 instructions a wedge more).
+        let last = k.checked_sub(1)?;
+        let (mut a, mut a_real) = (self.q(last), self.real[last]);
         for i in 0..k {
-            let j = if i + 1 == k { 0 } else { i + 1 };
-            if !(self.real[i] && self.real[j]) {
+            let (b, b_real) = (self.q(i), self.real[i]);
+            if !(a_real && b_real) {
                 return None;
             }
-            let (a, b) = (self.q(i), self.q(j));
             let area = orient([0, 0], a, b);
             if area <= 0 {
                 return None;
@@ -708,8 +712,9 @@ impl PositionsFirst {
             boundary += gcd((b[0] - a[0]).unsigned_abs(), (b[1] - a[1]).unsigned_abs()) as i64;
             let crossing = a[1] < 0 && b[1] >= 0;
             crossings += i32::from(crossing);
-            turn = if crossing { j } else { turn };
-            upper += usize::from(!lower_half(a));
+            turn = if crossing { i } else { turn };
+            upper += usize::from(!lower_half(b));
+            (a, a_real) = (b, b_real);
         }
         if crossings != 1 {
             return None;
