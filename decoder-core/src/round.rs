@@ -256,7 +256,7 @@ impl MeshState<'_> {
     /// Whether `v` is blocked in this round (its flag is inferred 0).
     #[inline]
     fn is_blocked(&self, v: u32) -> bool {
-        let third = self.candidates.len() / 3;
+        let third = self.bitmap_words;
         let w = 2 * third + (v / 64) as usize;
         self.candidates
             .get(w)

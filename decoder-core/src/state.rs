@@ -64,6 +64,12 @@ pub struct MeshState<'ws> {
     /// them, so they are not recomputed from the array lengths each time).
     vertex_capacity: u32,
     triangle_capacity: u32,
+    /// Words of each of the three bitmaps in `candidates` (a third of it),
+    /// fixed when the state is made. A round's flags ask for it twice a
+    /// candidate (`is_blocked`, `split_bit`), where a division by 3 is a
+    /// multiply and shifts; the colder uses still divide (reading this
+    /// there too measured more instructions, and more Cortex-M4 code).
+    pub(crate) bitmap_words: usize,
     pub(crate) bits: u8,
     /// Which vertices are candidates, and what `deficit` holds (SPEC §6.2,
     /// format 3.6): deficits under `SplitValences`, valences under
@@ -104,8 +110,9 @@ impl<'ws> MeshState<'ws> {
             deficit,
             candidates,
         } = memory;
+        let bitmap_words = candidates.len() / 3;
         let vertex_capacity = {
-            let by_bits = (candidates.len() as u64 / 3) * 64;
+            let by_bits = bitmap_words as u64 * 64;
             let n = positions.len().min(vertex_corner.len()).min(deficit.len()) as u64;
             n.min(by_bits).min(u32::MAX as u64 - 1) as u32
         };
@@ -126,6 +133,7 @@ impl<'ws> MeshState<'ws> {
             fans_ahead_from: crate::round::FANS_AHEAD_FROM_VERTICES,
             vertex_capacity,
             triangle_capacity,
+            bitmap_words,
             bits,
             schedule,
         }
@@ -190,7 +198,7 @@ impl<'ws> MeshState<'ws> {
     /// times per vertex, twice each with the fans walked ahead).
     #[inline]
     pub(crate) fn split_bit(&self, v: u32) -> u8 {
-        let third = self.candidates.len() / 3;
+        let third = self.bitmap_words;
         let word = self
             .candidates
             .get(third + (v / 64) as usize)
