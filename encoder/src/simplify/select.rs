@@ -58,13 +58,17 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
             _ => pc,
         }
     } else if s.constrained {
-        // P, C or their midpoint.
-        let mut best = (pp, q.error(s.geometry(p)));
-        for cand in [pc, midpoint(pp, pc)] {
-            let e = q.error(s.to_metric(cand));
-            if e < best.1 {
-                best = (cand, e);
-            }
+        // P, C or their midpoint, in that order on ties (P's and C's
+        // errors taken together).
+        let [ep, ec] = q.error_pair(s.to_metric(pp), s.to_metric(pc));
+        let mut best = (pp, ep);
+        if ec < best.1 {
+            best = (pc, ec);
+        }
+        let mid = midpoint(pp, pc);
+        let e = q.error(s.to_metric(mid));
+        if e < best.1 {
+            best = (mid, e);
         }
         // The error is already known: a fourth evaluation of the quadric
         // would give the same bits.
