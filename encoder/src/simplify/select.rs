@@ -13,7 +13,7 @@ use std::sync::atomic::Ordering::Relaxed;
 
 use super::state::State;
 use crate::corner_table::{NONE, next, prev};
-use crate::quadric::collapse_target;
+use crate::quadric::{Quadric, collapse_target};
 
 /// A vertex's chosen collapse; `other == NONE` when it has none.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,30 +51,43 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
     let (pi, ci) = (p as usize, c as usize);
     let q = s.quadrics[pi] + s.quadrics[ci];
     let (pp, pc) = (s.positions[pi], s.positions[ci]);
+    if (s.lock_boundary && (s.boundary[pi] || s.boundary[ci])) || !s.constrained {
+        return evaluate_otherwise(s, p, c, &q);
+    }
+    // P, C or their midpoint, in that order on ties (P's and C's errors
+    // taken together).
+    let [ep, ec] = q.error_pair(s.to_metric(pp), s.to_metric(pc));
+    let mut best = (pp, ep);
+    if ec < best.1 {
+        best = (pc, ec);
+    }
+    let mid = midpoint(pp, pc);
+    let e = q.error(s.to_metric(mid));
+    if e < best.1 {
+        best = (mid, e);
+    }
+    // The error is already known: a fourth evaluation of the quadric would
+    // give the same bits.
+    Some(best)
+}
+
+/// [`evaluate`] of edge (p, c), p < c, with merged quadric `q`, where a
+/// locked boundary holds an end or the placement is optimal. Out of line:
+/// the constrained path, the one every raster and default encode takes,
+/// then keeps the quadric in registers (taken by reference here, it went
+/// through the stack on every evaluation).
+#[inline(never)]
+fn evaluate_otherwise(s: &State, p: u32, c: u32, q: &Quadric) -> Option<([u32; 3], f64)> {
+    let (pi, ci) = (p as usize, c as usize);
+    let (pp, pc) = (s.positions[pi], s.positions[ci]);
     let target = if s.lock_boundary && (s.boundary[pi] || s.boundary[ci]) {
         match (s.boundary[pi], s.boundary[ci]) {
             (true, true) => return None,
             (true, false) => pp,
             _ => pc,
         }
-    } else if s.constrained {
-        // P, C or their midpoint, in that order on ties (P's and C's
-        // errors taken together).
-        let [ep, ec] = q.error_pair(s.to_metric(pp), s.to_metric(pc));
-        let mut best = (pp, ep);
-        if ec < best.1 {
-            best = (pc, ec);
-        }
-        let mid = midpoint(pp, pc);
-        let e = q.error(s.to_metric(mid));
-        if e < best.1 {
-            best = (mid, e);
-        }
-        // The error is already known: a fourth evaluation of the quadric
-        // would give the same bits.
-        return Some(best);
     } else {
-        let (t, _) = collapse_target(&q, s.geometry(p), s.geometry(c), false);
+        let (t, _) = collapse_target(q, s.geometry(p), s.geometry(c), false);
         let top = ((1u64 << s.bits) - 1) as f64;
         std::array::from_fn(|k| to_grid(t[k] / s.metric[k], top))
     };
