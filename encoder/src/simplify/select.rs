@@ -54,9 +54,26 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
     if (s.lock_boundary && (s.boundary[pi] || s.boundary[ci])) || !s.constrained {
         return evaluate_otherwise(s, p, c, &q);
     }
+    Some(constrained_placement(
+        s,
+        &q,
+        (pp, s.to_metric(pp)),
+        (pc, s.to_metric(pc)),
+    ))
+}
+
+/// Constrained mode's placement of a collapse with merged quadric `q`,
+/// given P's and C's grid positions and metric points, and its error.
+#[inline(always)]
+fn constrained_placement(
+    s: &State,
+    q: &Quadric,
+    (pp, gp): ([u32; 3], [f64; 3]),
+    (pc, gc): ([u32; 3], [f64; 3]),
+) -> ([u32; 3], f64) {
     // P, C or their midpoint, in that order on ties (P's and C's errors
     // taken together).
-    let [ep, ec] = q.error_pair(s.to_metric(pp), s.to_metric(pc));
+    let [ep, ec] = q.error_pair(gp, gc);
     let mut best = (pp, ep);
     if ec < best.1 {
         best = (pc, ec);
@@ -68,7 +85,57 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
     }
     // The error is already known: a fourth evaluation of the quadric would
     // give the same bits.
-    Some(best)
+    best
+}
+
+/// [`edge_slot`] of the edges of one vertex `r` in turn (a refresh's):
+/// r's quadric, position and point are read once, not once an edge; the
+/// same operations otherwise, so the same slots.
+pub struct EdgesOf {
+    r: u32,
+    quadric: Quadric,
+    position: [u32; 3],
+    point: [f64; 3],
+}
+
+impl EdgesOf {
+    pub fn new(s: &State, r: u32) -> EdgesOf {
+        let position = s.positions[r as usize];
+        EdgesOf {
+            r,
+            quadric: s.quadrics[r as usize],
+            position,
+            point: s.to_metric(position),
+        }
+    }
+
+    /// The slot of the edge from `r` to `x`.
+    #[inline]
+    pub fn slot(&self, s: &State, x: u32) -> EdgeSlot {
+        let (r, xi) = (self.r, x as usize);
+        let locked = s.lock_boundary && (s.boundary[r as usize] || s.boundary[xi]);
+        let placed = if locked || !s.constrained {
+            evaluate(s, r, x).map(|(_, error)| error)
+        } else {
+            let end = (s.positions[xi], s.geometry(x));
+            let own = (self.position, self.point);
+            // The lower id is P, and its quadric the sum's left operand.
+            let (q, p, c) = if r < x {
+                (self.quadric + s.quadrics[xi], own, end)
+            } else {
+                (s.quadrics[xi] + self.quadric, end, own)
+            };
+            Some(constrained_placement(s, &q, p, c).1)
+        };
+        match placed {
+            Some(error) => EdgeSlot {
+                error,
+                refused: 0,
+                valid: 0,
+            },
+            None => EdgeSlot::FORBIDDEN,
+        }
+    }
 }
 
 /// [`evaluate`] of edge (p, c), p < c, with merged quadric `q`, where a
