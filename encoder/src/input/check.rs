@@ -225,13 +225,12 @@ impl std::error::Error for MeshError {}
 /// bucketed by the smaller endpoint, so sorting a bucket groups the
 /// triangles of each undirected edge in ascending triangle order.
 pub(crate) fn edge_table(triangles: &[[u32; 3]], vertex_count: usize) -> Buckets<u64> {
-    let mut table = Buckets::build(vertex_count, || {
-        triangles.iter().enumerate().flat_map(|(t, tri)| {
-            (0..3).map(move |k| {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                let (lo, hi, rev) = if a < b { (a, b, 0) } else { (b, a, 1) };
-                (lo as usize, (hi as u64) << 32 | (t as u64) << 1 | rev)
-            })
+    let mut table = Buckets::build_fixed::<3>(vertex_count, triangles.len(), |t| {
+        let tri = triangles[t];
+        std::array::from_fn(|k| {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            let (lo, hi, rev) = if a < b { (a, b, 0) } else { (b, a, 1) };
+            (lo as usize, (hi as u64) << 32 | (t as u64) << 1 | rev)
         })
     });
     table.sort_each(|s| s.sort_unstable());
@@ -242,12 +241,11 @@ pub(crate) fn edge_table(triangles: &[[u32; 3]], vertex_count: usize) -> Buckets
 /// edge a -> b. For an oriented edge-manifold mesh each vertex's link is a
 /// union of paths and cycles; one component means one fan.
 pub(crate) fn link_table(triangles: &[[u32; 3]], vertex_count: usize) -> Buckets<u64> {
-    let mut table = Buckets::build(vertex_count, || {
-        triangles.iter().flat_map(|tri| {
-            (0..3).map(move |k| {
-                let (v, a, b) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
-                (v as usize, (a as u64) << 32 | b as u64)
-            })
+    let mut table = Buckets::build_fixed::<3>(vertex_count, triangles.len(), |t| {
+        let tri = triangles[t];
+        std::array::from_fn(|k| {
+            let (v, a, b) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+            (v as usize, (a as u64) << 32 | b as u64)
         })
     });
     table.sort_each(|s| s.sort_unstable());
@@ -592,12 +590,10 @@ fn first_duplicate(table: &Buckets<(u64, u32)>, nv: usize) -> Option<(usize, usi
 /// Triangles bucketed by their smallest vertex, keyed by the other two
 /// (`mid << 32 | max`) and their index; sorting groups equal vertex sets.
 pub(crate) fn sorted_vertex_sets(tris: &[[u32; 3]], nv: usize) -> Buckets<(u64, u32)> {
-    let mut table = Buckets::build(nv, || {
-        tris.iter().enumerate().map(|(t, tri)| {
-            let mut s = *tri;
-            s.sort_unstable();
-            (s[0] as usize, ((s[1] as u64) << 32 | s[2] as u64, t as u32))
-        })
+    let mut table = Buckets::build_fixed::<1>(nv, tris.len(), |t| {
+        let mut s = tris[t];
+        s.sort_unstable();
+        [(s[0] as usize, ((s[1] as u64) << 32 | s[2] as u64, t as u32))]
     });
     table.sort_each(|s| s.sort_unstable());
     table

@@ -3,7 +3,7 @@
 use rayon::prelude::*;
 
 use super::state::State;
-use crate::corner_table::{NONE, next};
+use crate::corner_table::NONE;
 
 /// Mean length of the live edges, for the sub-grid cell size and the flat
 /// threshold. Keeps the list of triangles that were alive at the last
@@ -32,10 +32,11 @@ impl EdgeMeter {
             .map(|chunk| {
                 let mut sum = 0.0;
                 for &k in chunk {
-                    for c in 3 * k..3 * k + 3 {
-                        let a = s.geometry(t.v(c));
-                        let b = s.geometry(t.v(next(c)));
-                        sum += crate::quadric::norm(crate::quadric::sub(a, b));
+                    // Each corner's point once, its edges in corner order
+                    // (corner c to next c): the same sums as before.
+                    let g = [0, 1, 2].map(|j| s.geometry(t.v(3 * k + j)));
+                    for j in 0..3 {
+                        sum += crate::quadric::norm(crate::quadric::sub(g[j], g[(j + 1) % 3]));
                     }
                 }
                 sum

@@ -9,7 +9,7 @@ use super::apply::Raw;
 use super::offers::Offer;
 use super::offers::prefetch_ahead;
 use super::parallel::chunk_size;
-use super::select::{Best, Choices, EdgeSlot, Ranking, Scale, edge_slot};
+use super::select::{Best, Choices, EdgeSlot, EdgesOf, Ranking, Scale, edge_slot};
 use super::state::State;
 use super::tracking::Tracking;
 use crate::corner_table::{Fan, NONE, next, prev};
@@ -87,8 +87,10 @@ pub(super) fn refresh_edges(
                     slots.prefetch(s_now.slot_index(facing));
                 }
                 let mut ranking = Ranking::new(s_now, r, scale);
+                let of_r = EdgesOf::new(s_now, r);
                 for &(x, facing) in &edges {
-                    let slot = edge_slot(s_now, facing);
+                    let slot = of_r.slot(s_now, x);
+                    debug_assert_eq!(slot, edge_slot(s_now, facing));
                     let index = s_now.slot_index(facing);
                     #[cfg(debug_assertions)]
                     out.updates.push((index as u32, slot));

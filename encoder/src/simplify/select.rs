@@ -13,7 +13,7 @@ use std::sync::atomic::Ordering::Relaxed;
 
 use super::state::State;
 use crate::corner_table::{NONE, next, prev};
-use crate::quadric::collapse_target;
+use crate::quadric::{Quadric, collapse_target};
 
 /// A vertex's chosen collapse; `other == NONE` when it has none.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -51,26 +51,110 @@ pub fn evaluate(s: &State, v: u32, u: u32) -> Option<([u32; 3], f64)> {
     let (pi, ci) = (p as usize, c as usize);
     let q = s.quadrics[pi] + s.quadrics[ci];
     let (pp, pc) = (s.positions[pi], s.positions[ci]);
+    if (s.lock_boundary && (s.boundary[pi] || s.boundary[ci])) || !s.constrained {
+        return evaluate_otherwise(s, p, c, &q);
+    }
+    Some(constrained_placement(
+        s,
+        &q,
+        (pp, s.to_metric(pp)),
+        (pc, s.to_metric(pc)),
+    ))
+}
+
+/// Constrained mode's placement of a collapse with merged quadric `q`,
+/// given P's and C's grid positions and metric points, and its error.
+#[inline(always)]
+fn constrained_placement(
+    s: &State,
+    q: &Quadric,
+    (pp, gp): ([u32; 3], [f64; 3]),
+    (pc, gc): ([u32; 3], [f64; 3]),
+) -> ([u32; 3], f64) {
+    // P, C or their midpoint, in that order on ties (P's and C's errors
+    // taken together).
+    let [ep, ec] = q.error_pair(gp, gc);
+    let mut best = (pp, ep);
+    if ec < best.1 {
+        best = (pc, ec);
+    }
+    let mid = midpoint(pp, pc);
+    let e = q.error(s.to_metric(mid));
+    if e < best.1 {
+        best = (mid, e);
+    }
+    // The error is already known: a fourth evaluation of the quadric would
+    // give the same bits.
+    best
+}
+
+/// [`edge_slot`] of the edges of one vertex `r` in turn (a refresh's):
+/// r's quadric, position and point are read once, not once an edge; the
+/// same operations otherwise, so the same slots.
+pub struct EdgesOf {
+    r: u32,
+    quadric: Quadric,
+    position: [u32; 3],
+    point: [f64; 3],
+}
+
+impl EdgesOf {
+    pub fn new(s: &State, r: u32) -> EdgesOf {
+        let position = s.positions[r as usize];
+        EdgesOf {
+            r,
+            quadric: s.quadrics[r as usize],
+            position,
+            point: s.to_metric(position),
+        }
+    }
+
+    /// The slot of the edge from `r` to `x`.
+    #[inline]
+    pub fn slot(&self, s: &State, x: u32) -> EdgeSlot {
+        let (r, xi) = (self.r, x as usize);
+        let locked = s.lock_boundary && (s.boundary[r as usize] || s.boundary[xi]);
+        let placed = if locked || !s.constrained {
+            evaluate(s, r, x).map(|(_, error)| error)
+        } else {
+            let end = (s.positions[xi], s.geometry(x));
+            let own = (self.position, self.point);
+            // The lower id is P, and its quadric the sum's left operand.
+            let (q, p, c) = if r < x {
+                (self.quadric + s.quadrics[xi], own, end)
+            } else {
+                (s.quadrics[xi] + self.quadric, end, own)
+            };
+            Some(constrained_placement(s, &q, p, c).1)
+        };
+        match placed {
+            Some(error) => EdgeSlot {
+                error,
+                refused: 0,
+                valid: 0,
+            },
+            None => EdgeSlot::FORBIDDEN,
+        }
+    }
+}
+
+/// [`evaluate`] of edge (p, c), p < c, with merged quadric `q`, where a
+/// locked boundary holds an end or the placement is optimal. Out of line:
+/// the constrained path, the one every raster and default encode takes,
+/// then keeps the quadric in registers (taken by reference here, it went
+/// through the stack on every evaluation).
+#[inline(never)]
+fn evaluate_otherwise(s: &State, p: u32, c: u32, q: &Quadric) -> Option<([u32; 3], f64)> {
+    let (pi, ci) = (p as usize, c as usize);
+    let (pp, pc) = (s.positions[pi], s.positions[ci]);
     let target = if s.lock_boundary && (s.boundary[pi] || s.boundary[ci]) {
         match (s.boundary[pi], s.boundary[ci]) {
             (true, true) => return None,
             (true, false) => pp,
             _ => pc,
         }
-    } else if s.constrained {
-        // P, C or their midpoint.
-        let mut best = (pp, q.error(s.geometry(p)));
-        for cand in [pc, midpoint(pp, pc)] {
-            let e = q.error(s.to_metric(cand));
-            if e < best.1 {
-                best = (cand, e);
-            }
-        }
-        // The error is already known: a fourth evaluation of the quadric
-        // would give the same bits.
-        return Some(best);
     } else {
-        let (t, _) = collapse_target(&q, s.geometry(p), s.geometry(c), false);
+        let (t, _) = collapse_target(q, s.geometry(p), s.geometry(c), false);
         let top = ((1u64 << s.bits) - 1) as f64;
         std::array::from_fn(|k| to_grid(t[k] / s.metric[k], top))
     };
@@ -322,7 +406,7 @@ impl<'a> Ranking<'a> {
 
     /// Considers the edge to `u` whose slot (held by corner `facing`) is
     /// `slot`.
-    #[inline]
+    #[inline(always)]
     pub fn consider(&mut self, u: u32, facing: u32, slot: &EdgeSlot) {
         if slot.error == f64::INFINITY {
             return;
@@ -374,32 +458,53 @@ pub fn pick_edge(
     if !s.alive[v as usize] {
         return ranking.choices();
     }
-    let changed_v = known.changed[v as usize];
-    let mut consider = |u: u32, facing: u32| {
-        if known.blocked[u as usize].load(Relaxed) == known.state {
-            return;
-        }
-        let slot = s.slot(facing);
-        if slot.refused != 0 {
-            if known.refused(slot, v, u) {
-                return;
-            }
-            if slot.refused < changed_v {
-                reopened.push(u);
-            }
-        }
-        ranking.consider(u, facing, slot);
+    let edges = PickEdges {
+        s,
+        v,
+        known,
+        changed_v: known.changed[v as usize],
     };
     // Every edge of v once: (v, next c) faces prev c for each corner c; on a
     // boundary the edge (v, prev c) of the fan's open end faces next c and
     // has no corner of its own.
     s.table.for_each_corner(v, |c| {
-        consider(s.table.v(next(c)), prev(c));
+        edges.consider(&mut ranking, reopened, s.table.v(next(c)), prev(c));
         if s.table.o(next(c)) == NONE {
-            consider(s.table.v(prev(c)), next(c));
+            edges.consider(&mut ranking, reopened, s.table.v(prev(c)), next(c));
         }
     });
     ranking.choices()
+}
+
+/// What [`pick_edge`] weighs each edge of `v` with.
+struct PickEdges<'a> {
+    s: &'a State,
+    v: u32,
+    known: Known<'a>,
+    changed_v: u32,
+}
+
+impl PickEdges<'_> {
+    /// Ranks the edge to `u` facing corner `facing`, unless `u` is blocked
+    /// or the edge is known to be invalid. (Inlined: as a call, with the
+    /// ranking's, it cost the picks about half their instructions again.)
+    #[inline(always)]
+    fn consider(&self, ranking: &mut Ranking<'_>, reopened: &mut Vec<u32>, u: u32, facing: u32) {
+        let (s, known) = (self.s, &self.known);
+        if known.blocked[u as usize].load(Relaxed) == known.state {
+            return;
+        }
+        let slot = s.slot(facing);
+        if slot.refused != 0 {
+            if known.refused(slot, self.v, u) {
+                return;
+            }
+            if slot.refused < self.changed_v {
+                reopened.push(u);
+            }
+        }
+        ranking.consider(u, facing, slot);
+    }
 }
 
 /// Updates `choices` of `v` with its edge to `u` facing corner `facing`,
