@@ -32,11 +32,29 @@ fn varint_len(v: u32) -> usize {
 }
 
 /// A context's static table as [`scaled_counts`] chooses it.
-#[derive(Default)]
 struct StaticTable {
     /// Its count bytes and the context's tokens under it, in bits.
     cost: f64,
-    counts: Vec<u32>,
+    /// Its tokens: the counts and frequencies of `..tokens` are its own.
+    tokens: usize,
+    counts: [u32; TOKENS],
+    /// The counts normalised (`normalise`), where `tokens > 0`.
+    freqs: [u32; TOKENS],
+}
+
+/// Bits of a token whose frequency is `f` out of `PROB_SCALE`, for `f` in
+/// `0..=PROB_SCALE` (entry 0 unused): `PROB_BITS − log2 f` as
+/// [`libm_log2`] computes it (the same function, evaluated once).
+static TOKEN_BITS: [f64; PROB_SCALE as usize + 1] = token_bits();
+
+const fn token_bits() -> [f64; PROB_SCALE as usize + 1] {
+    let mut table = [0f64; PROB_SCALE as usize + 1];
+    let mut f = 1;
+    while f <= PROB_SCALE as usize {
+        table[f] = PROB_BITS as f64 - libm_log2(f as f64);
+        f += 1;
+    }
+    table
 }
 
 /// The static table of a context whose tokens counted `histogram`: the
@@ -44,44 +62,60 @@ struct StaticTable {
 /// bits left out: they do not depend on the table).
 fn scaled_counts(histogram: &[u32]) -> StaticTable {
     let n = histogram.iter().rposition(|&c| c > 0).map_or(0, |i| i + 1);
+    let mut best = StaticTable {
+        cost: 0.0,
+        tokens: 0,
+        counts: [0; TOKENS],
+        freqs: [0; TOKENS],
+    };
+    if n == 0 {
+        // (No scale normalises an empty table.)
+        return best;
+    }
     let histogram = &histogram[..n];
     let max = histogram.iter().copied().max().unwrap_or(0);
-    let mut best: Option<StaticTable> = None;
+    let mut found = false;
     for limit in [7u32, 31, 127, 1023, u32::MAX] {
-        let counts: Vec<u32> = if max <= limit {
-            histogram.to_vec()
+        let mut counts = [0u32; TOKENS];
+        if max <= limit {
+            counts[..n].copy_from_slice(histogram);
         } else {
-            histogram
-                .iter()
-                .map(|&c| {
-                    if c == 0 {
-                        0
-                    } else {
-                        ((c as u64 * limit as u64).div_ceil(max as u64)) as u32
-                    }
-                })
-                .collect()
-        };
-        let mut freqs = counts.clone();
-        if normalise(&mut freqs).is_err() {
+            for (c, &h) in counts.iter_mut().zip(histogram) {
+                if h != 0 {
+                    *c = ((h as u64 * limit as u64).div_ceil(max as u64)) as u32;
+                }
+            }
+        }
+        let mut freqs = counts;
+        if normalise(&mut freqs[..n]).is_err() {
             continue;
         }
-        let table_bits = 8.0 * counts.iter().map(|&c| varint_len(c)).sum::<usize>() as f64;
+        let table_bits = 8.0 * counts[..n].iter().map(|&c| varint_len(c)).sum::<usize>() as f64;
         let code_bits: f64 = histogram
             .iter()
             .zip(&freqs)
             .filter(|(c, _)| **c > 0)
-            .map(|(&c, &f)| c as f64 * (PROB_BITS as f64 - libm_log2(f as f64)))
+            .map(|(&c, &f)| c as f64 * TOKEN_BITS[f as usize])
             .sum();
         let cost = table_bits + code_bits;
-        if best.as_ref().is_none_or(|b| cost < b.cost) {
-            best = Some(StaticTable { cost, counts });
+        if !found || cost < best.cost {
+            found = true;
+            best = StaticTable {
+                cost,
+                tokens: n,
+                counts,
+                freqs,
+            };
         }
         if max <= limit {
             break;
         }
     }
-    best.unwrap_or_default()
+    if !found {
+        best.tokens = 0;
+        best.cost = 0.0;
+    }
+    best
 }
 
 /// Estimated bits of one rANS chunk coding `values` values whose tokens
@@ -299,7 +333,7 @@ fn choose_models(
     let mut lanes_tokens: Vec<Vec<Vec<u8>>> = priced
         .iter()
         .map(|table| {
-            if may_adapt(table.counts.len()) {
+            if may_adapt(table.tokens) {
                 vec![Vec::new(); lanes]
             } else {
                 Vec::new()
@@ -319,7 +353,7 @@ fn choose_models(
     }
     let mut models = Vec::with_capacity(contexts);
     for (ctx, (table, lanes_tokens)) in priced.into_iter().zip(&lanes_tokens).enumerate() {
-        let tokens = table.counts.len();
+        let tokens = table.tokens;
         if may_adapt(tokens) {
             // Each rate's bits per lane, kept as the rates are tried.
             let mut tried = [[0f64; MAX_LANES as usize]; 8];
@@ -347,15 +381,13 @@ fn choose_models(
             }
         }
         out.push(tokens as u8);
-        for &count in &table.counts {
+        for &count in &table.counts[..tokens] {
             push_varint(out, count);
         }
         let (mut start, mut freq) = ([0u32; TOKENS], [0u32; TOKENS]);
-        if !table.counts.is_empty() {
-            let mut f = table.counts;
-            normalise(&mut f).expect("nonzero counts normalise");
+        if tokens > 0 {
             let mut cum = 0;
-            for (t, &ft) in f.iter().enumerate() {
+            for (t, &ft) in table.freqs[..tokens].iter().enumerate() {
                 start[t] = cum;
                 freq[t] = ft;
                 cum += ft;
@@ -363,13 +395,7 @@ fn choose_models(
         }
         if let Some(lane_bits) = lane_bits.as_deref_mut() {
             // Each token's bits under the table, then each lane's tokens.
-            let token_bits = freq.map(|f| {
-                if f == 0 {
-                    0.0
-                } else {
-                    PROB_BITS as f64 - libm_log2(f as f64)
-                }
-            });
+            let token_bits = freq.map(|f| TOKEN_BITS[f as usize]);
             for (lane, bits) in lane_bits.iter_mut().enumerate() {
                 let counts = &lane_histograms[lane * contexts + ctx];
                 *bits += counts
