@@ -209,8 +209,6 @@ fn best_rate(mut cost: impl FnMut(u8) -> f64) -> (f64, u8) {
 
 /// Bits of a binary decision whose chosen side has frequency `f` out of
 /// `PROB_SCALE`, for `f` in `0..=PROB_SCALE` (entry 0 unused).
-static DECISION_BITS: [f32; PROB_SCALE as usize + 1] = decision_bits();
-
 const fn decision_bits() -> [f32; PROB_SCALE as usize + 1] {
     let mut table = [0f32; PROB_SCALE as usize + 1];
     let mut f = 1;
@@ -248,15 +246,58 @@ fn adaptive_byte(tokens: usize, rate: u8) -> u8 {
     ADAPTIVE_FLAG | (rate - ADAPTIVE_RATE_MIN) << 4 | (tokens - 1) as u8
 }
 
+/// For a probability `q` of an adaptive decision, indexed by `q >>
+/// (ADAPTIVE_BITS − PROB_BITS)`: the bits of the answer "above" and of
+/// "not above" ([`decision_bits`] of [`decision_frequencies`]).
+static ANSWER_BITS: [[f32; 2]; PROB_SCALE as usize] = answer_bits();
+
+const fn answer_bits() -> [[f32; 2]; PROB_SCALE as usize] {
+    let bits = decision_bits();
+    let mut table = [[0f32; 2]; PROB_SCALE as usize];
+    let mut i = 0;
+    while i < PROB_SCALE as usize {
+        let above = if i == 0 { 1 } else { i };
+        table[i] = [bits[above], bits[PROB_SCALE as usize - above]];
+        i += 1;
+    }
+    table
+}
+
+/// For each rate less `ADAPTIVE_RATE_MIN`, the shift of a probability used
+/// `count` times before, by `count`: [`adaptive_shift`]'s `min(rate, 1 +
+/// bit length of count)` (`tests::the_shift_table_is_adaptive_shift`).
+static SHIFTS: [[u8; 256]; 8] = shifts();
+
+const fn shifts() -> [[u8; 256]; 8] {
+    let mut table = [[0u8; 256]; 8];
+    let mut r = 0;
+    while r < 8 {
+        let mut count = 0;
+        while count < 256 {
+            let rate = ADAPTIVE_RATE_MIN + r as u8;
+            let shift = 1 + (8 - (count as u8).leading_zeros()) as u8;
+            table[r][count] = if shift < rate { shift } else { rate };
+            count += 1;
+        }
+        r += 1;
+    }
+    table
+}
+
 /// Bits the tokens `lanes_tokens` (each lane's tokens of one context, in
 /// order) cost under an adaptive table of `tokens` tokens and `rate`;
-/// `per_lane(lane, bits)` takes each lane's share.
+/// `per_lane(lane, bits)` takes each lane's share. Token `t` answers "above"
+/// to the decisions before `t` and "not above" to decision `t`, if there is
+/// one (the decisions of [`lane_steps`], by tables).
 fn adaptive_bits(
     lanes_tokens: &[Vec<u8>],
     tokens: usize,
     rate: u8,
     mut per_lane: impl FnMut(usize, f64),
 ) -> f64 {
+    const INDEX_SHIFT: u32 = ADAPTIVE_BITS - PROB_BITS;
+    let shifts = &SHIFTS[(rate - ADAPTIVE_RATE_MIN) as usize];
+    let decisions = tokens - 1;
     let mut bits = 0f64;
     let mut probs = [ADAPTIVE_START; ADAPTIVE_TOKENS];
     let mut counts = [0u8; ADAPTIVE_TOKENS];
@@ -265,15 +306,20 @@ fn adaptive_bits(
         counts.fill(0);
         let mut lane_bits = 0f32;
         for &t in lane_tokens {
-            let decisions = probs[..tokens - 1].iter_mut().zip(&mut counts);
-            for (i, (q, count)) in decisions.enumerate() {
-                let (above, below) = decision_frequencies(*q);
-                let is_above = (t as usize) > i;
-                lane_bits += DECISION_BITS[if is_above { above } else { below } as usize];
-                adapt(q, count, is_above, rate);
-                if !is_above {
-                    break;
-                }
+            let t = t as usize;
+            let aboves = t.min(decisions);
+            for (q, count) in probs[..aboves].iter_mut().zip(&mut counts[..aboves]) {
+                lane_bits += ANSWER_BITS[(*q >> INDEX_SHIFT) as usize][0];
+                let shift = shifts[*count as usize];
+                *count = count.saturating_add(1);
+                *q += (((1u32 << ADAPTIVE_BITS) - *q as u32) >> shift) as u16;
+            }
+            if t < decisions {
+                let (q, count) = (&mut probs[t], &mut counts[t]);
+                lane_bits += ANSWER_BITS[(*q >> INDEX_SHIFT) as usize][1];
+                let shift = shifts[*count as usize];
+                *count = count.saturating_add(1);
+                *q -= *q >> shift;
             }
         }
         per_lane(lane, lane_bits as f64);
@@ -684,6 +730,16 @@ mod tests {
             for x in xs.into_iter().filter(|&x| x <= top) {
                 let (x, f) = (x as u32, f as u32);
                 assert_eq!(div_rem(x, f), (x / f, x % f), "{x} / {f}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_shift_table_is_adaptive_shift() {
+        for (r, row) in SHIFTS.iter().enumerate() {
+            for (count, &shift) in row.iter().enumerate() {
+                let rate = ADAPTIVE_RATE_MIN + r as u8;
+                assert_eq!(shift as u32, adaptive_shift(count as u8, rate));
             }
         }
     }
