@@ -32,11 +32,29 @@ fn varint_len(v: u32) -> usize {
 }
 
 /// A context's static table as [`scaled_counts`] chooses it.
-#[derive(Default)]
 struct StaticTable {
     /// Its count bytes and the context's tokens under it, in bits.
     cost: f64,
-    counts: Vec<u32>,
+    /// Its tokens: the counts and frequencies of `..tokens` are its own.
+    tokens: usize,
+    counts: [u32; TOKENS],
+    /// The counts normalised (`normalise`), where `tokens > 0`.
+    freqs: [u32; TOKENS],
+}
+
+/// Bits of a token whose frequency is `f` out of `PROB_SCALE`, for `f` in
+/// `0..=PROB_SCALE` (entry 0 unused): `PROB_BITS − log2 f` as
+/// [`libm_log2`] computes it (the same function, evaluated once).
+static TOKEN_BITS: [f64; PROB_SCALE as usize + 1] = token_bits();
+
+const fn token_bits() -> [f64; PROB_SCALE as usize + 1] {
+    let mut table = [0f64; PROB_SCALE as usize + 1];
+    let mut f = 1;
+    while f <= PROB_SCALE as usize {
+        table[f] = PROB_BITS as f64 - libm_log2(f as f64);
+        f += 1;
+    }
+    table
 }
 
 /// The static table of a context whose tokens counted `histogram`: the
@@ -44,44 +62,60 @@ struct StaticTable {
 /// bits left out: they do not depend on the table).
 fn scaled_counts(histogram: &[u32]) -> StaticTable {
     let n = histogram.iter().rposition(|&c| c > 0).map_or(0, |i| i + 1);
+    let mut best = StaticTable {
+        cost: 0.0,
+        tokens: 0,
+        counts: [0; TOKENS],
+        freqs: [0; TOKENS],
+    };
+    if n == 0 {
+        // (No scale normalises an empty table.)
+        return best;
+    }
     let histogram = &histogram[..n];
     let max = histogram.iter().copied().max().unwrap_or(0);
-    let mut best: Option<StaticTable> = None;
+    let mut found = false;
     for limit in [7u32, 31, 127, 1023, u32::MAX] {
-        let counts: Vec<u32> = if max <= limit {
-            histogram.to_vec()
+        let mut counts = [0u32; TOKENS];
+        if max <= limit {
+            counts[..n].copy_from_slice(histogram);
         } else {
-            histogram
-                .iter()
-                .map(|&c| {
-                    if c == 0 {
-                        0
-                    } else {
-                        ((c as u64 * limit as u64).div_ceil(max as u64)) as u32
-                    }
-                })
-                .collect()
-        };
-        let mut freqs = counts.clone();
-        if normalise(&mut freqs).is_err() {
+            for (c, &h) in counts.iter_mut().zip(histogram) {
+                if h != 0 {
+                    *c = ((h as u64 * limit as u64).div_ceil(max as u64)) as u32;
+                }
+            }
+        }
+        let mut freqs = counts;
+        if normalise(&mut freqs[..n]).is_err() {
             continue;
         }
-        let table_bits = 8.0 * counts.iter().map(|&c| varint_len(c)).sum::<usize>() as f64;
+        let table_bits = 8.0 * counts[..n].iter().map(|&c| varint_len(c)).sum::<usize>() as f64;
         let code_bits: f64 = histogram
             .iter()
             .zip(&freqs)
             .filter(|(c, _)| **c > 0)
-            .map(|(&c, &f)| c as f64 * (PROB_BITS as f64 - libm_log2(f as f64)))
+            .map(|(&c, &f)| c as f64 * TOKEN_BITS[f as usize])
             .sum();
         let cost = table_bits + code_bits;
-        if best.as_ref().is_none_or(|b| cost < b.cost) {
-            best = Some(StaticTable { cost, counts });
+        if !found || cost < best.cost {
+            found = true;
+            best = StaticTable {
+                cost,
+                tokens: n,
+                counts,
+                freqs,
+            };
         }
         if max <= limit {
             break;
         }
     }
-    best.unwrap_or_default()
+    if !found {
+        best.tokens = 0;
+        best.cost = 0.0;
+    }
+    best
 }
 
 /// Estimated bits of one rANS chunk coding `values` values whose tokens
@@ -175,8 +209,6 @@ fn best_rate(mut cost: impl FnMut(u8) -> f64) -> (f64, u8) {
 
 /// Bits of a binary decision whose chosen side has frequency `f` out of
 /// `PROB_SCALE`, for `f` in `0..=PROB_SCALE` (entry 0 unused).
-static DECISION_BITS: [f32; PROB_SCALE as usize + 1] = decision_bits();
-
 const fn decision_bits() -> [f32; PROB_SCALE as usize + 1] {
     let mut table = [0f32; PROB_SCALE as usize + 1];
     let mut f = 1;
@@ -214,15 +246,58 @@ fn adaptive_byte(tokens: usize, rate: u8) -> u8 {
     ADAPTIVE_FLAG | (rate - ADAPTIVE_RATE_MIN) << 4 | (tokens - 1) as u8
 }
 
+/// For a probability `q` of an adaptive decision, indexed by `q >>
+/// (ADAPTIVE_BITS − PROB_BITS)`: the bits of the answer "above" and of
+/// "not above" ([`decision_bits`] of [`decision_frequencies`]).
+static ANSWER_BITS: [[f32; 2]; PROB_SCALE as usize] = answer_bits();
+
+const fn answer_bits() -> [[f32; 2]; PROB_SCALE as usize] {
+    let bits = decision_bits();
+    let mut table = [[0f32; 2]; PROB_SCALE as usize];
+    let mut i = 0;
+    while i < PROB_SCALE as usize {
+        let above = if i == 0 { 1 } else { i };
+        table[i] = [bits[above], bits[PROB_SCALE as usize - above]];
+        i += 1;
+    }
+    table
+}
+
+/// For each rate less `ADAPTIVE_RATE_MIN`, the shift of a probability used
+/// `count` times before, by `count`: [`adaptive_shift`]'s `min(rate, 1 +
+/// bit length of count)` (`tests::the_shift_table_is_adaptive_shift`).
+static SHIFTS: [[u8; 256]; 8] = shifts();
+
+const fn shifts() -> [[u8; 256]; 8] {
+    let mut table = [[0u8; 256]; 8];
+    let mut r = 0;
+    while r < 8 {
+        let mut count = 0;
+        while count < 256 {
+            let rate = ADAPTIVE_RATE_MIN + r as u8;
+            let shift = 1 + (8 - (count as u8).leading_zeros()) as u8;
+            table[r][count] = if shift < rate { shift } else { rate };
+            count += 1;
+        }
+        r += 1;
+    }
+    table
+}
+
 /// Bits the tokens `lanes_tokens` (each lane's tokens of one context, in
 /// order) cost under an adaptive table of `tokens` tokens and `rate`;
-/// `per_lane(lane, bits)` takes each lane's share.
+/// `per_lane(lane, bits)` takes each lane's share. Token `t` answers "above"
+/// to the decisions before `t` and "not above" to decision `t`, if there is
+/// one (the decisions of [`lane_steps`], by tables).
 fn adaptive_bits(
     lanes_tokens: &[Vec<u8>],
     tokens: usize,
     rate: u8,
     mut per_lane: impl FnMut(usize, f64),
 ) -> f64 {
+    const INDEX_SHIFT: u32 = ADAPTIVE_BITS - PROB_BITS;
+    let shifts = &SHIFTS[(rate - ADAPTIVE_RATE_MIN) as usize];
+    let decisions = tokens - 1;
     let mut bits = 0f64;
     let mut probs = [ADAPTIVE_START; ADAPTIVE_TOKENS];
     let mut counts = [0u8; ADAPTIVE_TOKENS];
@@ -231,15 +306,20 @@ fn adaptive_bits(
         counts.fill(0);
         let mut lane_bits = 0f32;
         for &t in lane_tokens {
-            let decisions = probs[..tokens - 1].iter_mut().zip(&mut counts);
-            for (i, (q, count)) in decisions.enumerate() {
-                let (above, below) = decision_frequencies(*q);
-                let is_above = (t as usize) > i;
-                lane_bits += DECISION_BITS[if is_above { above } else { below } as usize];
-                adapt(q, count, is_above, rate);
-                if !is_above {
-                    break;
-                }
+            let t = t as usize;
+            let aboves = t.min(decisions);
+            for (q, count) in probs[..aboves].iter_mut().zip(&mut counts[..aboves]) {
+                lane_bits += ANSWER_BITS[(*q >> INDEX_SHIFT) as usize][0];
+                let shift = shifts[*count as usize];
+                *count = count.saturating_add(1);
+                *q += (((1u32 << ADAPTIVE_BITS) - *q as u32) >> shift) as u16;
+            }
+            if t < decisions {
+                let (q, count) = (&mut probs[t], &mut counts[t]);
+                lane_bits += ANSWER_BITS[(*q >> INDEX_SHIFT) as usize][1];
+                let shift = shifts[*count as usize];
+                *count = count.saturating_add(1);
+                *q -= *q >> shift;
             }
         }
         per_lane(lane, lane_bits as f64);
@@ -299,7 +379,7 @@ fn choose_models(
     let mut lanes_tokens: Vec<Vec<Vec<u8>>> = priced
         .iter()
         .map(|table| {
-            if may_adapt(table.counts.len()) {
+            if may_adapt(table.tokens) {
                 vec![Vec::new(); lanes]
             } else {
                 Vec::new()
@@ -319,7 +399,7 @@ fn choose_models(
     }
     let mut models = Vec::with_capacity(contexts);
     for (ctx, (table, lanes_tokens)) in priced.into_iter().zip(&lanes_tokens).enumerate() {
-        let tokens = table.counts.len();
+        let tokens = table.tokens;
         if may_adapt(tokens) {
             // Each rate's bits per lane, kept as the rates are tried.
             let mut tried = [[0f64; MAX_LANES as usize]; 8];
@@ -347,15 +427,13 @@ fn choose_models(
             }
         }
         out.push(tokens as u8);
-        for &count in &table.counts {
+        for &count in &table.counts[..tokens] {
             push_varint(out, count);
         }
         let (mut start, mut freq) = ([0u32; TOKENS], [0u32; TOKENS]);
-        if !table.counts.is_empty() {
-            let mut f = table.counts;
-            normalise(&mut f).expect("nonzero counts normalise");
+        if tokens > 0 {
             let mut cum = 0;
-            for (t, &ft) in f.iter().enumerate() {
+            for (t, &ft) in table.freqs[..tokens].iter().enumerate() {
                 start[t] = cum;
                 freq[t] = ft;
                 cum += ft;
@@ -363,13 +441,7 @@ fn choose_models(
         }
         if let Some(lane_bits) = lane_bits.as_deref_mut() {
             // Each token's bits under the table, then each lane's tokens.
-            let token_bits = freq.map(|f| {
-                if f == 0 {
-                    0.0
-                } else {
-                    PROB_BITS as f64 - libm_log2(f as f64)
-                }
-            });
+            let token_bits = freq.map(|f| TOKEN_BITS[f as usize]);
             for (lane, bits) in lane_bits.iter_mut().enumerate() {
                 let counts = &lane_histograms[lane * contexts + ctx];
                 *bits += counts
@@ -658,6 +730,16 @@ mod tests {
             for x in xs.into_iter().filter(|&x| x <= top) {
                 let (x, f) = (x as u32, f as u32);
                 assert_eq!(div_rem(x, f), (x / f, x % f), "{x} / {f}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_shift_table_is_adaptive_shift() {
+        for (r, row) in SHIFTS.iter().enumerate() {
+            for (count, &shift) in row.iter().enumerate() {
+                let rate = ADAPTIVE_RATE_MIN + r as u8;
+                assert_eq!(shift as u32, adaptive_shift(count as u8, rate));
             }
         }
     }
