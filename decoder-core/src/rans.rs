@@ -743,9 +743,16 @@ fn decide(
 
 /// How far a probability used `count` times before moves (§5.5.4, 3.9):
 /// `2^-shift` of the way, `shift = min(rate, 1 + bit length of count)`.
+/// (A `const fn`, so the encoder's cost tables are built from it.)
 #[inline(always)]
-pub fn adaptive_shift(count: u8, rate: u8) -> u32 {
-    (1 + (8 - count.leading_zeros())).min(rate as u32)
+pub const fn adaptive_shift(count: u8, rate: u8) -> u32 {
+    let shift = 1 + (8 - count.leading_zeros());
+    // `shift.min(rate)` (not `const`), in `min`'s own form.
+    if (rate as u32) < shift {
+        rate as u32
+    } else {
+        shift
+    }
 }
 
 /// Finishes a value whose token has been read, leaving the lane's state

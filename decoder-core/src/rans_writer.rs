@@ -111,10 +111,6 @@ fn scaled_counts(histogram: &[u32]) -> StaticTable {
             break;
         }
     }
-    if !found {
-        best.tokens = 0;
-        best.cost = 0.0;
-    }
     best
 }
 
@@ -274,9 +270,7 @@ const fn shifts() -> [[u8; 256]; 8] {
     while r < 8 {
         let mut count = 0;
         while count < 256 {
-            let rate = ADAPTIVE_RATE_MIN + r as u8;
-            let shift = 1 + (8 - (count as u8).leading_zeros()) as u8;
-            table[r][count] = if shift < rate { shift } else { rate };
+            table[r][count] = adaptive_shift(count as u8, ADAPTIVE_RATE_MIN + r as u8) as u8;
             count += 1;
         }
         r += 1;
