@@ -897,7 +897,7 @@ mod tests {
         let expected: Vec<u32> = symbols.iter().map(|s| s.1).collect();
         for lanes in [1, 2, 3, 4, 16, 32] {
             let (payload, adaptive) =
-                crate::rans_writer::encode_chunk_with(&symbols, 3, lanes, true);
+                crate::rans_writer::encode_chunk_with(&symbols, 3, lanes, true, None);
             let (in_payload, in_use) = table_kinds(&payload, 3).unwrap();
             assert_eq!((in_payload > 0, in_use), (adaptive, 3));
             // With many lanes each lane's probabilities learn from few
@@ -909,7 +909,7 @@ mod tests {
             }
             assert_eq!(decode(&payload, &contexts, 3, lanes).unwrap(), expected);
             let (static_only, adaptive) =
-                crate::rans_writer::encode_chunk_with(&symbols, 3, lanes, false);
+                crate::rans_writer::encode_chunk_with(&symbols, 3, lanes, false, None);
             assert!(!adaptive);
             assert!(payload.len() <= static_only.len(), "{lanes} lanes");
             assert_eq!(table_kinds(&static_only, 3), Ok((0, 3)));
@@ -961,7 +961,7 @@ mod tests {
     fn peeking_adaptive_bits_consumes_nothing() {
         let symbols: Vec<Symbol> = skewed(900).into_iter().filter(|s| s.0 < 2).collect();
         let contexts: Vec<u8> = symbols.iter().map(|s| s.0).collect();
-        let (payload, adaptive) = crate::rans_writer::encode_chunk_with(&symbols, 2, 2, true);
+        let (payload, adaptive) = crate::rans_writer::encode_chunk_with(&symbols, 2, 2, true, None);
         assert!(adaptive);
         let mut words = vec![0u32; TABLE_WORDS + LANE_WORDS * MAX_LANES as usize];
         let mut chunk = ChunkDecoder::new(&mut words, 2).expect("room");
@@ -1033,7 +1033,7 @@ mod tests {
                 .map(|&(ctx, v)| (ctx, match ctx { 0 | 1 => v & 1, 2 => (v == 0) as u32, _ => v }))
                 .collect();
             let (mut payload, _) =
-                crate::rans_writer::encode_chunk_with(&symbols, 4, lanes, adaptive);
+                crate::rans_writer::encode_chunk_with(&symbols, 4, lanes, adaptive, None);
             for (at, flip) in &edits {
                 let i = at.index(payload.len());
                 payload[i] ^= flip;

@@ -32,6 +32,7 @@ fn varint_len(v: u32) -> usize {
 }
 
 /// A context's static table as [`scaled_counts`] chooses it.
+#[derive(Clone, Copy, Debug)]
 struct StaticTable {
     /// Its count bytes and the context's tokens under it, in bits.
     cost: f64,
@@ -150,6 +151,7 @@ const fn libm_log2(x: f64) -> f64 {
     clippy::large_enum_variant,
     reason = "at most 8 per chunk, built once per chunk"
 )]
+#[derive(Clone, Debug)]
 enum Model {
     /// A static table: each token's cumulative start and frequency.
     Static {
@@ -322,21 +324,38 @@ fn adaptive_bits(
     bits
 }
 
+/// A chunk's tables as [`estimated_chunk_len`] chose them, kept so that
+/// coding the same values ([`encode_chunk_with`]) need not choose them
+/// again: an encoder costs the alternative it writes before it frames it.
+#[derive(Clone, Debug)]
+pub(crate) struct ChunkTables {
+    /// Whether `models` were chosen with adaptive tables allowed.
+    adaptive_tables: bool,
+    /// The table bytes that announce `models` (SPEC §5.5.2).
+    bytes: Vec<u8>,
+    models: Vec<Model>,
+    /// Every context's best static table: what adaptive tables are weighed
+    /// against where coding allows them and costing did not.
+    priced: Vec<StaticTable>,
+}
+
 /// The model of each context for `symbols` coded in `lanes` lanes, and the
 /// table bytes that announce them: an adaptive table where it is estimated
 /// smaller than the best static one (at most `ADAPTIVE_TOKENS` tokens,
 /// every lane's probabilities within `ADAPTIVE_STATES`), a static table
 /// otherwise. With `lane_bits`, also the bits each lane is estimated to
 /// take under them ([`estimated_chunk_len`]): its tokens under the chosen
-/// models and its values' raw bits.
+/// models and its values' raw bits. `priced`: the contexts' static tables
+/// when they are known already (the same values costed before).
 fn choose_models(
     symbols: &[Symbol],
     contexts: usize,
     lanes: usize,
     adaptive_tables: bool,
-    out: &mut Vec<u8>,
+    priced: Option<&[StaticTable]>,
     mut lane_bits: Option<&mut Vec<f64>>,
-) -> Vec<Model> {
+) -> ChunkTables {
+    let mut out = Vec::new();
     let mut histograms = vec![[0u32; TOKENS]; contexts];
     // Per lane and context (`lane * contexts + context`), when estimating.
     let mut lane_histograms = Vec::new();
@@ -357,12 +376,15 @@ fn choose_models(
                 *all += n;
             }
         }
-    } else {
+    } else if priced.is_none() {
         for &(ctx, value) in symbols {
             histograms[ctx as usize][token_of(value).0 as usize] += 1;
         }
     }
-    let priced: Vec<StaticTable> = histograms.iter().map(|h| scaled_counts(h)).collect();
+    let priced: Vec<StaticTable> = match priced {
+        Some(priced) if lane_bits.is_none() => priced.to_vec(),
+        _ => histograms.iter().map(|h| scaled_counts(h)).collect(),
+    };
     let may_adapt = |tokens: usize| {
         adaptive_tables
             && tokens > 1
@@ -392,7 +414,7 @@ fn choose_models(
         }
     }
     let mut models = Vec::with_capacity(contexts);
-    for (ctx, (table, lanes_tokens)) in priced.into_iter().zip(&lanes_tokens).enumerate() {
+    for (ctx, (table, lanes_tokens)) in priced.iter().zip(&lanes_tokens).enumerate() {
         let tokens = table.tokens;
         if may_adapt(tokens) {
             // Each rate's bits per lane, kept as the rates are tried.
@@ -422,7 +444,7 @@ fn choose_models(
         }
         out.push(tokens as u8);
         for &count in &table.counts[..tokens] {
-            push_varint(out, count);
+            push_varint(&mut out, count);
         }
         let (mut start, mut freq) = ([0u32; TOKENS], [0u32; TOKENS]);
         if tokens > 0 {
@@ -447,7 +469,12 @@ fn choose_models(
         }
         models.push(Model::Static { start, freq });
     }
-    models
+    ChunkTables {
+        adaptive_tables,
+        bytes: out,
+        models,
+        priced,
+    }
 }
 
 /// One step of a lane as the decoder takes it: a symbol of `freq` slots
@@ -628,20 +655,22 @@ fn code_lane(
 /// all of its bits but the 23 to 31 its final state keeps, so it takes
 /// within a byte of its bits over eight, plus its 4-byte state and its
 /// length. What an encoder ranking alternatives needs: coding the lanes to
-/// count their bytes took most of the time of ranking them.
-pub fn estimated_chunk_len(
+/// count their bytes took most of the time of ranking them. Also the
+/// tables it chose: [`encode_chunk_with`] codes the same values under them
+/// without choosing again.
+pub(crate) fn estimated_chunk_len(
     symbols: &[Symbol],
     contexts: usize,
     lanes: usize,
     adaptive_tables: bool,
-) -> usize {
-    let (mut tables, mut lane_bits) = (Vec::new(), Vec::new());
-    choose_models(
+) -> (usize, ChunkTables) {
+    let mut lane_bits = Vec::new();
+    let tables = choose_models(
         symbols,
         contexts,
         lanes,
         adaptive_tables,
-        &mut tables,
+        None,
         Some(&mut lane_bits),
     );
     // round(bits / 8 − 1/2) bytes shifted out, which is the floor (`as`
@@ -654,28 +683,41 @@ pub fn estimated_chunk_len(
         })
         .sum();
     // Lanes with no value: a 0 length each.
-    tables.len() + lanes_len + (lanes - lane_bits.len())
+    let len = tables.bytes.len() + lanes_len + (lanes - lane_bits.len());
+    (len, tables)
 }
 
 /// [`encode_chunk_with`] allowing adaptive tables, the payload alone (the
 /// tests' shorthand).
 #[cfg(test)]
 pub fn encode_chunk(symbols: &[Symbol], contexts: usize, lanes: usize) -> Vec<u8> {
-    encode_chunk_with(symbols, contexts, lanes, true).0
+    encode_chunk_with(symbols, contexts, lanes, true, None).0
 }
 
 /// Encodes `symbols` as one rANS chunk payload with `contexts` tables and
 /// `lanes` lanes (SPEC §5.5.2, §5.5.3), with an adaptive table (3.9) for a
 /// context where `adaptive_tables` allows it and it is smaller; and
-/// whether the chunk has one.
-pub fn encode_chunk_with(
+/// whether the chunk has one. `chosen`: the tables [`estimated_chunk_len`]
+/// chose for the same values, coded under as they are where adaptive tables
+/// were allowed alike, or else weighed from their static tables, which do
+/// not depend on it; the same payload either way.
+pub(crate) fn encode_chunk_with(
     symbols: &[Symbol],
     contexts: usize,
     lanes: usize,
     adaptive_tables: bool,
+    chosen: Option<&ChunkTables>,
 ) -> (Vec<u8>, bool) {
-    let mut out = Vec::new();
-    let models = choose_models(symbols, contexts, lanes, adaptive_tables, &mut out, None);
+    let fresh;
+    let tables = match chosen {
+        Some(chosen) if chosen.adaptive_tables == adaptive_tables => chosen,
+        _ => {
+            let priced = chosen.map(|c| &c.priced[..]);
+            fresh = choose_models(symbols, contexts, lanes, adaptive_tables, priced, None);
+            &fresh
+        }
+    };
+    let (mut out, models) = (tables.bytes.clone(), &tables.models[..]);
     let adaptive = models.iter().any(|m| matches!(m, Model::Adaptive { .. }));
     let mut lane_bytes: Vec<Vec<u8>> = Vec::with_capacity(lanes);
     for lane in 0..lanes {
@@ -684,7 +726,7 @@ pub fn encode_chunk_with(
             continue;
         }
         let mut bytes = Vec::new(); // reversed
-        let x = code_lane(symbols, &models, adaptive, (lane, lanes), |b| bytes.push(b));
+        let x = code_lane(symbols, models, adaptive, (lane, lanes), |b| bytes.push(b));
         bytes.extend_from_slice(&x.to_be_bytes());
         bytes.reverse();
         // The state was pushed big-endian then reversed: little-endian now.
@@ -757,8 +799,8 @@ mod tests {
                     (ctx % contexts as u8, v)
                 })
                 .collect();
-            let (payload, _) = encode_chunk_with(&symbols, contexts, lanes, adaptive);
-            let estimated = estimated_chunk_len(&symbols, contexts, lanes, adaptive);
+            let (payload, _) = encode_chunk_with(&symbols, contexts, lanes, adaptive, None);
+            let (estimated, _) = estimated_chunk_len(&symbols, contexts, lanes, adaptive);
             let used = lanes.min(symbols.len());
             prop_assert!(
                 estimated.abs_diff(payload.len()) <= used,

@@ -1,8 +1,10 @@
 //! Writing streams (SPEC §3–§5), the inverse of the parsers: used by the
 //! encoder and by tests that build streams by hand. Needs the `alloc` feature.
 
+use alloc::boxed::Box;
 use alloc::vec;
 use alloc::vec::Vec;
+use core::ops::Range;
 
 use crate::bytes::crc32;
 use crate::context::{self, DeficitContexts};
@@ -19,18 +21,55 @@ use crate::limits::{
 use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
 use crate::rans_segments::rans_segments;
-use crate::rans_writer::{Symbol, encode_chunk_with, estimated_chunk_len, push_varint};
+use crate::rans_writer::{
+    ChunkTables, Symbol, encode_chunk_with, estimated_chunk_len, push_varint,
+};
 use crate::wing_order::WingPolicy;
 
 /// A growing substream: bytes, bits (least significant first) or varints
 /// for the byte codecs (SPEC §5.4), and the same values with their contexts
 /// for rANS (SPEC §5.5). The plain methods use context 0; the `_in` methods
 /// take the context the decoder will compute (see [`crate::context`]).
-#[derive(Clone, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Debug, Default)]
 pub struct SubstreamWriter {
     bytes: Vec<u8>,
     bit_count: u8,
     symbols: Vec<Symbol>,
+    /// What costing its rANS chunks last found ([`coded_len_under`]).
+    plan: Option<Box<RansPlan>>,
+}
+
+/// Two substreams are equal when they hold the same values: a plan is
+/// what costing found from them.
+impl PartialEq for SubstreamWriter {
+    fn eq(&self, other: &Self) -> bool {
+        (&self.bytes, self.bit_count, &self.symbols)
+            == (&other.bytes, other.bit_count, &other.symbols)
+    }
+}
+
+impl Eq for SubstreamWriter {}
+
+/// A substream's rANS chunks (SPEC §5.2, §5.5) as [`coded_len_under`]
+/// costed them: where it cuts them (`rans_segments`) and the tables it
+/// chose for each (`rans_writer::ChunkTables`). An encoder
+/// costs the alternative it writes (a plane policy's residuals, a choice of
+/// contexts) before it frames it, or costs it twice; both then find the
+/// same cuts and tables here instead of again, and write the same bytes.
+/// It holds for the substream's first `values` values (values are only
+/// appended), `contexts` tables, `lanes` lanes and chunks of at most
+/// `limit` values.
+#[derive(Clone, Debug)]
+struct RansPlan {
+    contexts: usize,
+    lanes: usize,
+    limit: usize,
+    values: usize,
+    /// Whether adaptive tables were allowed in costing.
+    adaptive_tables: bool,
+    /// The chunks' estimated payload bytes.
+    payloads: usize,
+    chunks: Vec<(Range<usize>, ChunkTables)>,
 }
 
 impl SubstreamWriter {
@@ -42,6 +81,7 @@ impl SubstreamWriter {
             bytes: Vec::with_capacity(bytes),
             bit_count: 0,
             symbols: Vec::with_capacity(values),
+            plan: None,
         }
     }
 
@@ -115,6 +155,58 @@ impl SubstreamWriter {
 
     pub fn is_empty(&self) -> bool {
         self.bytes.is_empty() && self.symbols.is_empty()
+    }
+
+    /// The plan of its rANS chunks in `contexts` tables, `lanes` lanes and
+    /// chunks of at most `limit` values, if costing left one for its
+    /// values as they are now.
+    fn plan_for(&self, contexts: usize, lanes: usize, limit: usize) -> Option<&RansPlan> {
+        let plan = self.plan.as_deref()?;
+        let key = (contexts, lanes, limit, self.symbols.len());
+        (key == (plan.contexts, plan.lanes, plan.limit, plan.values)).then_some(plan)
+    }
+
+    /// Its rANS chunks' estimated payload bytes and count, with
+    /// `adaptive_tables` allowed or not, kept as its plan: the plan left by
+    /// an earlier costing where it holds, or else its cuts where only
+    /// `adaptive_tables` differs.
+    fn costed_rans(
+        &mut self,
+        contexts: usize,
+        lanes: usize,
+        limit: usize,
+        adaptive_tables: bool,
+    ) -> (usize, usize) {
+        let kept = self.plan_for(contexts, lanes, limit);
+        if let Some(plan) = kept.filter(|p| p.adaptive_tables == adaptive_tables) {
+            return (plan.payloads, plan.chunks.len());
+        }
+        let symbols = &self.symbols;
+        let segments = match kept {
+            Some(plan) => plan.chunks.iter().map(|(r, _)| r.clone()).collect(),
+            None => rans_segments(symbols, contexts, lanes, limit),
+        };
+        let mut payloads = 0;
+        let chunks: Vec<(Range<usize>, ChunkTables)> = segments
+            .into_iter()
+            .map(|range| {
+                let values = &symbols[range.clone()];
+                let (len, tables) = estimated_chunk_len(values, contexts, lanes, adaptive_tables);
+                payloads += len;
+                (range, tables)
+            })
+            .collect();
+        let count = chunks.len();
+        self.plan = Some(Box::new(RansPlan {
+            contexts,
+            lanes,
+            limit,
+            values: symbols.len(),
+            adaptive_tables,
+            payloads,
+            chunks,
+        }));
+        (payloads, count)
     }
 }
 
@@ -579,7 +671,7 @@ fn substream_chunks(
     let rans_limit = params.rans_chunk_limit.max(1) as usize;
     let rans_in = |lanes: u8| {
         rans_chunks(
-            sub.symbols(),
+            sub,
             rans_limit,
             contexts,
             lanes as usize,
@@ -627,15 +719,17 @@ fn rans_or_deflate<T>(rans: (T, usize), mut deflate_at: impl FnMut(u8) -> (T, us
 /// encoder compare alternatives (the plane policies of SPEC §7.4) by their
 /// cost: exact under the byte codecs, and under rANS each lane of a chunk
 /// estimated from its values' bits, within a byte of its length
-/// ([`estimated_chunk_len`]).
-pub fn coded_len(sub: &SubstreamWriter, id: u8, params: &StreamParams) -> usize {
+/// ([`estimated_chunk_len`]). Under rANS it keeps the chunks' cuts and
+/// tables in `sub` for framing it or costing it again (`RansPlan`): the
+/// same bytes, found once.
+pub fn coded_len(sub: &mut SubstreamWriter, id: u8, params: &StreamParams) -> usize {
     coded_len_in(sub, id, DeficitContexts::Plain, params)
 }
 
 /// [`coded_len`] in a level whose deficit contexts are `deficits` (they set
 /// the table count of deficit-p and deficit-c, SPEC §5.5.5).
 pub fn coded_len_in(
-    sub: &SubstreamWriter,
+    sub: &mut SubstreamWriter,
     id: u8,
     deficits: DeficitContexts,
     params: &StreamParams,
@@ -646,7 +740,7 @@ pub fn coded_len_in(
 /// [`coded_len_in`] in a level whose record order is `records` (it sets
 /// the table count of edge and placement, SPEC §5.5.5, 3.7).
 pub fn coded_len_under(
-    sub: &SubstreamWriter,
+    sub: &mut SubstreamWriter,
     id: u8,
     deficits: DeficitContexts,
     records: RecordOrder,
@@ -656,20 +750,14 @@ pub fn coded_len_under(
     // The rANS chunks' payloads and count, their lanes estimated, not
     // coded: the same cuts and tables as `substream_chunks`, which
     // `frame_level` writes, and each lane within a byte of its own.
-    let rans_len = |lanes: u8| {
-        let symbols = sub.symbols();
-        let limit = params.rans_chunk_limit.max(1) as usize;
-        let segments = rans_segments(symbols, contexts, lanes as usize, limit);
-        let payloads: usize = segments
-            .iter()
-            .map(|range| {
-                let values = &symbols[range.clone()];
-                estimated_chunk_len(values, contexts, lanes as usize, params.adaptive_tables)
-            })
-            .sum();
-        (payloads, segments.len())
-    };
+    let limit = params.rans_chunk_limit.max(1) as usize;
+    let mut rans_len =
+        |lanes: u8| sub.costed_rans(contexts, lanes as usize, limit, params.adaptive_tables);
     let framed = |(payloads, chunks): (usize, usize)| payloads + chunks * CHUNK_ENTRY_LEN;
+    let rans = match params.codec {
+        ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } => Some(rans_len(lanes)),
+        ChunkCodec::Stored | ChunkCodec::Deflate(_) => None,
+    };
     let byte_codec = |level: Option<u8>| {
         let chunks = byte_chunks(
             sub.as_bytes(),
@@ -685,9 +773,9 @@ pub fn coded_len_under(
     framed(match params.codec {
         ChunkCodec::Stored => byte_codec(None),
         ChunkCodec::Deflate(l) => byte_codec(Some(l)),
-        ChunkCodec::RansAlways { lanes } => rans_len(lanes),
-        ChunkCodec::Rans { lanes } => {
-            let rans = rans_len(lanes);
+        ChunkCodec::RansAlways { .. } => rans.expect("costed above"),
+        ChunkCodec::Rans { .. } => {
+            let rans = rans.expect("costed above");
             rans_or_deflate((rans, rans.0), |level| {
                 let deflate = byte_codec(Some(level));
                 (deflate, deflate.0)
@@ -740,7 +828,7 @@ impl GrowingCodedLen {
     /// [`coded_len_in`] of the complete substream `sub`, the one advanced.
     pub fn finish(
         &self,
-        sub: &SubstreamWriter,
+        sub: &mut SubstreamWriter,
         id: u8,
         deficits: DeficitContexts,
         params: &StreamParams,
@@ -810,19 +898,26 @@ fn byte_chunk(bytes: &[u8], limit: usize, level: Option<u8>, i: usize) -> Chunk 
 
 /// rANS chunks of at most `limit` values each, `contexts` tables each
 /// (SPEC §5.5), cut where [`rans_segments`] estimates the substream
-/// smallest.
+/// smallest: the cuts and tables of `sub`'s plan where costing left one.
 fn rans_chunks(
-    symbols: &[Symbol],
+    sub: &SubstreamWriter,
     limit: usize,
     contexts: usize,
     lanes: usize,
     adaptive_tables: bool,
     map: ChunkMap<'_>,
 ) -> Vec<Chunk> {
-    let segments = rans_segments(symbols, contexts, lanes, limit);
+    let symbols = sub.symbols();
+    let plan = sub.plan_for(contexts, lanes, limit);
+    let segments = match plan {
+        Some(plan) => plan.chunks.iter().map(|(r, _)| r.clone()).collect(),
+        None => rans_segments(symbols, contexts, lanes, limit),
+    };
     map(segments.len(), &|i| {
         let values = &symbols[segments[i].clone()];
-        let (stored, adaptive) = encode_chunk_with(values, contexts, lanes, adaptive_tables);
+        let chosen = plan.map(|p| &p.chunks[i].1);
+        let (stored, adaptive) =
+            encode_chunk_with(values, contexts, lanes, adaptive_tables, chosen);
         Chunk {
             codec: codec::RANS,
             raw_len: values.len() as u32,
@@ -888,7 +983,7 @@ mod tests {
             };
             let rans_chunks =
                 rans_segments(sub.symbols(), contexts, lanes, rans_chunk_limit as usize).len();
-            let coded = coded_len(&sub, substream::EDGE, &params);
+            let coded = coded_len(&mut sub, substream::EDGE, &params);
             prop_assert!(
                 coded.abs_diff(framed) <= rans_chunks * lanes,
                 "coded {} bytes, framed {}, {} rANS chunks of {} lanes",
@@ -897,6 +992,72 @@ mod tests {
                 rans_chunks,
                 lanes
             );
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// A substream costed before it is framed (its plan kept: the
+        /// chunks' cuts and tables) frames as one never costed: with
+        /// adaptive tables allowed in costing or not, in framing or not,
+        /// chunks cut by `rans_segments`' blocks or by a small limit, and
+        /// values written after the costing (the plan no longer holds).
+        #[test]
+        fn a_costed_substream_frames_as_a_fresh_one(
+            values in proptest::collection::vec((any::<u8>(), -3000i32..3000), 0..12_000),
+            skew in 1i32..3000,
+            lanes in 1u8..=4,
+            rans_always in any::<bool>(),
+            adaptive_cost in any::<bool>(),
+            adaptive_frame in any::<bool>(),
+            small_chunks in any::<bool>(),
+            runs in any::<bool>(),
+            appended in 0usize..2,
+        ) {
+            let codec = if rans_always {
+                ChunkCodec::RansAlways { lanes }
+            } else {
+                ChunkCodec::Rans { lanes }
+            };
+            let rans_chunk_limit = if small_chunks { 300 } else { DEFAULT_RANS_CHUNK_LIMIT };
+            let params = |adaptive_tables| StreamParams {
+                codec,
+                rans_chunk_limit,
+                adaptive_tables,
+                ..StreamParams::default()
+            };
+            // Values whose spread drifts, for chunks of their own; or runs
+            // of zeros and small values, which adaptive tables code smaller.
+            let mut fresh = SubstreamWriter::default();
+            for (i, &(ctx, v)) in values.iter().enumerate() {
+                let v = if runs {
+                    (i / 37 % 2) as i32 * (v % 3)
+                } else {
+                    (v % skew) >> (i / 2500 % 3)
+                };
+                fresh.signed_in(ctx % 3, v);
+            }
+            let mut costed = fresh.clone();
+            coded_len(&mut costed, substream::EDGE, &params(adaptive_cost));
+            for sub in [&mut fresh, &mut costed] {
+                for i in 0..appended {
+                    sub.signed_in(1, i as i32);
+                }
+            }
+            let contexts = context::count(
+                substream::EDGE,
+                DeficitContexts::Plain,
+                RecordOrder::WingsFirst,
+                Schedule::default(),
+            );
+            let frame = |sub: &SubstreamWriter| -> Vec<(u8, u32, Vec<u8>, bool)> {
+                substream_chunks(sub, contexts, &params(adaptive_frame), &one_by_one)
+                    .into_iter()
+                    .map(|c| (c.codec, c.raw_len, c.stored, c.adaptive))
+                    .collect()
+            };
+            prop_assert_eq!(frame(&costed), frame(&fresh));
         }
     }
 }

@@ -68,8 +68,8 @@ proptest! {
             }
         }
         prop_assert_eq!(
-            growing.finish(&sub, id, deficits, &params),
-            coded_len_in(&sub, id, deficits, &params)
+            growing.finish(&mut sub.clone(), id, deficits, &params),
+            coded_len_in(&mut sub, id, deficits, &params)
         );
     }
 }

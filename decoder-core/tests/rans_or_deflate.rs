@@ -15,7 +15,7 @@ fn len(sub: &SubstreamWriter, codec: ChunkCodec) -> usize {
         codec,
         ..StreamParams::default()
     };
-    coded_len(sub, substream::EDGE, &params)
+    coded_len(&mut sub.clone(), substream::EDGE, &params)
 }
 
 fn pseudo_random() -> impl FnMut() -> u64 {

@@ -55,8 +55,8 @@ impl DeficitCoding {
         let ranking = ranking_params(params);
         let best = DeficitContexts::ALL
             .into_iter()
-            .zip(&self.coded)
-            .filter_map(|(d, coded)| Some((cost(coded.as_ref()?, d, &ranking), d.to_byte())))
+            .zip(&mut self.coded)
+            .filter_map(|(d, coded)| Some((cost(coded.as_mut()?, d, &ranking), d.to_byte())))
             .min();
         if let Some((_, best)) = best {
             for (d, coded) in DeficitContexts::ALL.into_iter().zip(&mut self.coded) {
@@ -72,16 +72,19 @@ impl DeficitCoding {
     pub fn choose(self, subs: &mut [SubstreamWriter], params: &StreamParams) -> DeficitContexts {
         let ranking = ranking_params(params);
         let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
-        let (contexts, [p, c]) = DeficitContexts::ALL
+        let (_, contexts, [p, c]) = DeficitContexts::ALL
             .into_iter()
             .zip(self.coded)
             .filter_map(|(d, c)| c.map(|c| (d, c)))
-            .min_by_key(|(d, coded)| {
-                (
-                    if single { 0 } else { cost(coded, *d, &ranking) },
-                    d.to_byte(),
-                )
+            .map(|(d, mut coded)| {
+                let cost = if single {
+                    0
+                } else {
+                    cost(&mut coded, d, &ranking)
+                };
+                ((cost, d.to_byte()), d, coded)
             })
+            .min_by_key(|&(key, ..)| key)
             .expect("at least one choice of deficit contexts");
         subs[(substream::DEFICIT_P - substream::FLAGS) as usize] = p;
         subs[(substream::DEFICIT_C - substream::FLAGS) as usize] = c;
@@ -90,8 +93,12 @@ impl DeficitCoding {
 }
 
 /// Bytes a choice's deficit-p and deficit-c substreams take under the
-/// ranking parameters.
-fn cost([p, c]: &[SubstreamWriter; 2], contexts: DeficitContexts, ranking: &StreamParams) -> usize {
+/// ranking parameters (their rANS plans kept for framing, `coded_len_in`).
+fn cost(
+    [p, c]: &mut [SubstreamWriter; 2],
+    contexts: DeficitContexts,
+    ranking: &StreamParams,
+) -> usize {
     coded_len_in(p, substream::DEFICIT_P, contexts, ranking)
         + coded_len_in(c, substream::DEFICIT_C, contexts, ranking)
 }

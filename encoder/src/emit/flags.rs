@@ -90,23 +90,26 @@ impl FlagCoding {
     }
 
     /// The choice still open whose flags so far code smaller (`valence`
-    /// on a tie, which 3.9 decoders read).
-    fn cheaper(&self) -> DeficitContexts {
+    /// on a tie, which 3.9 decoders read); their rANS plans are kept for
+    /// framing (`coded_len_in`).
+    fn cheaper(&mut self) -> DeficitContexts {
         let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
+        let params = &self.params;
         CHOICES
             .into_iter()
-            .zip(&self.coded)
-            .filter_map(|(c, sub)| Some((c, sub.as_ref()?)))
-            .min_by_key(|&(c, sub)| {
+            .zip(&mut self.coded)
+            .filter_map(|(c, sub)| Some((c, sub.as_mut()?)))
+            .map(|(c, sub)| {
                 let cost = if single {
                     0
                 } else {
-                    coded_len_in(sub, substream::FLAGS, c, &self.params)
+                    coded_len_in(sub, substream::FLAGS, c, params)
                 };
-                (cost, c.to_byte())
+                ((cost, c.to_byte()), c)
             })
+            .min_by_key(|&(key, _)| key)
             .expect("at least one choice of flag contexts")
-            .0
+            .1
     }
 
     /// Puts the cheaper choice's flags into `subs` (ids 1..=7 at 0..=6)

@@ -234,7 +234,7 @@ pub fn code_geometry(
             early = None;
             let wing_cost = wings.choose_early(params);
             if let (Some(pf), Some(order)) = (&mut positions_first, &order) {
-                match choose_order_early(pf, order, wing_cost, &placement, params) {
+                match choose_order_early(pf, order, wing_cost, &mut placement, params) {
                     Some(EarlyChoice::PositionsFirst(ties)) => {
                         pf.chosen = true;
                         if let Some(ties) = ties {
@@ -286,10 +286,10 @@ enum EarlyChoice {
 /// whose coder failed (its error ends the level) count as costing more
 /// than any alternative.
 fn choose_order_early(
-    pf: &PositionsFirstCoding,
+    pf: &mut PositionsFirstCoding,
     order: &EarlyOrder,
     wing_cost: Option<usize>,
-    placement: &SubstreamWriter,
+    placement: &mut SubstreamWriter,
     params: &StreamParams,
 ) -> Option<EarlyChoice> {
     let Some(edge_cost) = &order.edge_cost else {

@@ -85,12 +85,17 @@ impl PolicyResiduals {
     /// The substreams' cost under `ranking`, the parameters they were
     /// advanced under: `coded_len` of `edge`, plus that of `placement` in
     /// optimal mode.
-    fn cost(&self, optimal: bool, ranking: &StreamParams) -> usize {
+    fn cost(&mut self, optimal: bool, ranking: &StreamParams) -> usize {
         let [edge, placement] = &self.costs;
-        let edge = edge.finish(&self.edge, substream::EDGE, DeficitContexts::Plain, ranking);
+        let edge = edge.finish(
+            &mut self.edge,
+            substream::EDGE,
+            DeficitContexts::Plain,
+            ranking,
+        );
         let placement = if optimal {
             placement.finish(
-                &self.placement,
+                &mut self.placement,
                 substream::PLACEMENT,
                 DeficitContexts::Plain,
                 ranking,
@@ -192,9 +197,11 @@ pub fn code_policies(
             // policy kept stays usable.
             let mut kept_cost = None;
             if only.is_none() {
-                let best = (0..out.len())
-                    .filter(|&i| out[i].usable)
-                    .map(|i| (out[i].cost(optimal, &ranking), i))
+                let best = out
+                    .iter_mut()
+                    .enumerate()
+                    .filter(|(_, r)| r.usable)
+                    .map(|(i, r)| (r.cost(optimal, &ranking), i))
                     .min();
                 if let Some((cost, best)) = best {
                     only = Some(PlanePolicy::ALL[best]);
@@ -208,8 +215,8 @@ pub fn code_policies(
             } else if early_cost.is_some() {
                 kept_cost = PlanePolicy::ALL
                     .iter()
-                    .zip(&out)
-                    .find(|&(p, r)| only == Some(*p) && r.usable)
+                    .zip(&mut out)
+                    .find(|(p, r)| only == Some(**p) && r.usable)
                     .map(|(_, r)| r.cost(optimal, &ranking));
             }
             if let Some(tell) = &early_cost {
@@ -277,7 +284,7 @@ pub fn ranking_params(params: &StreamParams) -> StreamParams {
 /// earlier policy of `PlanePolicy::ALL` (`off` first).
 pub fn choose_policy(
     subs: &mut [SubstreamWriter],
-    residuals: Vec<PolicyResiduals>,
+    mut residuals: Vec<PolicyResiduals>,
     params: &StreamParams,
     forced: Option<PlanePolicy>,
 ) -> Result<PlanePolicy, String> {
@@ -286,7 +293,7 @@ pub fn choose_policy(
     let params = &ranking;
     // A single usable policy (forced, or chosen early) is not weighed.
     let single = residuals.iter().filter(|r| r.usable).count() == 1;
-    let cost = |(r, policy): (&PolicyResiduals, PlanePolicy)| {
+    let cost = |(r, policy): (&mut PolicyResiduals, PlanePolicy)| {
         if forced.is_some_and(|f| f != policy) {
             return None;
         }
@@ -301,10 +308,14 @@ pub fn choose_policy(
     // the pool is busy with the exactness check, and this level's framing
     // waited about 40 ms behind it for the answer (1M terrain).
     let costs: Vec<Option<usize>> = if forced.is_some() || single {
-        residuals.iter().zip(PlanePolicy::ALL).map(cost).collect()
+        residuals
+            .iter_mut()
+            .zip(PlanePolicy::ALL)
+            .map(cost)
+            .collect()
     } else {
         residuals
-            .par_iter()
+            .par_iter_mut()
             .zip(PlanePolicy::ALL)
             .map(cost)
             .collect()
@@ -392,9 +403,13 @@ mod tests {
             let ranking = ranking_params(&params);
             let splits = splits();
             let coded = code_policies(batches(&splits), &params, None, splits.len(), None).unwrap();
-            for residuals in &coded {
-                let whole = coded_len(&residuals.edge, substream::EDGE, &ranking)
-                    + coded_len(&residuals.placement, substream::PLACEMENT, &ranking);
+            for mut residuals in coded {
+                let whole = coded_len(&mut residuals.edge.clone(), substream::EDGE, &ranking)
+                    + coded_len(
+                        &mut residuals.placement.clone(),
+                        substream::PLACEMENT,
+                        &ranking,
+                    );
                 assert_eq!(residuals.cost(true, &ranking), whole, "{codec:?}");
             }
         }
@@ -449,9 +464,9 @@ mod tests {
             .iter()
             .map(|&p| {
                 let coded = code_policies(send(&splits), &params, Some(p), n, None).unwrap();
-                let r = coded.into_iter().find(|r| r.usable).unwrap();
+                let mut r = coded.into_iter().find(|r| r.usable).unwrap();
                 (
-                    coded_len(&r.edge, substream::EDGE, &ranking),
+                    coded_len(&mut r.edge, substream::EDGE, &ranking),
                     r.edge.as_bytes().to_vec(),
                 )
             })

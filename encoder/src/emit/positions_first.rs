@@ -217,28 +217,29 @@ impl PositionsFirstCoding {
     /// positions-first level, with the wings under the tie rule that codes
     /// them smallest (the lowest rule of equal cost: `ring` keeps the
     /// stream readable by 3.7 decoders); and that rule.
-    pub fn cost(&self, params: &StreamParams) -> (usize, Ties) {
+    pub fn cost(&mut self, params: &StreamParams) -> (usize, Ties) {
         let (rest, wings) = self.costs_by_rule(params, None);
         let (wing_cost, best) = cheapest(&wings);
         (rest + wing_cost, best)
     }
 
     /// [`Self::cost`] with the wings under `ties`.
-    pub fn cost_under(&self, params: &StreamParams, ties: Ties) -> usize {
+    pub fn cost_under(&mut self, params: &StreamParams, ties: Ties) -> usize {
         let (rest, wings) = self.costs_by_rule(params, Some(ties));
         rest + cheapest(&wings).0
     }
 
     /// The edge and placement substreams' cost under `params`' ranking
     /// parameters, and the two wing substreams' under each tie rule still
-    /// written, or only under `only`.
+    /// written, or only under `only` (their rANS plans kept for framing,
+    /// `coded_len_under`).
     pub fn costs_by_rule(
-        &self,
+        &mut self,
         params: &StreamParams,
         only: Option<Ties>,
     ) -> (usize, Vec<(usize, Ties)>) {
         let ranking = ranking_params(params);
-        let cost = |id: u8, sub: &SubstreamWriter| {
+        let cost = |id: u8, sub: &mut SubstreamWriter| {
             coded_len_under(
                 sub,
                 id,
@@ -247,19 +248,20 @@ impl PositionsFirstCoding {
                 &ranking,
             )
         };
-        let [edge, placement] = &self.rest;
+        let [edge, placement] = &mut self.rest;
         let only = only.or(self.kept);
-        let wings: Vec<(Ties, &[SubstreamWriter; 2])> = Ties::ALL
+        let mut wings: Vec<(Ties, &mut [SubstreamWriter; 2])> = Ties::ALL
             .into_iter()
-            .zip(&self.wings)
+            .zip(&mut self.wings)
             .filter(|&(ties, _)| only.is_none_or(|forced| forced == ties))
             .collect();
         rayon::join(
             || cost(substream::EDGE, edge) + cost(substream::PLACEMENT, placement),
             || {
                 wings
-                    .par_iter()
-                    .map(|&(ties, [o, d])| {
+                    .par_iter_mut()
+                    .map(|(ties, [o, d])| {
+                        let ties = *ties;
                         let wings =
                             cost(substream::WING_OFFSET, o) + cost(substream::WING_DISTANCE, d);
                         (wings, ties)

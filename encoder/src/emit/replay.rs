@@ -642,7 +642,7 @@ fn choose_record_order(
     forced: Option<RecordOrder>,
     forced_ties: Option<Ties>,
 ) -> Option<(PlanePolicy, WingPolicy, RecordOrder, Ties)> {
-    let pf = positions_first?;
+    let mut pf = positions_first?;
     // A large level that chose positions first on its first eighth
     // (`geometry::code_geometry`) wrote no wings-first records after it,
     // and where it chose its tie rule too, no other rule's wings.
@@ -652,7 +652,9 @@ fn choose_record_order(
         forced_ties.unwrap_or_else(|| pf.cost(params).1)
     } else {
         // The eight substreams are costed in parallel: after the last
-        // level's replay this is on the emission's critical path.
+        // level's replay this is on the emission's critical path. The
+        // wings-first ones were costed as their policies were chosen:
+        // their plans give their lengths again.
         let ranking = ranking_params(params);
         let ids = [
             substream::WING_OFFSET,
@@ -660,12 +662,14 @@ fn choose_record_order(
             substream::EDGE,
             substream::PLACEMENT,
         ];
-        let held: &[SubstreamWriter] = subs;
+        let held = &mut *subs;
         let (wings_first, positions_first) = rayon::join(
             || {
-                ids.par_iter()
-                    .map(|&id| {
-                        let sub = &held[slot(id)];
+                held.par_iter_mut()
+                    .enumerate()
+                    .map(|(i, sub)| (substream::FLAGS + i as u8, sub))
+                    .filter(|(id, _)| ids.contains(id))
+                    .map(|(id, sub)| {
                         coded_len_under(
                             sub,
                             id,

@@ -75,7 +75,7 @@ impl WingCoding {
     pub fn choose_early(&mut self, params: &StreamParams) -> Option<usize> {
         let ranking = ranking_params(params);
         let (cost, best) = (0..self.coded.len())
-            .filter_map(|i| Some((cost(self.coded[i].as_ref()?, &ranking), i)))
+            .filter_map(|i| Some((cost(self.coded[i].as_mut()?, &ranking), i)))
             .min()?;
         for (i, coded) in self.coded.iter_mut().enumerate() {
             if i != best {
@@ -91,11 +91,19 @@ impl WingCoding {
     pub fn choose(self, subs: &mut [SubstreamWriter], params: &StreamParams) -> WingPolicy {
         let ranking = ranking_params(params);
         let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
-        let (policy, [offset, distance]) = WingPolicy::ALL
+        let (_, policy, [offset, distance]) = WingPolicy::ALL
             .into_iter()
             .zip(self.coded)
             .filter_map(|(p, c)| c.map(|c| (p, c)))
-            .min_by_key(|(p, coded)| (if single { 0 } else { cost(coded, &ranking) }, p.to_byte()))
+            .map(|(p, mut coded)| {
+                let cost = if single {
+                    0
+                } else {
+                    cost(&mut coded, &ranking)
+                };
+                ((cost, p.to_byte()), p, coded)
+            })
+            .min_by_key(|&(key, ..)| key)
             .expect("at least one wing policy is a choice");
         subs[(substream::WING_OFFSET - substream::FLAGS) as usize] = offset;
         subs[(substream::WING_DISTANCE - substream::FLAGS) as usize] = distance;
@@ -104,8 +112,8 @@ impl WingCoding {
 }
 
 /// Bytes a policy's wing-offset and wing-distance substreams take under the
-/// ranking parameters.
-fn cost([offset, distance]: &[SubstreamWriter; 2], ranking: &StreamParams) -> usize {
+/// ranking parameters (their rANS plans kept for framing, `coded_len`).
+fn cost([offset, distance]: &mut [SubstreamWriter; 2], ranking: &StreamParams) -> usize {
     coded_len(offset, substream::WING_OFFSET, ranking)
         + coded_len(distance, substream::WING_DISTANCE, ranking)
 }
