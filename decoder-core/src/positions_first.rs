@@ -1061,10 +1061,16 @@ impl PositionsFirst {
     /// `off(i)`; always 0 under `ring`).
     #[inline]
     fn off_diagonal_edges(&self, i: usize) -> u8 {
+        self.off_diagonal_edges_under(self.ties, i)
+    }
+
+    /// [`Self::off_diagonal_edges`] under the tie rule `ties`.
+    #[inline]
+    fn off_diagonal_edges_under(&self, ties: Ties, i: usize) -> u8 {
         let q = self.q(i);
         self.list_edge
             .iter()
-            .map(|e| u8::from(self.ties.off_diagonal([q[0] - e[0], q[1] - e[1]])))
+            .map(|e| u8::from(ties.off_diagonal([q[0] - e[0], q[1] - e[1]])))
             .sum()
     }
 
@@ -1164,20 +1170,48 @@ impl PositionsFirst {
     }
 
     /// The rank of ring position `entry` among the last `n` choices
-    /// collected (encoder): how many come before it.
+    /// collected (encoder): how many come before it under the tie rule
+    /// set ([`Self::set_ties`]).
     pub fn rank_of_choice(&self, n: usize, entry: usize) -> Option<usize> {
+        self.ranks_of_choice(n, entry)
+            .map(|ranks| ranks[self.ties as usize])
+    }
+
+    /// [`Self::rank_of_choice`] under every tie rule at once, by
+    /// [`Ties::ALL`] index (encoder): the rules differ only between choices
+    /// of equal angle, so each choice's angle is compared once for all
+    /// three (an encoder writes a small level's wings under each rule).
+    pub fn ranks_of_choice(&self, n: usize, entry: usize) -> Option<[usize; 3]> {
         let list = &self.choices[..n];
-        list.iter().any(|&c| c as usize == entry).then(|| {
-            // Entry's angle once, not once per comparison.
-            let [a, b] = self.list_edge;
-            let seen = angle_of(a, b, self.q(entry));
-            list.iter()
-                .map(|&c| c as usize)
-                .filter(|&c| {
-                    c != entry && self.before_seen(c, angle_of(a, b, self.q(c)), entry, seen)
-                })
-                .count()
-        })
+        if !list.iter().any(|&c| c as usize == entry) {
+            return None;
+        }
+        // Entry's angle and diagonal edges once, not once per comparison.
+        let [a, b] = self.list_edge;
+        let seen = angle_of(a, b, self.q(entry));
+        let entry_off = Ties::ALL.map(|t| self.off_diagonal_edges_under(t, entry));
+        let mut ranks = [0usize; 3];
+        for c in list.iter().map(|&c| c as usize).filter(|&c| c != entry) {
+            let order = match (self.real[c], self.real[entry]) {
+                (true, false) => core::cmp::Ordering::Less,
+                (false, true) => core::cmp::Ordering::Greater,
+                (false, false) => c.cmp(&entry),
+                (true, true) => wider(angle_of(a, b, self.q(c)), seen),
+            };
+            match order {
+                core::cmp::Ordering::Less => ranks.iter_mut().for_each(|r| *r += 1),
+                core::cmp::Ordering::Greater => {}
+                // Real entries on one circle: the rule's diagonal edges,
+                // then the ring position (`before_seen`).
+                core::cmp::Ordering::Equal => {
+                    for (t, rank) in Ties::ALL.into_iter().zip(&mut ranks) {
+                        let off = self.off_diagonal_edges_under(t, c);
+                        *rank += usize::from((off, c) < (entry_off[t as usize], entry));
+                    }
+                }
+            }
+        }
+        Some(ranks)
     }
 }
 

@@ -173,24 +173,11 @@ impl PositionsFirstCoding {
         let rank = self.pf.rank_of(n)?;
         // The lists do not depend on the tie rule, only their order.
         let xs = self.pf.order_xs(s.eligible, &edge);
-        // Under the rules still written (`u`, `v`: by `Ties::ALL` index).
-        let kept = self.kept;
-        let rules = || {
-            Ties::ALL
-                .into_iter()
-                .filter(move |&t| kept.is_none_or(|k| k == t))
-        };
-        let mut u = [0; 3];
-        for ties in rules() {
-            self.pf.set_ties(ties);
-            u[ties as usize] = self.pf.rank_of_choice(xs, pair.0)?;
-        }
+        // Under every rule at once (`u`, `v`: by `Ties::ALL` index); only
+        // the rules still written are read.
+        let u = self.pf.ranks_of_choice(xs, pair.0)?;
         let ys = self.pf.order_ys(&edge, pair.0);
-        let mut v = [0; 3];
-        for ties in rules() {
-            self.pf.set_ties(ties);
-            v[ties as usize] = self.pf.rank_of_choice(ys, pair.1)?;
-        }
+        let v = self.pf.ranks_of_choice(ys, pair.1)?;
         // z: the fan's surface at the new x and y, or 0 where no wedge
         // holds it.
         let target = Target::of_code(s.code)?;
