@@ -14,6 +14,8 @@
 //! bounding box (1,024 lattice points) keeps coordinates below 2^10, so
 //! 64-bit arithmetic is exact throughout (SPEC §7.4 "Bounds").
 
+use core::cmp::Ordering;
+
 use crate::limits::{MAX_SPLIT_VALENCE, NONE};
 use crate::ring::Ring;
 use crate::symbols::WingCandidates;
@@ -201,7 +203,7 @@ fn angle_of(e: [i64; 2], f: [i64; 2], q: [i64; 2]) -> [i64; 2] {
 /// `Less` when angle `p` (of [`angle_of`]) is wider than angle `c`,
 /// `Equal` when they are the same (the four points on one circle).
 #[inline]
-fn wider(p: [i64; 2], c: [i64; 2]) -> core::cmp::Ordering {
+fn wider(p: [i64; 2], c: [i64; 2]) -> Ordering {
     (p[0] * c[1]).cmp(&(c[0] * p[1]))
 }
 
@@ -1045,28 +1047,39 @@ impl PositionsFirst {
     /// [`Self::before`] with the angles of `u` and `w` given.
     #[inline]
     fn before_seen(&self, u: usize, angle_u: [i64; 2], w: usize, angle_w: [i64; 2]) -> bool {
-        match (self.real[u], self.real[w]) {
-            (true, false) => true,
-            (false, true) => false,
-            (false, false) => u < w,
-            (true, true) => wider(angle_u, angle_w)
-                .then_with(|| self.off_diagonal_edges(u).cmp(&self.off_diagonal_edges(w)))
-                .then(u.cmp(&w))
-                .is_lt(),
+        match self.seen_order(u, angle_u, w, angle_w) {
+            Ordering::Equal => self.tie_before(self.ties, u, w),
+            order => order.is_lt(),
         }
     }
 
-    /// How many of the new edges from the list's edge ends to real entry
-    /// `i` run along the diagonal the level's ties disfavour (SPEC §7.4
-    /// `off(i)`; always 0 under `ring`).
+    /// `before` of SPEC §7.4 up to the tie rule: the ghost last, real
+    /// entries widest angle first, two ghosts by ring position; `Equal`
+    /// for real entries seen under the same angle, which
+    /// [`Self::tie_before`] orders.
     #[inline]
-    fn off_diagonal_edges(&self, i: usize) -> u8 {
-        self.off_diagonal_edges_under(self.ties, i)
+    fn seen_order(&self, u: usize, angle_u: [i64; 2], w: usize, angle_w: [i64; 2]) -> Ordering {
+        match (self.real[u], self.real[w]) {
+            (true, false) => Ordering::Less,
+            (false, true) => Ordering::Greater,
+            (false, false) => u.cmp(&w),
+            (true, true) => wider(angle_u, angle_w),
+        }
     }
 
-    /// [`Self::off_diagonal_edges`] under the tie rule `ties`.
+    /// Whether real entry `u` comes before real entry `w` seen under the
+    /// same angle, under the tie rule `ties`: fewer new edges along the
+    /// disfavoured diagonal first, then by ring position.
     #[inline]
-    fn off_diagonal_edges_under(&self, ties: Ties, i: usize) -> u8 {
+    fn tie_before(&self, ties: Ties, u: usize, w: usize) -> bool {
+        (self.off_diagonal_edges(ties, u), u) < (self.off_diagonal_edges(ties, w), w)
+    }
+
+    /// How many of the new edges from the list's edge ends to real entry
+    /// `i` run along the diagonal the tie rule `ties` disfavours (SPEC
+    /// §7.4 `off(i)`; always 0 under `ring`).
+    #[inline]
+    fn off_diagonal_edges(&self, ties: Ties, i: usize) -> u8 {
         let q = self.q(i);
         self.list_edge
             .iter()
@@ -1186,27 +1199,18 @@ impl PositionsFirst {
         if !list.iter().any(|&c| c as usize == entry) {
             return None;
         }
-        // Entry's angle and diagonal edges once, not once per comparison.
+        // Entry's angle once, not once per comparison.
         let [a, b] = self.list_edge;
         let seen = angle_of(a, b, self.q(entry));
-        let entry_off = Ties::ALL.map(|t| self.off_diagonal_edges_under(t, entry));
         let mut ranks = [0usize; 3];
         for c in list.iter().map(|&c| c as usize).filter(|&c| c != entry) {
-            let order = match (self.real[c], self.real[entry]) {
-                (true, false) => core::cmp::Ordering::Less,
-                (false, true) => core::cmp::Ordering::Greater,
-                (false, false) => c.cmp(&entry),
-                (true, true) => wider(angle_of(a, b, self.q(c)), seen),
-            };
-            match order {
-                core::cmp::Ordering::Less => ranks.iter_mut().for_each(|r| *r += 1),
-                core::cmp::Ordering::Greater => {}
-                // Real entries on one circle: the rule's diagonal edges,
-                // then the ring position (`before_seen`).
-                core::cmp::Ordering::Equal => {
+            match self.seen_order(c, angle_of(a, b, self.q(c)), entry, seen) {
+                Ordering::Less => ranks.iter_mut().for_each(|r| *r += 1),
+                Ordering::Greater => {}
+                // Seen under the same angle: the rules differ here only.
+                Ordering::Equal => {
                     for (t, rank) in Ties::ALL.into_iter().zip(&mut ranks) {
-                        let off = self.off_diagonal_edges_under(t, c);
-                        *rank += usize::from((off, c) < (entry_off[t as usize], entry));
+                        *rank += usize::from(self.tie_before(t, c, entry));
                     }
                 }
             }
@@ -1234,9 +1238,9 @@ fn select_nth(keys: &mut [u64], j: usize) -> u64 {
         }
         keys.swap(store, hi - 1);
         match j.cmp(&store) {
-            core::cmp::Ordering::Equal => return keys[store],
-            core::cmp::Ordering::Less => hi = store,
-            core::cmp::Ordering::Greater => lo = store + 1,
+            Ordering::Equal => return keys[store],
+            Ordering::Less => hi = store,
+            Ordering::Greater => lo = store + 1,
         }
     }
     keys[lo]
