@@ -79,6 +79,26 @@ pub(super) fn rans_vectors(s: &mut Specs) {
         },
     );
     s.invalid(
+        "rans-adaptive-too-many-states-unused",
+        "malformed",
+        "In a stream of 4 lanes, the wing-offset chunk's table of context 7, which no value reads, is adaptive with 16 tokens (table byte 0x8F, in place of its 0): 60 probabilities, above the 48 a table holds (SPEC §5.5.2, 3.9). Nothing else is wrong, so only the bound fails it (chunk CRC fixed).",
+        &["rans", "rans-adaptive", "handmade"],
+        {
+            let mut b = handmade::tetra_stream(ChunkCodec::RansAlways { lanes: 4 });
+            // Level 1's second chunk: wing-offset (substream id 2), 8
+            // contexts by the eligible entries; the tetrahedron's ring has
+            // 3, so context 7 (9 or more) is never read.
+            assert_eq!(b[chunk_entry_at(&b, 1, 1)], 2, "the wing-offset chunk");
+            assert_eq!(chunk_codec(&b, 1, 1), codec::RANS);
+            let layout = rans_layout(&b, chunk_payload(&b, 1, 1), 8, 4);
+            let table = layout.token_counts[7];
+            assert_eq!(b[table], 0, "context 7's table is unused");
+            b[table] = 0x8F;
+            fix_chunk_crc(&mut b, 1, 1);
+            b
+        },
+    );
+    s.invalid(
         "rans-adaptive-table-too-short",
         "malformed",
         "The flags table of the one-lane stream is the adaptive table byte 0x81 of handmade-tetra-split-rans-adaptive followed by nothing: the lane directory is missing (SPEC §5.5.2, §5.5.3; chunk payload replaced, its length and every CRC fixed).",
