@@ -519,8 +519,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
     /// Zigzag-decoded signed varint (SPEC §5.4).
     #[inline(always)]
     pub fn signed(&mut self, slot: usize, context: u8) -> Result<i32, Error> {
-        let u = self.varint(slot, context)?;
-        Ok(((u >> 1) as i32) ^ -((u & 1) as i32))
+        Ok(zigzag(self.varint(slot, context)?))
     }
 
     /// Checks that every substream was read to its end and that the padding
@@ -535,6 +534,13 @@ impl<'l, 'b> Substreams<'l, 'b> {
         }
         Ok(())
     }
+}
+
+/// The signed value of zigzag code `u` (SPEC §5.4): 0, -1, 1, -2, … for
+/// 0, 1, 2, 3, …
+#[inline(always)]
+pub fn zigzag(u: u32) -> i32 {
+    ((u >> 1) as i32) ^ -((u & 1) as i32)
 }
 
 /// Loads a rANS chunk of `values` values whose `stored_len` payload bytes
