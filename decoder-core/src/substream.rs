@@ -247,7 +247,16 @@ impl<'l, 'b> Substreams<'l, 'b> {
     }
 
     /// Next value of the rANS-coded substream in `slot`, in `context` (SPEC §5.5).
-    #[inline(always)]
+    ///
+    /// Inlined into every reader on the host, where the records' reads are
+    /// the hot path. On 32-bit Arm one out-of-line copy: its eight inlined
+    /// copies (the two wing ranks, the two split valences, the placement
+    /// code, the residual vectors' signed values and the out-of-line byte
+    /// and varint readers, each with the whole decode of a value) were
+    /// about 4.3 KB of a thumbv7em decoder's `.text`, for a call and
+    /// return per value.
+    #[cfg_attr(not(target_arch = "arm"), inline(always))]
+    #[cfg_attr(target_arch = "arm", inline(never))]
     fn rans_value(&mut self, slot: usize, context: u8) -> Result<u32, Error> {
         self.rans_value_as(slot, context, false)
     }
