@@ -662,13 +662,23 @@ pub fn placement_context(means: &ArcMeans) -> u8 {
         let q = means.count * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
         (t as i128, q as i128)
     } else {
-        let a = a.map(|x| x as i128);
-        let g = g.map(|x| x as i128);
-        let t = -(g[0] * a[0] + g[1] * a[1] + g[2] * a[2]);
-        let q = means.count as i128 * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        let t = -(mul_wide(g[0], a[0]) + mul_wide(g[1], a[1]) + mul_wide(g[2], a[2]));
+        let q = means.count as i128
+            * (mul_wide(a[0], a[0]) + mul_wide(a[1], a[1]) + mul_wide(a[2], a[2]));
         (t, q)
     };
     bucket(t, q)
+}
+
+/// `a · b` in 128 bits, for [`placement_context`]'s wide path (SPEC
+/// §5.5.5). Inlined on the host; on 32-bit Arm one out-of-line copy: each
+/// inlined 128-bit product was a long run of 32-bit multiplies (the six
+/// took 232 bytes more of a thumbv7em decoder's `.text`), on a path only
+/// grids of over 23 bits take.
+#[cfg_attr(not(target_arch = "arm"), inline(always))]
+#[cfg_attr(target_arch = "arm", inline(never))]
+fn mul_wide(a: i64, b: i64) -> i128 {
+    a as i128 * b as i128
 }
 
 /// The placement context of `T` against `Q` (SPEC §5.5.5).
