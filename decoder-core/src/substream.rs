@@ -548,7 +548,7 @@ impl<'l, 'b> Substreams<'l, 'b> {
 /// The signed value of zigzag code `u` (SPEC §5.4): 0, -1, 1, -2, … for
 /// 0, 1, 2, 3, …
 #[inline(always)]
-pub fn zigzag(u: u32) -> i32 {
+pub(crate) fn zigzag(u: u32) -> i32 {
     ((u >> 1) as i32) ^ -((u & 1) as i32)
 }
 
