@@ -428,8 +428,37 @@ fn round_div_wide(p: i128, q: i128) -> i128 {
     // the 128-bit one is a library call.
     match (i64::try_from(x), i64::try_from(d)) {
         (Ok(x), Ok(d)) => x.div_euclid(d) as i128,
+        #[cfg(not(target_arch = "arm"))]
         _ => x.div_euclid(d),
+        // 32-bit Arm has no 128-bit division routine: LLVM expands
+        // `div_euclid` inline (about 1 KB of thumbv7em `.text`); the
+        // shift-and-subtract loop is the same floor division in 720 bytes
+        // less. The host keeps the library call (`__divti3`).
+        #[cfg(target_arch = "arm")]
+        _ => floor_div_positive(x, d),
     }
+}
+
+/// `floor(x / d)` for `d > 0` (so `x.div_euclid(d)`), by shift and
+/// subtract: the 128-bit division of [`round_div_wide`] on 32-bit Arm.
+/// For `x < 0`, `floor(x / d) = !((!x) / d)` (`!y = -y - 1`).
+#[cfg(any(target_arch = "arm", test))]
+fn floor_div_positive(x: i128, d: i128) -> i128 {
+    let negative = x < 0;
+    let n = if negative { !x } else { x } as u128;
+    let d = d as u128;
+    let (mut q, mut r) = (0u128, 0u128);
+    for i in (0..u128::BITS - n.leading_zeros()).rev() {
+        // `r < d`, so a bit shifted out of `r` means `r > d`.
+        let carry = r >> 127 != 0;
+        r = (r << 1) | ((n >> i) & 1);
+        q <<= 1;
+        if carry || r >= d {
+            r = r.wrapping_sub(d);
+            q |= 1;
+        }
+    }
+    if negative { !(q as i128) } else { q as i128 }
 }
 
 /// The plane prediction of one split (SPEC §7.4): the shifted normal and
@@ -633,13 +662,23 @@ pub fn placement_context(means: &ArcMeans) -> u8 {
         let q = means.count * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
         (t as i128, q as i128)
     } else {
-        let a = a.map(|x| x as i128);
-        let g = g.map(|x| x as i128);
-        let t = -(g[0] * a[0] + g[1] * a[1] + g[2] * a[2]);
-        let q = means.count as i128 * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        let t = -(mul_wide(g[0], a[0]) + mul_wide(g[1], a[1]) + mul_wide(g[2], a[2]));
+        let q = means.count as i128
+            * (mul_wide(a[0], a[0]) + mul_wide(a[1], a[1]) + mul_wide(a[2], a[2]));
         (t, q)
     };
     bucket(t, q)
+}
+
+/// `a · b` in 128 bits, for [`placement_context`]'s wide path (SPEC
+/// §5.5.5). Inlined on the host; on 32-bit Arm one out-of-line copy: each
+/// inlined 128-bit product was a long run of 32-bit multiplies (the six
+/// took 232 bytes more of a thumbv7em decoder's `.text`), on a path only
+/// grids of over 23 bits take.
+#[cfg_attr(not(target_arch = "arm"), inline(always))]
+#[cfg_attr(target_arch = "arm", inline(never))]
+fn mul_wide(a: i64, b: i64) -> i128 {
+    a as i128 * b as i128
 }
 
 /// The placement context of `T` against `Q` (SPEC §5.5.5).
@@ -844,6 +883,43 @@ mod tests {
             round_div_wide(-(1i128 << 96) + 1, (1i128 << 63) - 1),
             -(1 << 33)
         );
+    }
+
+    /// The shift-and-subtract division used on 32-bit Arm is `div_euclid`
+    /// for positive divisors, small and wide.
+    #[test]
+    fn floor_division_by_shifts_is_div_euclid() {
+        let values = [
+            0i128,
+            1,
+            2,
+            3,
+            7,
+            (1 << 40) + 5,
+            (1 << 63) - 1,
+            1 << 64,
+            (1 << 95) + (1 << 40),
+            (1 << 126) - 3,
+            i128::MAX,
+        ];
+        for &x in &values {
+            for &d in &values[1..] {
+                for x in [x, -x, !x] {
+                    assert_eq!(floor_div_positive(x, d), x.div_euclid(d), "{x} {d}");
+                }
+            }
+        }
+        let mut seed = 7u128;
+        for _ in 0..2000 {
+            seed = seed
+                .wrapping_mul(0x2360_ED05_1FC6_5DA4_4385_DF64_9FCC_F645)
+                .wrapping_add(1);
+            let x = (seed >> (seed as u32 & 63)) as i128 - (1 << 62);
+            let d = ((seed >> 64) as u64 >> ((seed >> 58) as u32 & 63)).max(1) as i128;
+            assert_eq!(floor_div_positive(x, d), x.div_euclid(d), "{x} {d}");
+            let x = (seed as i128) >> 2;
+            assert_eq!(floor_div_positive(x, d), x.div_euclid(d), "{x} {d}");
+        }
     }
 
     #[test]
