@@ -8,6 +8,7 @@ use core::ops::Range;
 
 use crate::bytes::crc32;
 use crate::context::{self, DeficitContexts};
+use crate::deflate_trial::deflate_instead;
 use crate::header::{Framing, Header, PositionMode, Schedule};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_header::ChunkEntry;
@@ -641,20 +642,6 @@ pub fn frame_level_with(
     }
 }
 
-/// Under the rANS codec a substream is deflated at level 10 too, and the
-/// smaller kept; the level-10 trial is skipped when a level-1 deflate is at
-/// least this ratio (3/2) of the rANS size. Measured on 2026-12-04 over the
-/// real meshes, the DEM and the 1M demo terrain (encoder/BENCHMARKS.md,
-/// "Serial work off the critical path"): level 10 was at most 1.34 times
-/// smaller than level 1, and it beat
-/// rANS only where level 1 came within 1.07 of the rANS size (the seed's
-/// substreams, incompressible flags). At 5/3 the trial still ran on the
-/// last level's largest substreams, after its replay, on the emission's
-/// critical path. Were level 10 ever 1.62 times smaller than level 1 (the
-/// largest gain seen on earlier formats), a skipped trial would cost at most
-/// 8 % of that substream's bytes; the stream stays valid either way.
-const DEFLATE_QUICK_RATIO: (usize, usize) = (3, 2);
-
 /// The chunks of a substream as `frame_level` codes them, in a level whose
 /// rANS chunks have `contexts` tables for it (`context::count`): byte-codec
 /// chunks of at most `params.chunk_limit` bytes, rANS chunks of at most
@@ -683,34 +670,14 @@ fn substream_chunks(
         ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None, map),
         ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l), map),
         ChunkCodec::Rans { lanes } => {
-            let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
             let rans = rans_in(lanes);
-            let rans_size = size(&rans);
-            rans_or_deflate((rans, rans_size), |level| {
-                let deflate = byte_chunks(sub.as_bytes(), limit, Some(level), map);
-                let deflate_size = size(&deflate);
-                (deflate, deflate_size)
-            })
+            let rans_size = rans.iter().map(Chunk::stored_len).sum();
+            match deflate_instead(sub.as_bytes(), limit, rans_size) {
+                Some((deflate, _)) => deflate,
+                None => rans,
+            }
         }
         ChunkCodec::RansAlways { lanes } => rans_in(lanes),
-    }
-}
-
-/// The rANS codec's choice (SPEC §5.2: any codec per chunk): `rans`, or
-/// `deflate_at(10)` where that is smaller, each with its payload bytes.
-/// Level 10 is slow (up to 1,500 match probes per byte); a quick level-1
-/// pass first rules it out where it cannot win ([`DEFLATE_QUICK_RATIO`]).
-/// [`substream_chunks`] chooses chunks so, [`coded_len_under`] lengths.
-fn rans_or_deflate<T>(rans: (T, usize), mut deflate_at: impl FnMut(u8) -> (T, usize)) -> T {
-    let quick = deflate_at(1);
-    if quick.1 * DEFLATE_QUICK_RATIO.1 >= rans.1 * DEFLATE_QUICK_RATIO.0 {
-        return rans.0;
-    }
-    let deflate = deflate_at(10);
-    if rans.1 < deflate.1 {
-        rans.0
-    } else {
-        deflate.0
     }
 }
 
@@ -776,10 +743,11 @@ pub fn coded_len_under(
         ChunkCodec::RansAlways { .. } => rans.expect("costed above"),
         ChunkCodec::Rans { .. } => {
             let rans = rans.expect("costed above");
-            rans_or_deflate((rans, rans.0), |level| {
-                let deflate = byte_codec(Some(level));
-                (deflate, deflate.0)
-            })
+            let limit = params.chunk_limit.max(1) as usize;
+            match deflate_instead(sub.as_bytes(), limit, rans.0) {
+                Some((deflate, payloads)) => (payloads, deflate.len()),
+                None => rans,
+            }
         }
     })
 }
@@ -868,6 +836,13 @@ pub struct Chunk {
     adaptive: bool,
 }
 
+impl Chunk {
+    /// Its payload bytes.
+    pub(crate) fn stored_len(&self) -> usize {
+        self.stored.len()
+    }
+}
+
 /// Byte-codec chunks of at most `limit` raw bytes; deflated at `level` where
 /// that is smaller than storing.
 fn byte_chunks(bytes: &[u8], limit: usize, level: Option<u8>, map: ChunkMap<'_>) -> Vec<Chunk> {
@@ -877,7 +852,7 @@ fn byte_chunks(bytes: &[u8], limit: usize, level: Option<u8>, map: ChunkMap<'_>)
 }
 
 /// Chunk `i` of [`byte_chunks`].
-fn byte_chunk(bytes: &[u8], limit: usize, level: Option<u8>, i: usize) -> Chunk {
+pub(crate) fn byte_chunk(bytes: &[u8], limit: usize, level: Option<u8>, i: usize) -> Chunk {
     let raw = &bytes[i * limit..bytes.len().min((i + 1) * limit)];
     let packed = level.map(|l| miniz_oxide::deflate::compress_to_vec(raw, l));
     match packed {
