@@ -28,45 +28,82 @@ use crate::writer::{Chunk, byte_chunk};
 /// critical path. Were level 10 ever 1.62 times smaller than level 1 (the
 /// largest gain seen on earlier formats), a skipped trial would cost at most
 /// 8 % of that substream's bytes; the stream stays valid either way.
-pub(crate) const DEFLATE_QUICK_RATIO: (usize, usize) = (3, 2);
+const DEFLATE_QUICK_RATIO: (usize, usize) = (3, 2);
 
-/// The level-10 deflate chunks of `bytes` (chunks of at most `limit` raw
-/// bytes, as `byte_chunks` cuts them) and their payload bytes, where the
-/// rANS codec writes the substream with them instead of its rANS chunks of
-/// `rans` payload bytes; `None` where it writes rANS.
-pub(crate) fn deflate_instead(
-    bytes: &[u8],
+/// The chunks a deflate trial of a substream coded, at level 1 and at level
+/// 10, as many as it needed: kept with the substream
+/// (`writer::SubstreamWriter`), so that a substream costed and then framed,
+/// or two substreams of the same bytes (a level's flags under either choice
+/// of contexts), take them instead of coding them again. Chunks are coded
+/// the same whatever the rANS size they are weighed against; a later trial
+/// codes only the chunks it needs beyond them.
+#[derive(Clone, Debug)]
+pub(crate) struct DeflateTrial {
+    /// The substream's value count when its chunks were coded (values are
+    /// only appended: the same count, the same bytes), and their limit.
+    values: usize,
     limit: usize,
-    rans: usize,
-) -> Option<(Vec<Chunk>, usize)> {
-    let quick_loses = |quick: usize| quick * DEFLATE_QUICK_RATIO.1 >= rans * DEFLATE_QUICK_RATIO.0;
-    deflate_until(bytes, limit, 1, quick_loses)?;
-    // rANS is kept only where it is strictly smaller: a tie goes to deflate.
-    deflate_until(bytes, limit, 10, |deflate| rans < deflate)
+    /// The first chunks at level 1 and at level 10.
+    coded: [Vec<Chunk>; 2],
 }
 
-/// The chunks of `bytes` deflated at `level` and their payload bytes, coded
-/// one after the other; `None` as soon as the payloads so far make `loses`
-/// true (it must stay true as the sum grows), or where the whole sum does.
+impl DeflateTrial {
+    /// A trial of a substream of `values` values in chunks of at most
+    /// `limit` raw bytes, with no chunk coded yet.
+    pub(crate) fn new(values: usize, limit: usize) -> DeflateTrial {
+        DeflateTrial {
+            values,
+            limit,
+            coded: [Vec::new(), Vec::new()],
+        }
+    }
+
+    /// Whether its chunks are those of a substream of `values` values in
+    /// chunks of at most `limit` raw bytes.
+    pub(crate) fn holds(&self, values: usize, limit: usize) -> bool {
+        (self.values, self.limit) == (values, limit)
+    }
+
+    /// The level-10 deflate chunks of `bytes` (the substream's, as
+    /// `byte_chunks` cuts them), where the rANS codec writes the substream
+    /// with them instead of its rANS chunks of `rans` payload bytes; `None`
+    /// where it writes rANS.
+    pub(crate) fn deflate_instead(&mut self, bytes: &[u8], rans: usize) -> Option<&[Chunk]> {
+        let quick_loses =
+            |quick: usize| quick * DEFLATE_QUICK_RATIO.1 >= rans * DEFLATE_QUICK_RATIO.0;
+        let [quick, deep] = &mut self.coded;
+        deflate_until(bytes, self.limit, 1, quick, quick_loses)?;
+        // rANS is kept only where it is strictly smaller: a tie goes to
+        // deflate.
+        deflate_until(bytes, self.limit, 10, deep, |deflate| rans < deflate)?;
+        Some(deep)
+    }
+}
+
+/// Codes the chunks of `bytes` deflated at `level` after those `chunks`
+/// holds already, one after the other, into `chunks`, and returns their
+/// payload bytes; `None` as soon as the payloads so far make `loses` true
+/// (it must stay true as the sum grows), or where the whole sum does.
 fn deflate_until(
     bytes: &[u8],
     limit: usize,
     level: u8,
+    chunks: &mut Vec<Chunk>,
     loses: impl Fn(usize) -> bool,
-) -> Option<(Vec<Chunk>, usize)> {
+) -> Option<usize> {
     let count = bytes.len().div_ceil(limit);
-    let mut chunks = Vec::with_capacity(count);
     let mut payloads = 0;
     for i in 0..count {
-        let chunk = byte_chunk(bytes, limit, Some(level), i);
-        payloads += chunk.stored_len();
+        if i == chunks.len() {
+            chunks.push(byte_chunk(bytes, limit, Some(level), i));
+        }
+        payloads += chunks[i].stored_len();
         if loses(payloads) {
             return None;
         }
-        chunks.push(chunk);
     }
     // No chunk at all: the empty sum is weighed too.
-    (!loses(payloads)).then_some((chunks, payloads))
+    (!loses(payloads)).then_some(payloads)
 }
 
 #[cfg(test)]
@@ -80,7 +117,8 @@ mod tests {
         /// The trial stopped early takes the choice of the whole passes:
         /// rANS where a level-1 deflate is at least 3/2 of its size or
         /// level 10 is larger, else level 10's chunks (ties included, with
-        /// `rans` on and around the passes' own sizes).
+        /// `rans` on and around the passes' own sizes); so does a trial
+        /// that continues one kept from another rANS size.
         #[test]
         fn stopping_early_changes_no_choice(
             values in proptest::collection::vec(0u8..255, 0..3000),
@@ -97,6 +135,7 @@ mod tests {
                 (chunks, payloads)
             };
             let (quick, deep) = (whole(1).1, whole(10));
+            let deep_payloads = deep.1;
             let rans = match rans_at {
                 0 => deep.1,
                 1 => deep.1.saturating_sub(1),
@@ -109,14 +148,18 @@ mod tests {
             } else {
                 Some(deep)
             };
-            let got = deflate_instead(&bytes, limit, rans);
-            let key = |c: &Option<(Vec<Chunk>, usize)>| {
-                c.as_ref().map(|(chunks, payloads)| {
-                    let stored: Vec<usize> = chunks.iter().map(Chunk::stored_len).collect();
-                    (stored, *payloads)
-                })
-            };
-            prop_assert_eq!(key(&got), key(&expected));
+            let stored = |c: &[Chunk]| c.iter().map(Chunk::stored_len).collect::<Vec<_>>();
+            let expected = expected.map(|(chunks, _)| stored(&chunks));
+            let mut fresh = DeflateTrial::new(0, limit);
+            let got = fresh.deflate_instead(&bytes, rans).map(stored);
+            prop_assert_eq!(&got, &expected);
+            // A trial kept from one weighed against another rANS size (more
+            // or fewer chunks coded) answers the same.
+            for other in [0, quick / 2, quick, deep_payloads, usize::MAX / 4] {
+                let mut kept = DeflateTrial::new(0, limit);
+                kept.deflate_instead(&bytes, other);
+                prop_assert_eq!(&kept.deflate_instead(&bytes, rans).map(stored), &expected);
+            }
         }
     }
 }

@@ -8,7 +8,7 @@ use core::ops::Range;
 
 use crate::bytes::crc32;
 use crate::context::{self, DeficitContexts};
-use crate::deflate_trial::deflate_instead;
+use crate::deflate_trial::DeflateTrial;
 use crate::header::{Framing, Header, PositionMode, Schedule};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_header::ChunkEntry;
@@ -38,6 +38,9 @@ pub struct SubstreamWriter {
     symbols: Vec<Symbol>,
     /// What costing its rANS chunks last found ([`coded_len_under`]).
     plan: Option<Box<RansPlan>>,
+    /// The chunks the rANS codec's deflate trial coded in costing
+    /// ([`coded_len_under`]), for framing or costing it again.
+    trial: Option<Box<DeflateTrial>>,
 }
 
 /// Two substreams are equal when they hold the same values: a plan is
@@ -83,6 +86,7 @@ impl SubstreamWriter {
             bit_count: 0,
             symbols: Vec::with_capacity(values),
             plan: None,
+            trial: None,
         }
     }
 
@@ -156,6 +160,45 @@ impl SubstreamWriter {
 
     pub fn is_empty(&self) -> bool {
         self.bytes.is_empty() && self.symbols.is_empty()
+    }
+
+    /// Takes the deflate trial `other` kept (the chunks coded to weigh
+    /// deflate against rANS, [`coded_len_under`]) where `other` holds the
+    /// same bytes: a level's flags are written under two choices of
+    /// contexts, in the same bits.
+    pub fn share_deflate_trial(&mut self, other: &SubstreamWriter) {
+        let same = self.symbols.len() == other.symbols.len() && self.bytes == other.bytes;
+        if let Some(trial) = other.trial.as_deref().filter(|_| same) {
+            self.trial = Some(Box::new(trial.clone()));
+        }
+    }
+
+    /// Its deflate trial in chunks of at most `limit` raw bytes: the one
+    /// costing kept where it holds for its values as they are now, or a
+    /// fresh one.
+    fn trial_for(&self, limit: usize) -> DeflateTrial {
+        let values = self.symbols.len();
+        match self.trial.as_deref() {
+            Some(trial) if trial.holds(values, limit) => trial.clone(),
+            _ => DeflateTrial::new(values, limit),
+        }
+    }
+
+    /// The level-10 deflate chunks (of at most `limit` raw bytes) that the
+    /// rANS codec writes instead of its rANS chunks of `rans` payload bytes,
+    /// if it does ([`DeflateTrial::deflate_instead`]); the chunks coded to
+    /// find out are kept with it.
+    fn deflate_instead(&mut self, limit: usize, rans: usize) -> Option<&[Chunk]> {
+        let values = self.symbols.len();
+        if !self
+            .trial
+            .as_deref()
+            .is_some_and(|t| t.holds(values, limit))
+        {
+            self.trial = Some(Box::new(DeflateTrial::new(values, limit)));
+        }
+        let trial = self.trial.as_deref_mut().expect("kept above");
+        trial.deflate_instead(&self.bytes, rans)
     }
 
     /// The plan of its rANS chunks in `contexts` tables, `lanes` lanes and
@@ -672,8 +715,11 @@ fn substream_chunks(
         ChunkCodec::Rans { lanes } => {
             let rans = rans_in(lanes);
             let rans_size = rans.iter().map(Chunk::stored_len).sum();
-            match deflate_instead(sub.as_bytes(), limit, rans_size) {
-                Some((deflate, _)) => deflate,
+            match sub
+                .trial_for(limit)
+                .deflate_instead(sub.as_bytes(), rans_size)
+            {
+                Some(deflate) => deflate.to_vec(),
                 None => rans,
             }
         }
@@ -725,7 +771,7 @@ pub fn coded_len_under(
         ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } => Some(rans_len(lanes)),
         ChunkCodec::Stored | ChunkCodec::Deflate(_) => None,
     };
-    let byte_codec = |level: Option<u8>| {
+    let byte_codec = |sub: &SubstreamWriter, level: Option<u8>| {
         let chunks = byte_chunks(
             sub.as_bytes(),
             params.chunk_limit.max(1) as usize,
@@ -738,14 +784,14 @@ pub fn coded_len_under(
         )
     };
     framed(match params.codec {
-        ChunkCodec::Stored => byte_codec(None),
-        ChunkCodec::Deflate(l) => byte_codec(Some(l)),
+        ChunkCodec::Stored => byte_codec(sub, None),
+        ChunkCodec::Deflate(l) => byte_codec(sub, Some(l)),
         ChunkCodec::RansAlways { .. } => rans.expect("costed above"),
         ChunkCodec::Rans { .. } => {
             let rans = rans.expect("costed above");
             let limit = params.chunk_limit.max(1) as usize;
-            match deflate_instead(sub.as_bytes(), limit, rans.0) {
-                Some((deflate, payloads)) => (payloads, deflate.len()),
+            match sub.deflate_instead(limit, rans.0) {
+                Some(deflate) => (deflate.iter().map(Chunk::stored_len).sum(), deflate.len()),
                 None => rans,
             }
         }
@@ -828,6 +874,7 @@ fn single_chunk(sub: &SubstreamWriter, i: usize, params: &StreamParams) -> Chunk
 }
 
 /// One coded chunk before framing.
+#[derive(Clone, Debug)]
 pub struct Chunk {
     codec: u8,
     raw_len: u32,
