@@ -27,6 +27,8 @@ mod bytes;
 pub mod context;
 pub mod corner_refs;
 mod decoder;
+#[cfg(feature = "alloc")]
+mod deflate_trial;
 mod error;
 #[cfg(feature = "alloc")]
 pub mod handmade;

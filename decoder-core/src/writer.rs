@@ -8,6 +8,7 @@ use core::ops::Range;
 
 use crate::bytes::crc32;
 use crate::context::{self, DeficitContexts};
+use crate::deflate_trial::DeflateTrial;
 use crate::header::{Framing, Header, PositionMode, Schedule};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_header::ChunkEntry;
@@ -37,6 +38,9 @@ pub struct SubstreamWriter {
     symbols: Vec<Symbol>,
     /// What costing its rANS chunks last found ([`coded_len_under`]).
     plan: Option<Box<RansPlan>>,
+    /// The chunks the rANS codec's deflate trial coded in costing
+    /// ([`coded_len_under`]), for framing or costing it again.
+    trial: Option<Box<DeflateTrial>>,
 }
 
 /// Two substreams are equal when they hold the same values: a plan is
@@ -82,6 +86,7 @@ impl SubstreamWriter {
             bit_count: 0,
             symbols: Vec::with_capacity(values),
             plan: None,
+            trial: None,
         }
     }
 
@@ -155,6 +160,45 @@ impl SubstreamWriter {
 
     pub fn is_empty(&self) -> bool {
         self.bytes.is_empty() && self.symbols.is_empty()
+    }
+
+    /// Takes the deflate trial `other` kept (the chunks coded to weigh
+    /// deflate against rANS, [`coded_len_under`]) where `other` holds the
+    /// same bytes: a level's flags are written under two choices of
+    /// contexts, in the same bits.
+    pub fn share_deflate_trial(&mut self, other: &SubstreamWriter) {
+        let same = self.symbols.len() == other.symbols.len() && self.bytes == other.bytes;
+        if let Some(trial) = other.trial.as_deref().filter(|_| same) {
+            self.trial = Some(Box::new(trial.clone()));
+        }
+    }
+
+    /// Its deflate trial in chunks of at most `limit` raw bytes: the one
+    /// costing kept where it holds for its values as they are now, or a
+    /// fresh one.
+    fn trial_for(&self, limit: usize) -> DeflateTrial {
+        let values = self.symbols.len();
+        match self.trial.as_deref() {
+            Some(trial) if trial.holds(values, limit) => trial.clone(),
+            _ => DeflateTrial::new(values, limit),
+        }
+    }
+
+    /// The level-10 deflate chunks (of at most `limit` raw bytes) that the
+    /// rANS codec writes instead of its rANS chunks of `rans` payload bytes,
+    /// if it does ([`DeflateTrial::deflate_instead`]); the chunks coded to
+    /// find out are kept with it.
+    fn deflate_instead(&mut self, limit: usize, rans: usize) -> Option<&[Chunk]> {
+        let values = self.symbols.len();
+        if !self
+            .trial
+            .as_deref()
+            .is_some_and(|t| t.holds(values, limit))
+        {
+            self.trial = Some(Box::new(DeflateTrial::new(values, limit)));
+        }
+        let trial = self.trial.as_deref_mut().expect("kept above");
+        trial.deflate_instead(&self.bytes, rans)
     }
 
     /// The plan of its rANS chunks in `contexts` tables, `lanes` lanes and
@@ -641,20 +685,6 @@ pub fn frame_level_with(
     }
 }
 
-/// Under the rANS codec a substream is deflated at level 10 too, and the
-/// smaller kept; the level-10 trial is skipped when a level-1 deflate is at
-/// least this ratio (3/2) of the rANS size. Measured on 2026-12-04 over the
-/// real meshes, the DEM and the 1M demo terrain (encoder/BENCHMARKS.md,
-/// "Serial work off the critical path"): level 10 was at most 1.34 times
-/// smaller than level 1, and it beat
-/// rANS only where level 1 came within 1.07 of the rANS size (the seed's
-/// substreams, incompressible flags). At 5/3 the trial still ran on the
-/// last level's largest substreams, after its replay, on the emission's
-/// critical path. Were level 10 ever 1.62 times smaller than level 1 (the
-/// largest gain seen on earlier formats), a skipped trial would cost at most
-/// 8 % of that substream's bytes; the stream stays valid either way.
-const DEFLATE_QUICK_RATIO: (usize, usize) = (3, 2);
-
 /// The chunks of a substream as `frame_level` codes them, in a level whose
 /// rANS chunks have `contexts` tables for it (`context::count`): byte-codec
 /// chunks of at most `params.chunk_limit` bytes, rANS chunks of at most
@@ -683,34 +713,17 @@ fn substream_chunks(
         ChunkCodec::Stored => byte_chunks(sub.as_bytes(), limit, None, map),
         ChunkCodec::Deflate(l) => byte_chunks(sub.as_bytes(), limit, Some(l), map),
         ChunkCodec::Rans { lanes } => {
-            let size = |c: &[Chunk]| c.iter().map(|c| c.stored.len()).sum::<usize>();
             let rans = rans_in(lanes);
-            let rans_size = size(&rans);
-            rans_or_deflate((rans, rans_size), |level| {
-                let deflate = byte_chunks(sub.as_bytes(), limit, Some(level), map);
-                let deflate_size = size(&deflate);
-                (deflate, deflate_size)
-            })
+            let rans_size = rans.iter().map(Chunk::stored_len).sum();
+            match sub
+                .trial_for(limit)
+                .deflate_instead(sub.as_bytes(), rans_size)
+            {
+                Some(deflate) => deflate.to_vec(),
+                None => rans,
+            }
         }
         ChunkCodec::RansAlways { lanes } => rans_in(lanes),
-    }
-}
-
-/// The rANS codec's choice (SPEC §5.2: any codec per chunk): `rans`, or
-/// `deflate_at(10)` where that is smaller, each with its payload bytes.
-/// Level 10 is slow (up to 1,500 match probes per byte); a quick level-1
-/// pass first rules it out where it cannot win ([`DEFLATE_QUICK_RATIO`]).
-/// [`substream_chunks`] chooses chunks so, [`coded_len_under`] lengths.
-fn rans_or_deflate<T>(rans: (T, usize), mut deflate_at: impl FnMut(u8) -> (T, usize)) -> T {
-    let quick = deflate_at(1);
-    if quick.1 * DEFLATE_QUICK_RATIO.1 >= rans.1 * DEFLATE_QUICK_RATIO.0 {
-        return rans.0;
-    }
-    let deflate = deflate_at(10);
-    if rans.1 < deflate.1 {
-        rans.0
-    } else {
-        deflate.0
     }
 }
 
@@ -758,7 +771,7 @@ pub fn coded_len_under(
         ChunkCodec::Rans { lanes } | ChunkCodec::RansAlways { lanes } => Some(rans_len(lanes)),
         ChunkCodec::Stored | ChunkCodec::Deflate(_) => None,
     };
-    let byte_codec = |level: Option<u8>| {
+    let byte_codec = |sub: &SubstreamWriter, level: Option<u8>| {
         let chunks = byte_chunks(
             sub.as_bytes(),
             params.chunk_limit.max(1) as usize,
@@ -771,15 +784,16 @@ pub fn coded_len_under(
         )
     };
     framed(match params.codec {
-        ChunkCodec::Stored => byte_codec(None),
-        ChunkCodec::Deflate(l) => byte_codec(Some(l)),
+        ChunkCodec::Stored => byte_codec(sub, None),
+        ChunkCodec::Deflate(l) => byte_codec(sub, Some(l)),
         ChunkCodec::RansAlways { .. } => rans.expect("costed above"),
         ChunkCodec::Rans { .. } => {
             let rans = rans.expect("costed above");
-            rans_or_deflate((rans, rans.0), |level| {
-                let deflate = byte_codec(Some(level));
-                (deflate, deflate.0)
-            })
+            let limit = params.chunk_limit.max(1) as usize;
+            match sub.deflate_instead(limit, rans.0) {
+                Some(deflate) => (deflate.iter().map(Chunk::stored_len).sum(), deflate.len()),
+                None => rans,
+            }
         }
     })
 }
@@ -860,12 +874,20 @@ fn single_chunk(sub: &SubstreamWriter, i: usize, params: &StreamParams) -> Chunk
 }
 
 /// One coded chunk before framing.
+#[derive(Clone, Debug)]
 pub struct Chunk {
     codec: u8,
     raw_len: u32,
     stored: Vec<u8>,
     /// A rANS chunk with an adaptive table (3.9).
     adaptive: bool,
+}
+
+impl Chunk {
+    /// Its payload bytes.
+    pub(crate) fn stored_len(&self) -> usize {
+        self.stored.len()
+    }
 }
 
 /// Byte-codec chunks of at most `limit` raw bytes; deflated at `level` where
@@ -877,7 +899,7 @@ fn byte_chunks(bytes: &[u8], limit: usize, level: Option<u8>, map: ChunkMap<'_>)
 }
 
 /// Chunk `i` of [`byte_chunks`].
-fn byte_chunk(bytes: &[u8], limit: usize, level: Option<u8>, i: usize) -> Chunk {
+pub(crate) fn byte_chunk(bytes: &[u8], limit: usize, level: Option<u8>, i: usize) -> Chunk {
     let raw = &bytes[i * limit..bytes.len().min((i + 1) * limit)];
     let packed = level.map(|l| miniz_oxide::deflate::compress_to_vec(raw, l));
     match packed {

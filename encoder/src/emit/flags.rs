@@ -95,18 +95,29 @@ impl FlagCoding {
     fn cheaper(&mut self) -> DeficitContexts {
         let single = self.coded.iter().filter(|c| c.is_some()).count() == 1;
         let params = &self.params;
+        let mut costs = [None; CHOICES.len()];
+        for i in 0..CHOICES.len() {
+            let (before, rest) = self.coded.split_at_mut(i);
+            let Some(sub) = rest[0].as_mut() else {
+                continue;
+            };
+            // Both choices hold the same bits: the deflate trial the first
+            // coded to weigh deflate against its rANS chunks serves the
+            // second too.
+            for earlier in before.iter().flatten() {
+                sub.share_deflate_trial(earlier);
+            }
+            let c = CHOICES[i];
+            costs[i] = Some(if single {
+                0
+            } else {
+                coded_len_in(sub, substream::FLAGS, c, params)
+            });
+        }
         CHOICES
             .into_iter()
-            .zip(&mut self.coded)
-            .filter_map(|(c, sub)| Some((c, sub.as_mut()?)))
-            .map(|(c, sub)| {
-                let cost = if single {
-                    0
-                } else {
-                    coded_len_in(sub, substream::FLAGS, c, params)
-                };
-                ((cost, c.to_byte()), c)
-            })
+            .zip(costs)
+            .filter_map(|(c, cost)| Some(((cost?, c.to_byte()), c)))
             .min_by_key(|&(key, _)| key)
             .expect("at least one choice of flag contexts")
             .1
