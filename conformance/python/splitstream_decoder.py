@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""A second splitstream 3.11 decoder, in Python, written from
+"""A second splitstream 3.12 decoder, in Python, written from
 decoder-core/SPEC.md and the protocol of conformance/README.md alone,
 without reading the reference code: the check that the specification is
 enough to decode bit-exactly. (Written for 3.0 from the SPEC alone; 3.1's
@@ -16,7 +16,10 @@ header flag bit 1, was added with the SPEC sections that define it, and
 §5.1, §5.5.5, §6.1 and §7.5, and 3.11's `compact` level framing, header
 flag bit 2, with SPEC §5.1.1: parse_fixed and parse_compact read a level
 header up to its CRC check into the same fields, and decode_level applies
-the rules after it to either.) It speaks the conformance protocol (a stream
+the rules after it to either; and 3.12's `compact` level table, header
+flag bit 3 and table_len at offset 28, with SPEC §3.3 and §4.3: its
+entries are read into the fields of a fixed entry, offset implied, and
+go through §4.2's rules.) It speaks the conformance protocol (a stream
 on stdin; the state hash after the seed and after every round, then `ok`,
 or `error <class>`), so that .ci/test runs the vectors through it:
 
@@ -565,16 +568,24 @@ class Decoder:
         if crc32(s[0:92]) != u32(s, 92):
             raise Fail("checksum-mismatch")
         flags = u16(s, 10)
-        if flags & 0xFFF8:  # bit 1: schedule (3.6), bit 2: framing (3.11)
+        if flags & 0xFFF0:  # bit 1: schedule (3.6), bit 2: framing (3.11), bit 3: table (3.12)
             raise Fail("malformed")
         if not (1 <= s[12] <= 31):
             raise Fail("malformed")
-        if u32(s, 28) != 0 or u32(s, 88) != 0:
+        compact_table = (flags >> 3) & 1  # table: 0 fixed, 1 compact (3.12), SPEC §4.3
+        if compact_table and not (flags >> 2) & 1:  # only with the compact framing
+            raise Fail("malformed")
+        table_len = u32(s, 28)
+        if (not compact_table and table_len != 0) or u32(s, 88) != 0:
             raise Fail("malformed")
         if not (1 <= s[13] <= 32):
             raise Fail("malformed")
         if u16(s, 14) == 0:
             raise Fail("malformed")
+        if compact_table:
+            L = u16(s, 14)
+            if L > 255 or not (8 * L + 4 <= table_len <= 24 * L + 4):
+                raise Fail("malformed")
         vcap = u32(s, 16)
         tcap = u32(s, 20)
         mcl = u32(s, 24)
@@ -601,17 +612,38 @@ class Decoder:
         self.mcl = mcl
         wsb = u64(s, 80)
         # level table
-        head_len = 96 + 32 * L + 4
+        head_len = 96 + table_len if compact_table else 96 + 32 * L + 4
         if n < head_len:
             raise Fail("truncated")
         if crc32(s[96:head_len - 4]) != u32(s, head_len - 4):
             raise Fail("checksum-mismatch")
         expected = head_len
         entries = []
+        at = [96]
+        end = head_len - 4
+
+        def next_byte():  # compact table (3.12): the CRC matched, so past `end` is malformed
+            if at[0] + 1 > end:
+                raise Fail("malformed")
+            at[0] += 1
+            return s[at[0] - 1]
+
         for k in range(L):
-            o = 96 + 32 * k
-            e = dict(offset=u64(s, o), length=u32(s, o + 8), V=u32(s, o + 12), T=u32(s, o + 16),
-                     rounds=u32(s, o + 20), gerr=f32(s, o + 24), res=u32(s, o + 28))
+            if compact_table:  # SPEC §4.3: varints and an f32; offset implied, no reserved
+                length = leb128(next_byte)
+                dv = leb128(next_byte)
+                dt = leb128(next_byte)
+                rounds = leb128(next_byte)
+                if at[0] + 4 > end:
+                    raise Fail("malformed")
+                p = entries[k - 1] if k else dict(V=0, T=0)
+                e = dict(offset=expected, length=length, V=p["V"] + dv, T=p["T"] + dt,
+                         rounds=rounds, gerr=f32(s, at[0]), res=0)
+                at[0] += 4
+            else:
+                o = 96 + 32 * k
+                e = dict(offset=u64(s, o), length=u32(s, o + 8), V=u32(s, o + 12), T=u32(s, o + 16),
+                         rounds=u32(s, o + 20), gerr=f32(s, o + 24), res=u32(s, o + 28))
             if e["res"] != 0:
                 raise Fail("malformed")
             if e["offset"] != expected:
@@ -632,6 +664,8 @@ class Decoder:
                 if not (e["rounds"] >= 1 and dv >= e["rounds"] and dt >= 1 and dv <= dt <= 2 * dv):
                     raise Fail("malformed")
             entries.append(e)
+        if compact_table and at[0] != end:  # bytes left in the table
+            raise Fail("malformed")
         last = entries[-1]
         if last["V"] != vcap or last["T"] != tcap:
             raise Fail("malformed")

@@ -107,7 +107,7 @@ pub struct Decoder<'h, 'ws> {
 
 impl<'h, 'ws> Decoder<'h, 'ws> {
     /// Parses the header and level table at the start of `head` (the whole
-    /// stream or just its first bytes, see [`crate::head_len`]) and lays the
+    /// stream or just its first bytes, see [`Header::head_len`]) and lays the
     /// decoder out in `workspace` (SPEC §3.3, §4.2, §9, the first steps of
     /// §10.3).
     pub fn new(

@@ -2,10 +2,30 @@
 
 use crate::bytes::{crc32, f64_at, u8_at, u16_at, u32_at, u64_at};
 use crate::limits::{
-    HEADER_LEN, MAGIC, MAX_BITS, MAX_TRIANGLES, MAX_VERTICES, MIN_BITS, VERSION_MAJOR,
-    rans::MAX_LANES,
+    HEADER_LEN, LEVEL_ENTRY_LEN, MAGIC, MAX_BITS, MAX_COMPACT_ENTRY_LEN, MAX_COMPACT_LEVELS,
+    MAX_TRIANGLES, MAX_VERTICES, MIN_BITS, MIN_COMPACT_ENTRY_LEN, VERSION_MAJOR, rans::MAX_LANES,
 };
 use crate::{ChecksumScope, Error};
+
+/// The compact table's declared length, checked against the bounds of
+/// SPEC §3.3 (3.12): at most [`MAX_COMPACT_LEVELS`] entries of 8 to 24
+/// bytes each, then the CRC.
+fn compact_table_len(level_count: u16, declared: u32) -> Result<u32, Error> {
+    if level_count > MAX_COMPACT_LEVELS {
+        return Err(Error::InvalidHeader(
+            "more than 255 levels in a compact level table",
+        ));
+    }
+    let entries = level_count as u32;
+    if declared < MIN_COMPACT_ENTRY_LEN * entries + 4
+        || declared > MAX_COMPACT_ENTRY_LEN * entries + 4
+    {
+        return Err(Error::InvalidHeader(
+            "compact level table length out of range for its level count",
+        ));
+    }
+    Ok(declared)
+}
 
 /// How the two vertices of a split are placed relative to their parent
 /// (SPEC §3.2 header flag bit 0, §7.4).
@@ -43,16 +63,22 @@ impl Schedule {
     }
 }
 
-/// How every level header of a stream is laid out (SPEC §3.2 header flag
-/// bit 2, §5.1; format 3.11).
+/// How a stream's level table and level headers are laid out (SPEC §3.2
+/// header flag bits 2 and 3, §4, §5.1; formats 3.11 and 3.12).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Framing {
-    /// Fixed-width fields: `u32` counts, 16-byte directory entries (3.0).
+    /// Fixed-width fields: 32-byte table entries, `u32` counts, 16-byte
+    /// directory entries (3.0).
     #[default]
     Fixed,
-    /// 3.11: the counts and lengths as varints, a directory entry's id and
-    /// codec in one byte (SPEC §5.1.1): 7 to 10 bytes an entry instead of
-    /// 16, one or two bytes a round instead of 4.
+    /// 3.11: the level headers' counts and lengths as varints, a directory
+    /// entry's id and codec in one byte (SPEC §5.1.1): 7 to 10 bytes an
+    /// entry instead of 16, one or two bytes a round instead of 4. The
+    /// level table stays fixed (flag bit 2).
+    CompactLevels,
+    /// 3.12: the level headers as under `CompactLevels`, and the level
+    /// table's entries as varints (SPEC §4.3): 8 to 12 bytes an entry
+    /// instead of 32 (flag bits 2 and 3).
     Compact,
 }
 
@@ -61,8 +87,19 @@ impl Framing {
     pub fn name(self) -> &'static str {
         match self {
             Framing::Fixed => "fixed",
+            Framing::CompactLevels => "compact-levels",
             Framing::Compact => "compact",
         }
+    }
+
+    /// Whether the level headers are laid out as in SPEC §5.1.1 (3.11).
+    pub fn compact_level_headers(self) -> bool {
+        self != Framing::Fixed
+    }
+
+    /// Whether the level table is laid out as in SPEC §4.3 (3.12).
+    pub fn compact_table(self) -> bool {
+        self == Framing::Compact
     }
 }
 
@@ -73,8 +110,13 @@ pub struct Header {
     pub position_mode: PositionMode,
     /// Which vertices split in which round (header flag bit 1, 3.6).
     pub schedule: Schedule,
-    /// How the level headers are laid out (header flag bit 2, 3.11).
+    /// How the level headers (header flag bit 2, 3.11) and the level table
+    /// (bit 3, 3.12) are laid out.
     pub framing: Framing,
+    /// Bytes of the level table, its CRC included: under the compact table
+    /// (3.12) the header's field at offset 28 (SPEC §3.2, §4.3), under the
+    /// fixed one `32 × level_count + 4`.
+    pub table_len: u32,
     /// Quantization bits per axis: coordinates lie in `0 .. 2^bits`.
     pub bits: u8,
     /// Entries in the level table; entry 0 is the base mesh.
@@ -127,7 +169,7 @@ impl Header {
             return Err(Error::ChecksumMismatch(ChecksumScope::Header));
         }
         let flags = u16_at(bytes, 10)?;
-        if flags & !7 != 0 {
+        if flags & !15 != 0 {
             return Err(Error::InvalidHeader("reserved flag bits set"));
         }
         let position_mode = if flags & 1 == 0 {
@@ -140,16 +182,22 @@ impl Header {
         } else {
             Schedule::EveryVertex
         };
-        let framing = if flags & 4 == 0 {
-            Framing::Fixed
-        } else {
-            Framing::Compact
+        let framing = match flags & 12 {
+            0 => Framing::Fixed,
+            4 => Framing::CompactLevels,
+            12 => Framing::Compact,
+            _ => {
+                return Err(Error::InvalidHeader(
+                    "a compact level table without compact level headers",
+                ));
+            }
         };
         let bits = u8_at(bytes, 12)?;
         if !(MIN_BITS..=MAX_BITS).contains(&bits) {
             return Err(Error::InvalidHeader("bits per axis outside 1..=31"));
         }
-        if u32_at(bytes, 28)? != 0 || u32_at(bytes, 88)? != 0 {
+        let declared_table_len = u32_at(bytes, 28)?;
+        if (!framing.compact_table() && declared_table_len != 0) || u32_at(bytes, 88)? != 0 {
             return Err(Error::InvalidHeader("reserved field not zero"));
         }
         let lane_count = u8_at(bytes, 13)?;
@@ -160,6 +208,11 @@ impl Header {
         if level_count == 0 {
             return Err(Error::InvalidHeader("no levels"));
         }
+        let table_len = if framing.compact_table() {
+            compact_table_len(level_count, declared_table_len)?
+        } else {
+            (LEVEL_ENTRY_LEN * level_count as usize + 4) as u32
+        };
         let vertex_capacity = u32_at(bytes, 16)?;
         let triangle_capacity = u32_at(bytes, 20)?;
         if vertex_capacity == 0 || vertex_capacity > MAX_VERTICES {
@@ -190,6 +243,7 @@ impl Header {
             position_mode,
             schedule,
             framing,
+            table_len,
             bits,
             lane_count,
             level_count,
@@ -220,7 +274,8 @@ impl Header {
         };
         let framing: u16 = match self.framing {
             Framing::Fixed => 0,
-            Framing::Compact => 4,
+            Framing::CompactLevels => 4,
+            Framing::Compact => 12,
         };
         let flags = mode | schedule | framing;
         out[10..12].copy_from_slice(&flags.to_le_bytes());
@@ -230,6 +285,9 @@ impl Header {
         out[16..20].copy_from_slice(&self.vertex_capacity.to_le_bytes());
         out[20..24].copy_from_slice(&self.triangle_capacity.to_le_bytes());
         out[24..28].copy_from_slice(&self.max_chunk_len.to_le_bytes());
+        if self.framing.compact_table() {
+            out[28..32].copy_from_slice(&self.table_len.to_le_bytes());
+        }
         for k in 0..3 {
             out[32 + 8 * k..40 + 8 * k].copy_from_slice(&self.origin[k].to_le_bytes());
             out[56 + 8 * k..64 + 8 * k].copy_from_slice(&self.scale[k].to_le_bytes());
@@ -237,6 +295,13 @@ impl Header {
         out[80..88].copy_from_slice(&self.workspace_bytes.to_le_bytes());
         let crc = crc32(&out[..HEADER_LEN - 4]);
         out[HEADER_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
+    }
+
+    /// Bytes from the stream start to the end of the level table, its
+    /// checksum included (SPEC §3.3, §4.1, §4.3): what a client fetches
+    /// before it knows every level's byte range.
+    pub fn head_len(&self) -> usize {
+        HEADER_LEN + self.table_len as usize
     }
 
     /// Real coordinates of a quantized position: `origin + q * scale` (SPEC §3.2).

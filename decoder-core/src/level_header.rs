@@ -2,7 +2,7 @@
 //! contexts, split counts and the chunk directory (SPEC §5.1, §5.2), in
 //! the `fixed` framing or (3.11) the `compact` one (SPEC §5.1.1).
 
-use crate::bytes::{crc32, u8_at, u16_at, u32_at};
+use crate::bytes::{Cursor, crc32, u8_at, u16_at, u32_at};
 use crate::context::DeficitContexts;
 use crate::header::{Framing, PositionMode, Schedule};
 use crate::limits::{CHUNK_ENTRY_LEN, codec, substream};
@@ -107,7 +107,7 @@ impl<'l> LevelHeader<'l> {
     pub fn parse(level: &'l [u8], is_base: bool, rules: LevelRules) -> Result<Self, Error> {
         let fields = match rules.framing {
             Framing::Fixed => Fields::fixed(level, is_base)?,
-            Framing::Compact => Fields::compact(level, is_base)?,
+            Framing::CompactLevels | Framing::Compact => Fields::compact(level, is_base)?,
         };
         let crc_at = fields.crc_at;
         if crc32(&level[..crc_at]) != u32_at(level, crc_at)? {
@@ -279,13 +279,13 @@ impl<'l> LevelHeader<'l> {
                     crc: u32_at(self.directory, at + 12)?,
                 }
             }
-            Framing::Compact => {
+            Framing::CompactLevels | Framing::Compact => {
                 let id_codec = c.byte()?;
                 ChunkEntry {
                     substream: id_codec & 0x0F,
                     codec: id_codec >> 4,
-                    raw_len: c.varint()?,
-                    stored_len: c.varint()?,
+                    raw_len: c.varint(Error::InvalidLevelHeader)?,
+                    stored_len: c.varint(Error::InvalidLevelHeader)?,
                     crc: c.u32()?,
                 }
             }
@@ -348,23 +348,26 @@ impl Fields {
     /// `Truncated` after at most the level's length in steps.
     fn compact(level: &[u8], is_base: bool) -> Result<Fields, Error> {
         let mut c = Cursor::new(level);
-        let round_count = c.varint()?;
-        let chunk_count = c.varint()?;
+        let round_count = c.varint(Error::InvalidLevelHeader)?;
+        let chunk_count = c.varint(Error::InvalidLevelHeader)?;
         let policies = [c.byte()?, c.byte()?, c.byte()?, c.byte()?];
         let seed = if is_base {
-            [c.varint()?, c.varint()?]
+            [
+                c.varint(Error::InvalidLevelHeader)?,
+                c.varint(Error::InvalidLevelHeader)?,
+            ]
         } else {
             [0, 0]
         };
         let counts_at = c.at;
         for _ in 0..round_count {
-            c.varint()?;
+            c.varint(Error::InvalidLevelHeader)?;
         }
         let dir_start = c.at;
         for _ in 0..chunk_count {
             c.byte()?;
-            c.varint()?;
-            c.varint()?;
+            c.varint(Error::InvalidLevelHeader)?;
+            c.varint(Error::InvalidLevelHeader)?;
             c.u32()?;
         }
         let crc_at = c.at;
@@ -378,51 +381,6 @@ impl Fields {
             dir_start,
             crc_at,
         })
-    }
-}
-
-/// A reading position in a level header's bytes (SPEC §5.1.1).
-#[derive(Clone, Copy, Debug)]
-struct Cursor<'l> {
-    bytes: &'l [u8],
-    at: usize,
-}
-
-impl<'l> Cursor<'l> {
-    fn new(bytes: &'l [u8]) -> Self {
-        Cursor { bytes, at: 0 }
-    }
-
-    fn byte(&mut self) -> Result<u8, Error> {
-        let b = u8_at(self.bytes, self.at)?;
-        self.at += 1;
-        Ok(b)
-    }
-
-    fn u32(&mut self) -> Result<u32, Error> {
-        let v = u32_at(self.bytes, self.at)?;
-        self.at += 4;
-        Ok(v)
-    }
-
-    /// `varint()` of SPEC §5.1.1: §5.4's rules (5 bytes, 32 bits, minimal).
-    fn varint(&mut self) -> Result<u32, Error> {
-        let mut v = 0u32;
-        for i in 0..5 {
-            let b = self.byte()?;
-            if i == 4 && b > 0x0F {
-                return Err(Error::InvalidLevelHeader("varint over 32 bits"));
-            }
-            v |= u32::from(b & 0x7F) << (7 * i);
-            if b & 0x80 == 0 {
-                if b == 0 && i > 0 {
-                    return Err(Error::InvalidLevelHeader("varint not minimal"));
-                }
-                return Ok(v);
-            }
-        }
-        // Unreachable: the fifth byte is at most 0x0F, so it ends the value.
-        Err(Error::InvalidLevelHeader("varint over 32 bits"))
     }
 }
 
@@ -444,7 +402,9 @@ impl Iterator for SplitCounts<'_> {
         }
         match self.framing {
             Framing::Fixed => self.cursor.u32().ok(),
-            Framing::Compact => self.cursor.varint().ok(),
+            Framing::CompactLevels | Framing::Compact => {
+                self.cursor.varint(Error::InvalidLevelHeader).ok()
+            }
         }
     }
 }

@@ -1,6 +1,6 @@
 //! The level table: where each level's bytes lie and what it yields (SPEC §4).
 
-use crate::bytes::{crc32, f32_at, u32_at, u64_at};
+use crate::bytes::{Cursor, crc32, f32_at, u32_at, u64_at};
 use crate::level_header::LevelRules;
 use crate::limits::{HEADER_LEN, LEVEL_ENTRY_LEN};
 use crate::{ChecksumScope, Error, Header, LevelHeader};
@@ -23,23 +23,99 @@ pub struct LevelInfo {
     pub geometric_error: f32,
 }
 
-/// The validated level table, borrowed from the stream.
+/// What [`LevelTable::get`] answers past the table's end.
+const EMPTY_ENTRY: LevelInfo = LevelInfo {
+    offset: 0,
+    length: 0,
+    vertex_count: 0,
+    triangle_count: 0,
+    round_count: 0,
+    geometric_error: 0.0,
+};
+
+/// The validated level table, borrowed from the stream: fixed 32-byte
+/// entries (SPEC §4.1) or, 3.12, compact ones (§4.3).
 #[derive(Clone, Copy, Debug)]
 pub struct LevelTable<'h> {
+    /// The entries, without the table's CRC.
     bytes: &'h [u8],
     count: u16,
+    compact: bool,
+    /// Where level 0 starts: the end of the table.
+    head_len: u64,
 }
 
-/// Bytes from the stream start to the end of the level table, checksum
-/// included (SPEC §4.1, §4.2).
-pub fn head_len(level_count: u16) -> usize {
+/// Bytes from the stream start to the end of a fixed level table, checksum
+/// included (SPEC §4.1, §4.2); [`Header::head_len`] for either table.
+pub fn fixed_head_len(level_count: u16) -> usize {
     HEADER_LEN + LEVEL_ENTRY_LEN * level_count as usize + 4
 }
 
+/// A table entry as read, its counts in exact integers so that a count
+/// past its capacity is found before it is narrowed (SPEC §4.2, §4.3).
+struct ReadEntry {
+    info: LevelInfo,
+    vertex_count: u64,
+    triangle_count: u64,
+}
+
+/// Reads compact entries from the start (SPEC §4.3): offsets from the
+/// lengths before, counts as the sums of their steps.
+struct CompactEntries<'h> {
+    cursor: Cursor<'h>,
+    offset: u64,
+    vertex_count: u64,
+    triangle_count: u64,
+}
+
+impl<'h> CompactEntries<'h> {
+    fn new(table: &LevelTable<'h>) -> Self {
+        CompactEntries {
+            cursor: Cursor::new(table.bytes),
+            offset: table.head_len,
+            vertex_count: 0,
+            triangle_count: 0,
+        }
+    }
+
+    /// `varint()` and `f32` of SPEC §4.3: past the table's end is
+    /// `malformed` (its bytes are there and their CRC matched, so the
+    /// declared length is what is wrong).
+    fn next_entry(&mut self) -> Result<ReadEntry, Error> {
+        let past_end = |e: Error| match e {
+            Error::Truncated => Error::InvalidLevelTable("an entry runs past the table's length"),
+            other => other,
+        };
+        let c = &mut self.cursor;
+        let length = c.varint(Error::InvalidLevelTable).map_err(past_end)?;
+        let vertex_step = c.varint(Error::InvalidLevelTable).map_err(past_end)?;
+        let triangle_step = c.varint(Error::InvalidLevelTable).map_err(past_end)?;
+        let round_count = c.varint(Error::InvalidLevelTable).map_err(past_end)?;
+        let geometric_error = c.f32().map_err(past_end)?;
+        self.vertex_count += vertex_step as u64;
+        self.triangle_count += triangle_step as u64;
+        let info = LevelInfo {
+            offset: self.offset,
+            length,
+            vertex_count: self.vertex_count as u32,
+            triangle_count: self.triangle_count as u32,
+            round_count,
+            geometric_error,
+        };
+        self.offset += length as u64;
+        Ok(ReadEntry {
+            info,
+            vertex_count: self.vertex_count,
+            triangle_count: self.triangle_count,
+        })
+    }
+}
+
 impl<'h> LevelTable<'h> {
-    /// Parses and validates the table following the header (SPEC §4.2).
+    /// Parses and validates the table following the header (SPEC §4.2,
+    /// §4.3).
     pub fn parse(stream_head: &'h [u8], header: &Header) -> Result<LevelTable<'h>, Error> {
-        let end = head_len(header.level_count);
+        let end = header.head_len();
         let bytes = stream_head.get(HEADER_LEN..end).ok_or(Error::Truncated)?;
         let body = &bytes[..bytes.len() - 4];
         if crc32(body) != u32_at(bytes, body.len())? {
@@ -48,30 +124,44 @@ impl<'h> LevelTable<'h> {
         let table = LevelTable {
             bytes: body,
             count: header.level_count,
+            compact: header.framing.compact_table(),
+            head_len: end as u64,
         };
-        table.validate(header, end as u64)?;
+        table.validate(header)?;
         Ok(table)
     }
 
-    fn validate(&self, header: &Header, first_offset: u64) -> Result<(), Error> {
-        let mut expected_offset = first_offset;
+    fn validate(&self, header: &Header) -> Result<(), Error> {
+        let mut expected_offset = self.head_len;
         let mut previous: Option<LevelInfo> = None;
+        let mut compact = CompactEntries::new(self);
         for k in 0..self.count {
-            let e = self.get(k);
-            if u32_at(self.bytes, k as usize * LEVEL_ENTRY_LEN + 28)? != 0 {
-                return Err(Error::InvalidLevelTable("reserved field not zero"));
-            }
-            if e.offset != expected_offset {
-                return Err(Error::InvalidLevelTable("levels are not contiguous"));
-            }
-            expected_offset = e.offset + e.length as u64;
+            let read = if self.compact {
+                // Contiguous by construction; no reserved field.
+                compact.next_entry()?
+            } else {
+                let e = self.fixed_entry(k);
+                if u32_at(self.bytes, k as usize * LEVEL_ENTRY_LEN + 28)? != 0 {
+                    return Err(Error::InvalidLevelTable("reserved field not zero"));
+                }
+                if e.offset != expected_offset {
+                    return Err(Error::InvalidLevelTable("levels are not contiguous"));
+                }
+                expected_offset = e.offset + e.length as u64;
+                ReadEntry {
+                    info: e,
+                    vertex_count: e.vertex_count as u64,
+                    triangle_count: e.triangle_count as u64,
+                }
+            };
+            let e = read.info;
             if !(e.geometric_error.is_finite() && e.geometric_error >= 0.0) {
                 return Err(Error::InvalidLevelTable(
                     "geometric error not finite and >= 0",
                 ));
             }
-            if e.vertex_count > header.vertex_capacity
-                || e.triangle_count > header.triangle_capacity
+            if read.vertex_count > header.vertex_capacity as u64
+                || read.triangle_count > header.triangle_capacity as u64
             {
                 return Err(Error::CapacityExceeded);
             }
@@ -103,6 +193,11 @@ impl<'h> LevelTable<'h> {
             }
             previous = Some(e);
         }
+        if self.compact && compact.cursor.at != self.bytes.len() {
+            return Err(Error::InvalidLevelTable(
+                "bytes left after the last entry of a compact table",
+            ));
+        }
         let last = previous.ok_or(Error::InvalidLevelTable("empty"))?;
         if last.vertex_count != header.vertex_capacity
             || last.triangle_count != header.triangle_capacity
@@ -122,8 +217,35 @@ impl<'h> LevelTable<'h> {
         self.count == 0
     }
 
-    /// Entry `k`; panics if `k >= len()` (the table was validated on parse).
+    /// The entries in level order, each read once (a compact table from
+    /// its start, SPEC §4.3).
+    pub fn iter(&self) -> impl Iterator<Item = LevelInfo> + '_ {
+        let mut compact = CompactEntries::new(self);
+        (0..self.count).map(move |k| {
+            if self.compact {
+                compact.next_entry().map(|e| e.info).unwrap_or(EMPTY_ENTRY)
+            } else {
+                self.fixed_entry(k)
+            }
+        })
+    }
+
+    /// Entry `k` (the table was validated on parse; zeros past its end).
+    /// A compact table is read from its start (SPEC §4.3): at most 255
+    /// entries of up to 24 bytes.
     pub fn get(&self, k: u16) -> LevelInfo {
+        if self.compact {
+            let mut entries = CompactEntries::new(self);
+            let mut e = Err(Error::Truncated);
+            for _ in 0..=k.min(self.count) {
+                e = entries.next_entry();
+            }
+            return e.map(|e| e.info).unwrap_or(EMPTY_ENTRY);
+        }
+        self.fixed_entry(k)
+    }
+
+    fn fixed_entry(&self, k: u16) -> LevelInfo {
         let at = k as usize * LEVEL_ENTRY_LEN;
         // The table length was checked in `parse`, so these reads succeed.
         let read = |o: usize| u32_at(self.bytes, at + o).unwrap_or(0);
@@ -140,7 +262,7 @@ impl<'h> LevelTable<'h> {
     /// The coarsest level within `max_error` ([`level_within_error`] over
     /// this table).
     pub fn level_within_error(&self, max_error: f32) -> u16 {
-        level_within_error((0..self.count).map(|k| self.get(k)), max_error).unwrap_or(0)
+        level_within_error(self.iter(), max_error).unwrap_or(0)
     }
 
     /// Parses level `k`'s header from exactly its bytes (`bytes.len()` is

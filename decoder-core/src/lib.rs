@@ -70,7 +70,9 @@ pub use header::{Framing, Header, PositionMode, Schedule};
 pub use inflate::Inflater;
 pub use layout::Layout;
 pub use level_header::{ChunkEntry, LevelHeader, LevelRules, SplitCounts};
-pub use level_table::{LevelInfo, LevelTable, head_len, level_within_error, write_level_table};
+pub use level_table::{
+    LevelInfo, LevelTable, fixed_head_len, level_within_error, write_level_table,
+};
 pub use positions_first::{RecordOrder, Ties};
 pub use predict::{
     ArcMeans, Plane, PlanePolicy, SplitFan, Target, add_residual, arc_means, constrained_positions,
@@ -83,6 +85,8 @@ pub use split::{SplitOutcome, SplitRecord};
 pub use state::{MeshState, StateMemory, next, prev};
 pub use symbols::WingCandidates;
 pub use wing_order::WingPolicy;
+#[cfg(feature = "alloc")]
+pub use writer::compact_level_table;
 
 /// Bytes of workspace (with alignment slack) needed to decode all of
 /// `stream`, from its header and level table alone (SPEC §9).

@@ -8,7 +8,10 @@ pub const MAGIC: [u8; 8] = [0x89, b'S', b'P', b'S', b'\r', b'\n', 0x1A, b'\n'];
 /// stream; 3.5 added a check and no feature, so no stream is written with
 /// minor version 5 (the writer uses the constants below).
 pub const VERSION_MAJOR: u8 = 3;
-pub const VERSION_MINOR: u8 = 11;
+pub const VERSION_MINOR: u8 = 12;
+/// The minor version written when the header selects the `compact` level
+/// table (SPEC §3.2 flag bit 3, §4.3): 3.11 decoders reject the flag.
+pub const VERSION_MINOR_COMPACT_TABLE: u8 = 12;
 /// The minor version written when the header selects the `compact` level
 /// framing (SPEC §3.2 flag bit 2, §5.1.1): 3.10 decoders reject the flag.
 pub const VERSION_MINOR_COMPACT: u8 = 11;
@@ -50,6 +53,14 @@ pub const VERSION_MINOR_BASELINE: u8 = 0;
 pub const HEADER_LEN: usize = 96;
 /// Size of one level-table entry (SPEC §4).
 pub const LEVEL_ENTRY_LEN: usize = 32;
+/// Most levels a stream with a compact level table declares (SPEC §3.3,
+/// 3.12): its entries are read from the start, so a decoder that reads on
+/// from the start for every entry it needs stays within 255 × 255 reads.
+pub const MAX_COMPACT_LEVELS: u16 = 255;
+/// Bounds of one compact level-table entry: four varints of 1 to 5 bytes
+/// and an `f32` (SPEC §4.3).
+pub const MIN_COMPACT_ENTRY_LEN: u32 = 8;
+pub const MAX_COMPACT_ENTRY_LEN: u32 = 24;
 /// Size of one chunk-directory entry (SPEC §5.2).
 pub const CHUNK_ENTRY_LEN: usize = 16;
 

@@ -12,12 +12,13 @@ use crate::deflate_trial::DeflateTrial;
 use crate::header::{Framing, Header, PositionMode, Schedule};
 use crate::layout::{Layout, RANS_SLOT_BYTES};
 use crate::level_header::ChunkEntry;
-use crate::level_table::{LevelInfo, head_len, write_level_table};
+use crate::level_table::{LevelInfo, fixed_head_len, write_level_table};
 use crate::limits::{
-    CHUNK_ENTRY_LEN, HEADER_LEN, VERSION_MINOR_ADAPTIVE, VERSION_MINOR_BASELINE,
-    VERSION_MINOR_COMPACT, VERSION_MINOR_DEFICITS, VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS,
-    VERSION_MINOR_RECORDS, VERSION_MINOR_SCHEDULE, VERSION_MINOR_SPLIT_HISTORY, VERSION_MINOR_TIES,
-    VERSION_MINOR_WINGS, codec, substream,
+    CHUNK_ENTRY_LEN, HEADER_LEN, MAX_COMPACT_LEVELS, VERSION_MINOR_ADAPTIVE,
+    VERSION_MINOR_BASELINE, VERSION_MINOR_COMPACT, VERSION_MINOR_COMPACT_TABLE,
+    VERSION_MINOR_DEFICITS, VERSION_MINOR_HEIGHT, VERSION_MINOR_RANS_CHUNKS, VERSION_MINOR_RECORDS,
+    VERSION_MINOR_SCHEDULE, VERSION_MINOR_SPLIT_HISTORY, VERSION_MINOR_TIES, VERSION_MINOR_WINGS,
+    codec, substream,
 };
 use crate::positions_first::{RecordOrder, Ties};
 use crate::predict::PlanePolicy;
@@ -343,9 +344,11 @@ pub struct StreamParams {
     /// that is smaller (SPEC §5.5.2, format 3.9). Without, the stream stays
     /// readable by 3.8 decoders.
     pub adaptive_tables: bool,
-    /// How the level headers are laid out (SPEC §3.2 header flag bit 2,
-    /// §5.1.1, format 3.11). `Fixed` keeps the stream readable by 3.10
-    /// decoders.
+    /// How the level headers and the level table are laid out (SPEC §3.2
+    /// header flag bits 2 and 3, §4.3, §5.1.1, formats 3.11 and 3.12).
+    /// `CompactLevels` keeps the stream readable by 3.11 decoders, `Fixed`
+    /// by 3.10 ones. A stream of more than 255 levels gets `CompactLevels`
+    /// for `Compact` (SPEC §3.3).
     pub framing: Framing,
 }
 
@@ -490,19 +493,41 @@ pub fn assemble_stream(
     .max(1);
     let framed: Vec<Vec<u8>> = framed.into_iter().map(|f| f.bytes).collect();
     let level_count = levels.len() as u16;
-    let mut offset = head_len(level_count) as u64;
-    let mut entries = Vec::with_capacity(levels.len());
-    for (level, bytes) in levels.iter().zip(&framed) {
-        entries.push(LevelInfo {
-            offset,
+    let framing = if params.framing.compact_table() && level_count > MAX_COMPACT_LEVELS {
+        Framing::CompactLevels
+    } else {
+        params.framing
+    };
+    let mut entries: Vec<LevelInfo> = levels
+        .iter()
+        .zip(&framed)
+        .map(|(level, bytes)| LevelInfo {
+            offset: 0,
             length: bytes.len() as u32,
             vertex_count: level.vertex_count,
             triangle_count: level.triangle_count,
             round_count: level.round_splits.len() as u32,
             geometric_error: level.geometric_error,
-        });
-        offset += bytes.len() as u64;
+        })
+        .collect();
+    // A compact table leaves the offsets out, so it is written before
+    // them; where it ends, level 0 starts.
+    let compact_table = framing
+        .compact_table()
+        .then(|| compact_level_table(&entries));
+    let mut offset = match &compact_table {
+        Some(table) => (HEADER_LEN + table.len()) as u64,
+        None => fixed_head_len(level_count) as u64,
+    };
+    for e in &mut entries {
+        e.offset = offset;
+        offset += e.length as u64;
     }
+    let table = compact_table.unwrap_or_else(|| {
+        let mut table = vec![0u8; fixed_head_len(level_count) - HEADER_LEN];
+        write_level_table(&entries, &mut table);
+        table
+    });
     let (base, top) = (&levels[0], &levels[levels.len() - 1]);
     let layout = Layout::new(
         top.vertex_count,
@@ -511,14 +536,16 @@ pub fn assemble_stream(
         base.triangle_count,
         max_chunk,
     );
-    // SPEC §1: 3.11 where the level headers are compact, 3.10 where a level's flags use the contexts
+    // SPEC §1: 3.12 where the level table is compact, 3.11 where the level headers are compact, 3.10 where a level's flags use the contexts
     // `split-history`, 3.9 where a rANS chunk has an adaptive table, 3.8 where a positions-first level breaks ties by a
     // diagonal, 3.7 where a level reads its records positions first, 3.6 where the schedule `every-vertex` is used, 3.4 only where a 3.4 feature (a rANS chunk longer than
     // `max_chunk_len`) is used, 3.3 where a 3.3 feature (the deficit
     // contexts `valence`) is, 3.2 where a 3.2 feature (a wing policy other
     // than `ranks`) is, 3.1 where a 3.1 feature (the plane policy `height`)
     // is; every other stream stays readable by 3.0 decoders.
-    let version_minor = if params.framing == Framing::Compact {
+    let version_minor = if framing.compact_table() {
+        VERSION_MINOR_COMPACT_TABLE
+    } else if framing.compact_level_headers() {
         VERSION_MINOR_COMPACT
     } else if levels
         .iter()
@@ -554,7 +581,8 @@ pub fn assemble_stream(
         version_minor,
         position_mode: params.position_mode,
         schedule: params.schedule,
-        framing: params.framing,
+        framing,
+        table_len: table.len() as u32,
         bits: params.bits,
         lane_count: params.codec.lane_count(),
         level_count,
@@ -565,14 +593,33 @@ pub fn assemble_stream(
         scale: params.scale,
         workspace_bytes: layout.total,
     };
-    let mut out = vec![0u8; head_len(level_count)];
+    let mut out = vec![0u8; HEADER_LEN];
     let mut head = [0u8; HEADER_LEN];
     header.write(&mut head);
-    out[..HEADER_LEN].copy_from_slice(&head);
-    write_level_table(&entries, &mut out[HEADER_LEN..]);
+    out.copy_from_slice(&head);
+    out.extend_from_slice(&table);
     for bytes in framed {
         out.extend_from_slice(&bytes);
     }
+    out
+}
+
+/// A compact level table (SPEC §4.3, 3.12): each entry's length, vertex
+/// and triangle steps and round count as varints and its geometric error,
+/// then the CRC of the entries. The entries' offsets are not written.
+pub fn compact_level_table(entries: &[LevelInfo]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(12 * entries.len() + 4);
+    let (mut vertices, mut triangles) = (0u32, 0u32);
+    for e in entries {
+        push_varint(&mut out, e.length);
+        push_varint(&mut out, e.vertex_count.wrapping_sub(vertices));
+        push_varint(&mut out, e.triangle_count.wrapping_sub(triangles));
+        push_varint(&mut out, e.round_count);
+        out.extend_from_slice(&e.geometric_error.to_le_bytes());
+        (vertices, triangles) = (e.vertex_count, e.triangle_count);
+    }
+    let crc = crc32(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
     out
 }
 
@@ -639,7 +686,7 @@ pub fn frame_level_with(
         }
     }
     let mut out = Vec::new();
-    let compact = params.framing == Framing::Compact;
+    let compact = params.framing.compact_level_headers();
     // A count or length: a u32 under the fixed framing (SPEC §5.1), a
     // varint under the compact one (§5.1.1).
     let count = |out: &mut Vec<u8>, v: u32| {

@@ -97,20 +97,32 @@ fn fix_checksums_is_the_identity_on_valid_streams() {
 }
 
 /// `fix_checksums` finds every CRC of a compact-framing stream (SPEC
-/// §5.1.1): with each of them broken, it gives the stream back.
+/// §5.1.1), under either level table (§4.1, §4.3, 3.12): with each of
+/// them broken, it gives the stream back.
 #[test]
 fn fix_checksums_restores_a_compact_streams_crcs() {
-    let g = streams::seed_generated()
-        .into_iter()
-        .find(|g| g.stream[10] & 4 != 0 && g.stream.len() > 300)
-        .expect("a compact seed stream");
-    let header = splitstream_decoder_core::Header::parse(&g.stream).unwrap();
-    let table = splitstream_decoder_core::LevelTable::parse(&g.stream, &header).unwrap();
-    let mut broken = g.stream.clone();
+    // Flag bit 2 alone (3.11), and bits 2 and 3 (3.12).
+    for flags in [4, 12] {
+        let g = streams::seed_generated()
+            .into_iter()
+            .find(|g| g.stream[10] & 12 == flags && g.stream.len() > 300)
+            .expect("a compact seed stream");
+        restores_every_crc(&g.stream, g.base);
+    }
+}
+
+fn restores_every_crc(stream: &[u8], base: &str) {
+    let header = splitstream_decoder_core::Header::parse(stream).unwrap();
+    let table = splitstream_decoder_core::LevelTable::parse(stream, &header).unwrap();
+    let mut broken = stream.to_vec();
+    // The header's and the table's CRCs.
+    broken[92..96].fill(0);
+    let head = header.head_len();
+    broken[head - 4..head].fill(0);
     for k in 0..header.level_count {
         let info = table.get(k);
         let start = info.offset as usize;
-        let level = &g.stream[start..start + info.length as usize];
+        let level = &stream[start..start + info.length as usize];
         let lh = table.level_header(k, level, header.level_rules()).unwrap();
         // The level header's CRC, and each chunk's (the last 4 bytes of
         // its entry), zeroed.
@@ -129,7 +141,7 @@ fn fix_checksums_restores_a_compact_streams_crcs() {
             broken[directory_at + end - 4..directory_at + end].fill(0);
         }
     }
-    assert!(broken != g.stream);
+    assert!(broken != stream);
     fix_checksums(&mut broken);
-    assert!(broken == g.stream, "{}", g.base);
+    assert!(broken == stream, "{base}");
 }

@@ -502,30 +502,57 @@ fn verify_prints_the_state_hash_after_the_last_round() {
 /// `every-vertex` (format 3.6) and `split-valences` keeps the minor
 /// version older decoders read. `transcode` goes either way and keeps the
 /// mesh.
-/// The compact level framing (format 3.11, the default) and the fixed one
-/// decode to the same mesh; compact is smaller by what its level headers
-/// save and nothing else (the payloads are the same bytes), `info` names
-/// it, and `transcode` converts either way.
+/// The compact framing (format 3.12, the default: compact level table
+/// and level headers), `compact-levels` (3.11) and the fixed one decode to
+/// the same mesh; each is smaller than the next by what its table and
+/// level headers save and nothing else (the payloads are the same bytes),
+/// `info` names it, and `transcode` converts either way.
 #[test]
-fn both_framings_decode_to_the_same_mesh_and_compact_is_smaller() {
+fn every_framing_decodes_to_the_same_mesh_and_compact_is_smallest() {
     let (input, compact) = encoded_raster("framing-compact.sps");
     let fixed = input.with_file_name("framing-fixed.sps");
-    let (i, c, f) = (
+    let levels = input.with_file_name("framing-compact-levels.sps");
+    let (i, c, f, l) = (
         input.to_str().unwrap(),
         compact.to_str().unwrap(),
         fixed.to_str().unwrap(),
+        levels.to_str().unwrap(),
     );
     succeeded(&splitstream(&["encode", i, "-o", f, "--framing", "fixed"]));
+    succeeded(&splitstream(&[
+        "encode",
+        i,
+        "-o",
+        l,
+        "--framing",
+        "compact-levels",
+    ]));
     let bytes = |p: &PathBuf| std::fs::read(p).unwrap();
     let header = |p: &PathBuf| splitstream_decoder_core::Header::parse(&bytes(p)).unwrap();
     use splitstream_decoder_core::Framing;
     assert_eq!(header(&compact).framing, Framing::Compact);
-    assert_eq!(header(&compact).version_minor, 11);
+    assert_eq!(header(&compact).version_minor, 12);
+    assert_eq!(header(&levels).framing, Framing::CompactLevels);
+    assert_eq!(header(&levels).version_minor, 11);
     assert_eq!(header(&fixed).framing, Framing::Fixed);
     assert!(header(&fixed).version_minor < 11);
-    let (lc, lf) = (bytes(&compact).len(), bytes(&fixed).len());
-    assert!(lc < lf, "compact {lc} bytes, fixed {lf}");
-    assert!(succeeded(&splitstream(&["info", c])).contains("compact framing"));
+    let (lc, ll, lf) = (
+        bytes(&compact).len(),
+        bytes(&levels).len(),
+        bytes(&fixed).len(),
+    );
+    assert!(
+        lc < ll && ll < lf,
+        "compact {lc} bytes, compact-levels {ll}, fixed {lf}"
+    );
+    // The levels' bytes are the same under either compact framing.
+    let head = |p: &PathBuf| header(p).head_len();
+    assert_eq!(
+        bytes(&compact)[head(&compact)..],
+        bytes(&levels)[head(&levels)..]
+    );
+    assert!(succeeded(&splitstream(&["info", c])).contains("framing: compact (level table"));
+    assert!(succeeded(&splitstream(&["info", l])).contains("framing: compact-levels"));
     let doc: serde_json::Value =
         serde_json::from_str(&succeeded(&splitstream(&["info", f, "--json"]))).unwrap();
     assert_eq!(doc["framing"], "fixed", "{doc}");
@@ -534,7 +561,8 @@ fn both_framings_decode_to_the_same_mesh_and_compact_is_smaller() {
         (m.positions, m.triangles)
     };
     assert_eq!(mesh(&compact), mesh(&fixed));
-    // Transcoded to the other framing, each is the other's bytes.
+    assert_eq!(mesh(&levels), mesh(&fixed));
+    // Transcoded to another framing, each is the other's bytes.
     let to_fixed = input.with_file_name("framing-to-fixed.sps");
     let to_compact = input.with_file_name("framing-to-compact.sps");
     let (tf, tc) = (to_fixed.to_str().unwrap(), to_compact.to_str().unwrap());
@@ -548,8 +576,19 @@ fn both_framings_decode_to_the_same_mesh_and_compact_is_smaller() {
     ]));
     succeeded(&splitstream(&["transcode", f, "-o", tc]));
     assert_eq!(mesh(&to_fixed), mesh(&compact));
-    assert_eq!(bytes(&to_compact).len(), lc);
+    assert_eq!(bytes(&to_compact), bytes(&compact));
     assert_eq!(bytes(&to_fixed).len(), lf);
+    let to_levels = input.with_file_name("framing-to-compact-levels.sps");
+    let tl = to_levels.to_str().unwrap();
+    succeeded(&splitstream(&[
+        "transcode",
+        c,
+        "-o",
+        tl,
+        "--framing",
+        "compact-levels",
+    ]));
+    assert_eq!(bytes(&to_levels), bytes(&levels));
 }
 
 #[test]
@@ -579,8 +618,8 @@ fn both_schedules_decode_to_the_same_mesh() {
         |p: &PathBuf| splitstream_decoder_core::Header::parse(&std::fs::read(p).unwrap()).unwrap();
     use splitstream_decoder_core::Schedule;
     assert_eq!(header(&every).schedule, Schedule::EveryVertex);
-    // 3.11: the compact framing, the default (SPEC §1).
-    assert_eq!(header(&every).version_minor, 11);
+    // 3.12: the compact framing, the default (SPEC §1).
+    assert_eq!(header(&every).version_minor, 12);
     assert_eq!(header(&split).schedule, Schedule::SplitValences);
     assert!(header(&split).version_minor < 6);
     assert!(succeeded(&splitstream(&["info", e])).contains("schedule: every-vertex"));

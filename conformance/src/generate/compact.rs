@@ -4,7 +4,7 @@
 //! combined id and codec byte, a directory cut short).
 
 use splitstream_decoder_core::writer::ChunkCodec;
-use splitstream_decoder_core::{Framing, PositionMode, Schedule, crc32, head_len};
+use splitstream_decoder_core::{Framing, PositionMode, Schedule, crc32, fixed_head_len};
 use splitstream_encoder::emit::EncodeOptions;
 
 use super::meshes;
@@ -13,10 +13,12 @@ use super::{Specs, encoded, every_vertex, opts};
 
 const TAG: &str = "framing-compact";
 
-/// `options` with the compact framing.
+/// `options` with the compact level headers of format 3.11 (and the fixed
+/// level table, which `with_level` rewrites; 3.12's compact table has
+/// vectors of its own, `table.rs`).
 fn compact(options: EncodeOptions) -> EncodeOptions {
     EncodeOptions {
-        framing: Framing::Compact,
+        framing: Framing::CompactLevels,
         ..options
     }
 }
@@ -63,7 +65,7 @@ pub(super) fn compact_vectors(s: &mut Specs) {
     );
     s.valid(
         "compact-grid-defaults",
-        "A 40 x 40 height grid with the encoder's defaults (constrained, rANS, every-vertex, records positions first where smaller, compact framing).",
+        "A 40 x 40 height grid with the encoder's defaults (constrained, rANS, every-vertex, records positions first where smaller, compact level headers and, since 3.12, the compact level table).",
         &["encoded", TAG],
         encoded(&meshes::grid(40, 40, 7, None), EncodeOptions::default()),
     );
@@ -232,7 +234,7 @@ fn with_crc(mut level: Vec<u8>, crc_at: usize) -> Vec<u8> {
 /// offsets and lengths and its CRC follow.
 fn with_level(stream: &[u8], k: u16, level: &[u8]) -> Vec<u8> {
     let levels = level_count(stream);
-    let mut out = stream[..head_len(levels)].to_vec();
+    let mut out = stream[..fixed_head_len(levels)].to_vec();
     for l in 0..levels {
         if l == k {
             append_level(&mut out, l, level);

@@ -4,7 +4,7 @@
 use splitstream_decoder_core::handmade;
 use splitstream_decoder_core::limits::LEAF;
 use splitstream_decoder_core::writer::{ChunkCodec, write_stream};
-use splitstream_decoder_core::{DeficitContexts, Header, PositionMode, WingPolicy, head_len};
+use splitstream_decoder_core::{DeficitContexts, Header, PositionMode, WingPolicy, fixed_head_len};
 use splitstream_encoder::emit::EncodeOptions;
 
 use super::meshes;
@@ -40,7 +40,7 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
     );
     let levels = Header::parse(&subject).expect("valid").level_count;
     let last = levels - 1;
-    let head = head_len(levels);
+    let head = fixed_head_len(levels);
 
     // Truncation at several depths.
     let cut = |n: usize| subject[..n].to_vec();
@@ -223,11 +223,11 @@ pub(super) fn invalid_vectors(s: &mut Specs) {
     s.invalid(
         "reserved-header-flag",
         "malformed",
-        "Header flag bit 3 (reserved; bit 2 is the framing since 3.11) set.",
+        "Header flag bit 4 (reserved; bit 2 is the framing since 3.11, bit 3 the level table since 3.12) set.",
         &["reserved"],
         {
             let mut b = subject.clone();
-            b[10] |= 8;
+            b[10] |= 16;
             fix_header_crc(&mut b);
             b
         },

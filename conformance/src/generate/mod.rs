@@ -10,6 +10,7 @@ mod mutate;
 mod positions_first;
 mod rans;
 mod reach;
+mod table;
 mod valid;
 
 use std::collections::BTreeMap;
@@ -102,7 +103,8 @@ fn encoded(mesh: &Mesh, options: EncodeOptions) -> Vec<u8> {
 /// `positions-first` has vectors of its own, `positions_first.rs`); level
 /// headers in the fixed framing, which the vectors were written in and
 /// whose offsets the invalid vectors patch (format 3.11's compact framing
-/// has vectors of its own, `compact.rs`).
+/// has vectors of its own, `compact.rs`, and 3.12's compact table
+/// `table.rs`).
 fn opts() -> EncodeOptions {
     EncodeOptions {
         position_mode: PositionMode::Optimal,
@@ -138,6 +140,7 @@ pub fn generate(real_data: &Path) -> Result<Generated, String> {
     malformed::malformed_vectors(&mut specs);
     reach::reach_vectors(&mut specs);
     compact::compact_vectors(&mut specs);
+    table::table_vectors(&mut specs);
     let mut files = BTreeMap::new();
     let mut vectors = Vec::new();
     for spec in specs.0 {

@@ -12,7 +12,7 @@ use splitstream_decoder_core::writer::{
 };
 use splitstream_decoder_core::{
     DeficitContexts, Header, Inflater, LevelHeader, LevelTable, PlanePolicy, WingPolicy, crc32,
-    head_len,
+    fixed_head_len,
 };
 
 /// One level's content, substreams as raw bytes.
@@ -178,7 +178,7 @@ pub fn table_entry(k: u16) -> usize {
 
 /// Recomputes the level-table CRC (SPEC §4.2).
 pub fn fix_table_crc(s: &mut [u8]) {
-    let end = head_len(level_count(s)) - 4;
+    let end = fixed_head_len(level_count(s)) - 4;
     let crc = crc32(&s[HEADER_LEN..end]);
     s[end..end + 4].copy_from_slice(&crc.to_le_bytes());
 }
@@ -281,7 +281,7 @@ pub fn wrap_chunks_in_deflate(stream: &[u8]) -> Vec<u8> {
 /// `malformed`), with every CRC and length made to match it.
 pub fn wrap_chunks_in_deflate_with(stream: &[u8], extra_byte: Option<(u16, usize)>) -> Vec<u8> {
     let levels = level_count(stream);
-    let head = head_len(levels);
+    let head = fixed_head_len(levels);
     let mut out = stream[..head].to_vec();
     for k in 0..levels {
         let start = level_range(stream, k).start;
@@ -373,7 +373,7 @@ pub fn rans_layout(s: &[u8], payload: Range<usize>, contexts: usize, lanes: usiz
 /// every framing check passes.
 pub fn with_chunk_payload(stream: &[u8], k: u16, c: usize, payload: Vec<u8>) -> Vec<u8> {
     let levels = level_count(stream);
-    let mut out = stream[..head_len(levels)].to_vec();
+    let mut out = stream[..fixed_head_len(levels)].to_vec();
     for l in 0..levels {
         let range = level_range(stream, l);
         let mut level = stream[range.clone()].to_vec();

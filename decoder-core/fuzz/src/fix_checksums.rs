@@ -18,18 +18,39 @@ pub fn fix_checksums(stream: &mut [u8]) {
     let crc = crc32(&stream[..HEADER_LEN - 4]);
     stream[HEADER_LEN - 4..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
     let level_count = u16::from_le_bytes([stream[14], stream[15]]) as usize;
-    // Header flag bit 2: the compact level framing (SPEC §5.1.1, 3.11).
+    // Header flag bit 2: the compact level framing (SPEC §5.1.1, 3.11);
+    // bit 3: the compact level table (§4.3, 3.12), `table_len` at 28.
     let compact = stream[10] & 4 != 0;
-    let table_end = HEADER_LEN + ENTRY * level_count;
-    if stream.len() < table_end + 4 {
+    let compact_table = stream[10] & 8 != 0;
+    let table_end = if compact_table {
+        let Some(table_len) = rd32(stream, 28) else {
+            return;
+        };
+        (HEADER_LEN + table_len as usize).saturating_sub(4)
+    } else {
+        HEADER_LEN + ENTRY * level_count
+    };
+    if stream.len() < table_end + 4 || table_end < HEADER_LEN {
         return;
     }
     let crc = crc32(&stream[HEADER_LEN..table_end]);
     stream[table_end..table_end + 4].copy_from_slice(&crc.to_le_bytes());
-    for k in 0..level_count {
-        let at = HEADER_LEN + ENTRY * k;
-        let offset = u64::from_le_bytes(stream[at..at + 8].try_into().unwrap());
-        let length = rd32(stream, at + 8).unwrap_or(0) as u64;
+    let ranges: Vec<(u64, u64)> = if compact_table {
+        compact_ranges(
+            &stream[HEADER_LEN..table_end],
+            level_count,
+            table_end as u64 + 4,
+        )
+    } else {
+        (0..level_count)
+            .map(|k| {
+                let at = HEADER_LEN + ENTRY * k;
+                let offset = u64::from_le_bytes(stream[at..at + 8].try_into().unwrap());
+                (offset, rd32(stream, at + 8).unwrap_or(0) as u64)
+            })
+            .collect()
+    };
+    for (k, (offset, length)) in ranges.into_iter().enumerate() {
         let Some(end) = offset.checked_add(length) else {
             return;
         };
@@ -60,6 +81,37 @@ pub fn fix_checksums(stream: &mut [u8]) {
         let crc = crc32(&level[..crc_at]);
         level[crc_at..crc_at + 4].copy_from_slice(&crc.to_le_bytes());
     }
+}
+
+/// Each level's offset and length from a compact table's entries (SPEC
+/// §4.3), as far as they can be read; level 0 starts at `head_len`.
+fn compact_ranges(entries: &[u8], level_count: usize, head_len: u64) -> Vec<(u64, u64)> {
+    let varint = |at: &mut usize| -> Option<u32> {
+        let mut v = 0u32;
+        for i in 0..5 {
+            let b = *entries.get(*at)?;
+            *at += 1;
+            v |= u32::from(b & 0x7F).checked_shl(7 * i)?;
+            if b & 0x80 == 0 {
+                return Some(v);
+            }
+        }
+        None
+    };
+    let mut at = 0;
+    let mut ranges = Vec::new();
+    let mut offset = head_len;
+    for _ in 0..level_count {
+        let Some(length) = varint(&mut at) else { break };
+        if (0..3).any(|_| varint(&mut at).is_none()) {
+            break;
+        }
+        ranges.push((offset, length as u64));
+        offset += length as u64;
+        // The entry's geometric error.
+        at += 4;
+    }
+    ranges
 }
 
 /// Where each directory entry's CRC lies and its `stored_len`, and where

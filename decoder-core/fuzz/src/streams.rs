@@ -621,12 +621,12 @@ pub fn generate(choices: &mut Choices<'_>, allow_invalid: bool) -> Generated {
         schedule,
         // Adaptive tables where the writer finds them smaller (format 3.9).
         adaptive_tables: true,
-        // Both framings (format 3.11), by the bit count again (no choice of
-        // its own, as above).
-        framing: if (bits / 2).is_multiple_of(2) {
-            Framing::Compact
-        } else {
-            Framing::Fixed
+        // The three framings (formats 3.11 and 3.12), by the bit count
+        // again (no choice of its own, as above).
+        framing: match (bits / 2) % 3 {
+            0 => Framing::Compact,
+            1 => Framing::Fixed,
+            _ => Framing::CompactLevels,
         },
     };
     let refinement_levels = 4 - choices.below(4);

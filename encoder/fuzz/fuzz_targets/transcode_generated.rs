@@ -62,12 +62,12 @@ fn options(choices: &mut Choices<'_>, input: Schedule, mode: PositionMode) -> Tr
         // read last, so that an input of the earlier corpora, whose bytes
         // ran out before, keeps the default (a zero byte).
         adaptive_tables: choices.byte() & 1 == 0,
-        // The framing (3.11): read after every earlier choice, for the same
-        // reason (a zero byte: compact, the default).
-        framing: if choices.byte() & 1 == 0 {
-            Framing::Compact
-        } else {
-            Framing::Fixed
+        // The framing (3.11, 3.12): read after every earlier choice, for
+        // the same reason (a zero byte: compact, the default).
+        framing: match choices.byte() % 3 {
+            0 => Framing::Compact,
+            1 => Framing::Fixed,
+            _ => Framing::CompactLevels,
         },
     }
 }

@@ -20,12 +20,17 @@ pub enum TablesArg {
     Static,
 }
 
-/// `--framing`: how the level headers are laid out (SPEC §5.1.1).
+/// `--framing`: how the level table and level headers are laid out (SPEC
+/// §4.3, §5.1.1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum FramingArg {
-    /// Varint counts and lengths (format 3.11): 7–10 bytes a chunk and
-    /// 1–2 a round instead of 16 and 4.
+    /// Varint counts and lengths in the level table (format 3.12: 8–12
+    /// bytes a level instead of 32) and in the level headers (3.11: 7–10
+    /// bytes a chunk and 1–2 a round instead of 16 and 4).
     Compact,
+    /// Compact level headers and the fixed level table (3.11 decoders read
+    /// the stream).
+    CompactLevels,
     /// Fixed-width fields (3.10 decoders read the stream).
     Fixed,
 }
@@ -58,10 +63,12 @@ pub struct CodingArgs {
     /// (SPEC §5.5.2).
     #[arg(long, value_enum, default_value_t = TablesArg::Adaptive)]
     pub tables: TablesArg,
-    /// How each level header is laid out: `compact`, its counts and
-    /// lengths as varints (format 3.11; 380–900 bytes less a 5-level
-    /// stream, a tenth of a small terrain tile), or `fixed`, 32-bit fields
-    /// (3.10 decoders read the stream) (SPEC §5.1.1).
+    /// How the level table and each level header are laid out: `compact`,
+    /// their counts and lengths as varints (format 3.12; 480–1,000 bytes
+    /// less a 5-level stream, a sixth of a 33 × 33 terrain tile),
+    /// `compact-levels`, the level headers only (3.11 decoders read the
+    /// stream), or `fixed`, 32-bit fields (3.10 decoders read the stream)
+    /// (SPEC §4.3, §5.1.1).
     #[arg(long, value_enum, default_value_t = FramingArg::Compact)]
     pub framing: FramingArg,
     /// Which axis of each position residual the split's plane predicts, or
@@ -130,6 +137,7 @@ impl CodingArgs {
             adaptive_tables: self.tables == TablesArg::Adaptive,
             framing: match self.framing {
                 FramingArg::Compact => Framing::Compact,
+                FramingArg::CompactLevels => Framing::CompactLevels,
                 FramingArg::Fixed => Framing::Fixed,
             },
             plane: self.plane(),

@@ -66,7 +66,7 @@ pub fn run(
     let mut ws = OwnedWorkspace::for_stream(stream).map_err(fail)?;
     let mut decoder = ws.decoder(stream).map_err(fail)?;
     println!("level   vertices  triangles   bytes  total bytes  geometric error (m)  decode ms");
-    let mut total = splitstream_decoder_core::head_len(decoder.header().level_count) as u64;
+    let mut total = decoder.header().head_len() as u64;
     while let Some(k) = decoder.next_level() {
         let bytes = decoder.level_bytes(k, stream).map_err(fail)?;
         let t = Instant::now();

@@ -85,7 +85,7 @@ fn field_sizes_of(
     levels: u16,
 ) -> Result<FieldSizes, String> {
     let mut sizes = FieldSizes {
-        framing: splitstream_decoder_core::head_len(header.level_count) as u64,
+        framing: header.head_len() as u64,
         ..FieldSizes::default()
     };
     for k in 0..levels {
@@ -265,10 +265,7 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
     // one's vertices).
     let (vertices_held, bytes_held) = match in_file {
         k if k == table.len() => (header.vertex_capacity, stream.len() as u64),
-        0 => (
-            0,
-            splitstream_decoder_core::head_len(header.level_count) as u64,
-        ),
+        0 => (0, header.head_len() as u64),
         k => {
             let e = table.get(k - 1);
             (e.vertex_count, e.offset + e.length as u64)
@@ -416,9 +413,10 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
         header.bits, header.origin, header.scale
     );
     println!(
-        "  schedule: {}; level headers: {} framing (SPEC §3.2, §5.1)",
+        "  schedule: {}; framing: {} (level table {} bytes, SPEC §3.2, §4, §5.1)",
         header.schedule.name(),
-        header.framing.name()
+        header.framing.name(),
+        header.table_len
     );
     println!(
         "  decoder memory: {} bytes ({:.1} bytes/vertex), stored and deflate chunks up to {} bytes",

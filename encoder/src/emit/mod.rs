@@ -67,9 +67,10 @@ pub struct EncodeOptions {
     /// that is smaller (SPEC §5.5.2, format 3.9); without, 3.8 decoders
     /// read the stream.
     pub adaptive_tables: bool,
-    /// How the level headers are laid out (SPEC §3.2 flag bit 2, §5.1.1):
-    /// by default `compact` (format 3.11); `fixed` keeps the stream
-    /// readable by 3.10 decoders.
+    /// How the level table and level headers are laid out (SPEC §3.2 flag
+    /// bits 2 and 3, §4.3, §5.1.1): by default `compact` (format 3.12);
+    /// `compact-levels` keeps the stream readable by 3.11 decoders,
+    /// `fixed` by 3.10 ones.
     pub framing: Framing,
     pub lock_boundary: bool,
     pub admit_quantile: f64,

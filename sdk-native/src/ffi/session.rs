@@ -19,7 +19,7 @@ use core::ptr::NonNull;
 
 use splitstream_decoder_core::owned::OwnedWorkspace;
 use splitstream_decoder_core::{
-    Decoder, Error, Header, LevelDecoder, LevelInfo, MeshState, RoundInfo, head_len, layout_for,
+    Decoder, Error, Header, LevelDecoder, LevelInfo, MeshState, RoundInfo, layout_for,
     level_within_error,
 };
 
@@ -74,7 +74,7 @@ impl Session {
     /// not even the base level fits.
     pub fn open_within(head: &[u8], max_bytes: u64) -> Result<Session, Error> {
         let header = Header::parse(head)?;
-        let len = head_len(header.level_count);
+        let len = header.head_len();
         let head: Box<[u8]> = head.get(..len).ok_or(Error::Truncated)?.into();
         // Checks the level table and the declared size, refuses absurd ones.
         let workspace = Box::new(OwnedWorkspace::within(&head, max_bytes)?);
@@ -97,9 +97,7 @@ impl Session {
                 return Err(e);
             }
         };
-        let levels = (0..header.level_count)
-            .map(|k| decoder.level_table().get(k))
-            .collect();
+        let levels = decoder.level_table().iter().collect();
         let levels_that_fit = decoder.levels_that_fit();
         // SPEC §9's size for the levels that fit (the header's for all).
         let workspace_bytes = layout_for(&header, decoder.level_table(), levels_that_fit - 1).total;
@@ -123,7 +121,7 @@ impl Session {
     /// Bytes of header and level table, from the 96-byte header alone (so a
     /// client knows how much to fetch before [`Session::open`]).
     pub fn head_len(header: &[u8]) -> Result<usize, Error> {
-        Ok(head_len(Header::parse(header)?.level_count))
+        Ok(Header::parse(header)?.head_len())
     }
 
     /// The decoder, while no level borrows it (callers check; the assert
