@@ -556,6 +556,10 @@ fn every_framing_decodes_to_the_same_mesh_and_compact_is_smallest() {
     let doc: serde_json::Value =
         serde_json::from_str(&succeeded(&splitstream(&["info", f, "--json"]))).unwrap();
     assert_eq!(doc["framing"], "fixed", "{doc}");
+    // What a client fetches first: the header and the (compact) table.
+    let doc: serde_json::Value =
+        serde_json::from_str(&succeeded(&splitstream(&["info", c, "--json"]))).unwrap();
+    assert_eq!(doc["head_len"], head(&compact), "{doc}");
     let mesh = |p: &PathBuf| {
         let m = splitstream_decoder_core::owned::decode_all(&bytes(p), false).unwrap();
         (m.positions, m.triangles)

@@ -347,6 +347,7 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
             "connectivity_bits_per_vertex": bpv(connectivity),
             "geometry_bits_per_vertex": bpv(geometry),
             "framing_bytes": sizes.framing,
+            "head_len": header.head_len(),
             "rans_tables": sizes.tables.iter().sum::<u32>(),
             "rans_tables_adaptive": sizes.adaptive_tables.iter().sum::<u32>(),
             "workspace_bytes": header.workspace_bytes,
