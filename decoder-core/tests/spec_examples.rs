@@ -22,6 +22,10 @@ fn params() -> StreamParams {
 }
 
 fn tetra_stream() -> Vec<u8> {
+    tetra_stream_framed(splitstream_decoder_core::Framing::Fixed)
+}
+
+fn tetra_stream_framed(framing: splitstream_decoder_core::Framing) -> Vec<u8> {
     let positions = [[0i32, 0, 0], [10, 0, 0], [0, 10, 0], [0, 0, 10]];
     let triangles = [[0u32, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
     let deficits = [0u8, LEAF, LEAF, LEAF];
@@ -78,7 +82,13 @@ fn tetra_stream() -> Vec<u8> {
         triangle_count: 6,
         geometric_error: 0.0,
     };
-    write_stream(&params(), &[base, l1])
+    write_stream(
+        &StreamParams {
+            framing,
+            ..params()
+        },
+        &[base, l1],
+    )
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -94,6 +104,34 @@ fn hex(bytes: &[u8]) -> String {
 }
 
 const SPEC: &str = include_str!("../SPEC.md");
+
+/// Appendix A's compact framing (formats 3.11 and 3.12): the header's
+/// flags, version and `table_len`, and the compact table's bytes, as
+/// quoted; the stream decodes to the fixed one's hashes.
+#[test]
+fn appendix_a_tetrahedron_compact() {
+    use splitstream_decoder_core::{Framing, Header};
+    let stream = tetra_stream_framed(Framing::Compact);
+    let header = Header::parse(&stream).unwrap();
+    let head = header.head_len();
+    if std::env::var("DUMP").is_ok() {
+        println!("{} bytes, head_len {head}", stream.len());
+        println!("{}", hex(&stream[..head]));
+    }
+    assert_eq!(&stream[8..12], &[3, 12, 0x0c, 0]);
+    assert_eq!(header.table_len, 20);
+    assert_eq!(&stream[28..32], &[20, 0, 0, 0]);
+    let table = stream[96..head]
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect::<Vec<_>>()
+        .join(" ");
+    assert!(SPEC.contains(&format!("`{table}`")), "{table}");
+    assert!(SPEC.contains(&format!("{} bytes in all", stream.len())));
+    let fixed = decode_all(&tetra_stream(), true).unwrap();
+    let compact = decode_all(&stream, true).unwrap();
+    assert_eq!(fixed.round_hashes, compact.round_hashes);
+}
 
 #[test]
 fn appendix_a_tetrahedron() {
