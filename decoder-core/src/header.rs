@@ -301,7 +301,7 @@ impl Header {
     /// checksum included (SPEC §3.3, §4.1, §4.3): what a client fetches
     /// before it knows every level's byte range.
     pub fn head_len(&self) -> usize {
-        HEADER_LEN + self.table_len as usize
+        HEADER_LEN.saturating_add(self.table_len as usize)
     }
 
     /// Real coordinates of a quantized position: `origin + q * scale` (SPEC §3.2).

@@ -117,7 +117,13 @@ impl<'h> LevelTable<'h> {
     pub fn parse(stream_head: &'h [u8], header: &Header) -> Result<LevelTable<'h>, Error> {
         let end = header.head_len();
         let bytes = stream_head.get(HEADER_LEN..end).ok_or(Error::Truncated)?;
-        let body = &bytes[..bytes.len() - 4];
+        // A parsed header's table holds its CRC at least; a header built
+        // by hand may say otherwise.
+        let body_len = bytes
+            .len()
+            .checked_sub(4)
+            .ok_or(Error::InvalidHeader("level table shorter than its CRC"))?;
+        let body = &bytes[..body_len];
         if crc32(body) != u32_at(bytes, body.len())? {
             return Err(Error::ChecksumMismatch(ChecksumScope::LevelTable));
         }
@@ -426,6 +432,18 @@ mod tests {
                 count: table.len()
             })
         );
+    }
+
+    #[test]
+    fn a_hand_built_header_with_a_table_too_short_is_refused() {
+        use crate::handmade::tetra_stream;
+        use crate::writer::ChunkCodec;
+        let stream = tetra_stream(ChunkCodec::Stored);
+        let mut header = Header::parse(&stream).unwrap();
+        for table_len in [0, 3, u32::MAX] {
+            header.table_len = table_len;
+            assert!(LevelTable::parse(&stream, &header).is_err(), "{table_len}");
+        }
     }
 
     #[test]
