@@ -23,10 +23,14 @@ const DETAILED: [&str; 5] = [
 ];
 
 /// Checks no stream can reach, kept as guards, each with its reason.
-const GUARDS: [(&str, &str); 4] = [
+const GUARDS: [(&str, &str); 5] = [
     (
         "InvalidLevelTable(\"empty\")",
         "the header already rejects level_count 0 (SPEC §3.3)",
+    ),
+    (
+        "InvalidHeader(\"level table shorter than its CRC\")",
+        "a parsed header's table is at least 8 x level_count + 4 bytes (SPEC §3.3); only a header built by hand reaches it",
     ),
     (
         "InvalidRansChunk(\"counts cannot be normalised\")",
