@@ -158,28 +158,38 @@ pub(super) fn table_vectors(s: &mut Specs) {
         body[0] & 0x80 != 0 && body[1] & 0x80 == 0,
         "a two-byte length"
     );
-    s.invalid(
-        "table-compact-varint-not-minimal",
-        "malformed",
-        "Compact level table: entry 0's length written in three bytes, the last 0x00 (SPEC §5.4's minimality); table_len and both CRCs recomputed.",
-        &["reserved", TAG],
-        failing_with("InvalidLevelTable(\"varint not minimal\")", {
-            let mut b = vec![body[0], body[1] | 0x80, 0x00];
-            b.extend_from_slice(&body[2..]);
-            with_table_body(&stored, &b)
-        }),
-    );
-    s.invalid(
-        "table-compact-varint-over-32-bits",
-        "malformed",
-        "Compact level table: entry 0's length written in five bytes whose last is 0x10 (a 33rd bit); table_len and both CRCs recomputed.",
-        &["reserved", TAG],
-        failing_with("InvalidLevelTable(\"varint over 32 bits\")", {
-            let mut b = vec![body[0], body[1] | 0x80, 0x80, 0x80, 0x10];
-            b.extend_from_slice(&body[2..]);
-            with_table_body(&stored, &b)
-        }),
-    );
+    // Entry 0's two-byte length written longer: with a last byte 0x00
+    // (not minimal), or in five bytes whose last is 0x10 (a 33rd bit).
+    for (name, detail, how, tail) in [
+        (
+            "table-compact-varint-not-minimal",
+            "varint not minimal",
+            "in three bytes, the last 0x00 (SPEC §5.4's minimality)",
+            &[0x00][..],
+        ),
+        (
+            "table-compact-varint-over-32-bits",
+            "varint over 32 bits",
+            "in five bytes whose last is 0x10 (a 33rd bit)",
+            &[0x80, 0x80, 0x10][..],
+        ),
+    ] {
+        let mut b = vec![body[0], body[1] | 0x80];
+        b.extend_from_slice(tail);
+        b.extend_from_slice(&body[2..]);
+        s.invalid(
+            name,
+            "malformed",
+            &format!(
+                "Compact level table: entry 0's length written {how}; table_len and both CRCs recomputed."
+            ),
+            &["reserved", TAG],
+            failing_with(
+                &format!("InvalidLevelTable({detail:?})"),
+                with_table_body(&stored, &b),
+            ),
+        );
+    }
     s.invalid(
         "table-compact-entry-past-end",
         "malformed",
