@@ -88,6 +88,11 @@ pub use wing_order::WingPolicy;
 #[cfg(feature = "alloc")]
 pub use writer::compact_level_table;
 
+// The README's Rust examples run as doctests, so they follow the API.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeExamples;
+
 /// Bytes of workspace (with alignment slack) needed to decode all of
 /// `stream`, from its header and level table alone (SPEC §9).
 pub fn workspace_len(head: &[u8]) -> Result<usize, Error> {

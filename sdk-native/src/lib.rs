@@ -25,3 +25,9 @@ pub mod view;
 
 pub use ffi::Session;
 pub use view::{ScreenView, ViewError};
+
+// The README's Rust examples run as doctests, so they follow the API (one
+// of them uses the `gpu` module, which the workspace's tests enable).
+#[cfg(all(doctest, feature = "gpu"))]
+#[doc = include_str!("../README.md")]
+struct ReadmeExamples;
