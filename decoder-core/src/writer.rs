@@ -779,7 +779,7 @@ fn substream_chunks(
 /// encoder compare alternatives (the plane policies of SPEC §7.4) by their
 /// cost: exact under the byte codecs, and under rANS each lane of a chunk
 /// estimated from its values' bits, within a byte of its length
-/// ([`estimated_chunk_len`]). Under rANS it keeps the chunks' cuts and
+/// (`rans_writer::estimated_chunk_len`). Under rANS it keeps the chunks' cuts and
 /// tables in `sub` for framing it or costing it again (`RansPlan`): the
 /// same bytes, found once.
 pub fn coded_len(sub: &mut SubstreamWriter, id: u8, params: &StreamParams) -> usize {

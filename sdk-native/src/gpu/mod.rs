@@ -10,7 +10,7 @@
 //! resolved positions; [`capture_stream_two_threads`], which [`decode`] and
 //! [`verify`] use, reads a large level's records on a second thread), the
 //! GPU replays every round from its flags and
-//! records ([`GpuRefiner`], [`replay`]) and its state hash is read back
+//! records ([`GpuRefiner`], [`replay()`]) and its state hash is read back
 //! after every round. Faults of a stream are found by decoder-core while
 //! reading (ring offsets included: its record reader checks `o + d < k`
 //! before the record reaches the GPU); the kernels check the same rules

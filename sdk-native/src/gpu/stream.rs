@@ -1,7 +1,7 @@
 //! The CPU side of GPU decoding, phase 1: decoder-core reads the stream
 //! (headers, chunks, entropy decoding, records with resolved positions) and
 //! applies every round itself; a [`Capture`] keeps each round's flags and
-//! records so that the GPU can replay the same rounds ([`super::replay`]).
+//! records so that the GPU can replay the same rounds ([`super::replay()`]).
 //!
 //! [`capture_stream`] reads on one thread with decoder-core's `Decoder`,
 //! a [`Capture`] observing each round's flags and records.
