@@ -4,6 +4,12 @@
 //! decoding paths run: the owned `decode_all` and the no-alloc `Decoder`
 //! over an exactly sized workspace; they must agree.
 
+/// Rewrites the header and level-table CRCs (fixed or compact table), so
+/// mutations there reach the field checks (the chunk and level-header CRCs
+/// still guard the levels).
+#[path = "../fuzz/src/fix_checksums.rs"]
+#[allow(dead_code)]
+mod fix;
 #[path = "../fuzz/src/mesh_check.rs"]
 mod mesh_check;
 #[path = "../fuzz/src/streams.rs"]
@@ -12,8 +18,8 @@ mod streams;
 use std::sync::OnceLock;
 
 use proptest::prelude::*;
+use splitstream_decoder_core::Error;
 use splitstream_decoder_core::owned::decode_all;
-use splitstream_decoder_core::{Error, crc32};
 
 fn valid_streams() -> &'static Vec<Vec<u8>> {
     static S: OnceLock<Vec<Vec<u8>>> = OnceLock::new();
@@ -67,21 +73,6 @@ fn apply(stream: &mut Vec<u8>, m: &Mutation) {
     }
 }
 
-/// Rewrites the header and level-table CRCs, so mutations there reach the
-/// field checks (the chunk and level-header CRCs still guard the levels).
-fn fix_head_checksums(s: &mut [u8]) {
-    if s.len() >= 96 {
-        let c = crc32(&s[..92]);
-        s[92..96].copy_from_slice(&c.to_le_bytes());
-        let levels = u16::from_le_bytes([s[14], s[15]]) as usize;
-        let end = 96 + 32 * levels;
-        if s.len() >= end + 4 {
-            let c = crc32(&s[96..end]);
-            s[end..end + 4].copy_from_slice(&c.to_le_bytes());
-        }
-    }
-}
-
 /// Decodes both ways; checks they agree and that a success is a manifold.
 fn decode_both(stream: &[u8]) -> Result<(), TestCaseError> {
     let owned = decode_all(stream, true);
@@ -129,7 +120,7 @@ proptest! {
             apply(&mut s, m);
         }
         if fix_head {
-            fix_head_checksums(&mut s);
+            fix::fix_head_checksums(&mut s);
         }
         decode_both(&s)?;
     }
@@ -169,4 +160,35 @@ fn all_truncations_are_errors() {
             assert!(!e.class().is_empty());
         }
     }
+}
+
+/// The head fix finds a compact table too (SPEC §4.3): a changed table byte
+/// then reaches the table's field checks, not its checksum.
+#[test]
+fn head_fix_reaches_every_framings_table() {
+    let mut framings = std::collections::BTreeSet::new();
+    for s in valid_streams() {
+        let mut fixed = s.clone();
+        let table_end = fix::fix_head_checksums(&mut fixed).expect("a valid stream has its head");
+        assert_eq!(&fixed, s, "a valid stream's checksums are already right");
+        framings.insert(s[10] & 12);
+        for at in 96..table_end {
+            let mut m = s.clone();
+            m[at] ^= 0x40;
+            fix::fix_head_checksums(&mut m);
+            let e = decode_all(&m, false).err();
+            assert!(
+                !matches!(
+                    e,
+                    Some(Error::ChecksumMismatch(
+                        splitstream_decoder_core::ChecksumScope::LevelTable
+                    ))
+                ),
+                "table byte {at} of framing {:#x}: {e:?}",
+                s[10] & 12
+            );
+        }
+    }
+    // Fixed (0), compact level headers (4) and compact table (12).
+    assert_eq!(framings.into_iter().collect::<Vec<_>>(), [0, 4, 12]);
 }

@@ -1,40 +1,29 @@
 //! Checksum rewriting for byte-level fuzzing (shared with the tests).
+
+/// The header's length (SPEC §3.1).
+const HEADER_LEN: usize = 96;
+/// A fixed level table's entry (SPEC §4.1).
+const ENTRY: usize = 32;
+
 /// Rewrites every checksum of `stream` that can be located (header, level
 /// table, level headers, chunks) to match its bytes, so that byte-level
 /// mutations reach the parsers and the split logic behind the CRCs.
 /// Best effort: stops where the structure cannot be followed.
 pub fn fix_checksums(stream: &mut [u8]) {
     use splitstream_decoder_core::crc32;
-    const HEADER_LEN: usize = 96;
-    const ENTRY: usize = 32;
     let rd32 = |b: &[u8], at: usize| -> Option<u32> {
         Some(u32::from_le_bytes(
             b.get(at..at.checked_add(4)?)?.try_into().ok()?,
         ))
     };
-    if stream.len() < HEADER_LEN {
+    let Some(table_end) = fix_head_checksums(stream) else {
         return;
-    }
-    let crc = crc32(&stream[..HEADER_LEN - 4]);
-    stream[HEADER_LEN - 4..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
+    };
     let level_count = u16::from_le_bytes([stream[14], stream[15]]) as usize;
     // Header flag bit 2: the compact level framing (SPEC §5.1.1, 3.11);
-    // bit 3: the compact level table (§4.3, 3.12), `table_len` at 28.
+    // bit 3: the compact level table (§4.3, 3.12).
     let compact = stream[10] & 4 != 0;
     let compact_table = stream[10] & 8 != 0;
-    let table_end = if compact_table {
-        let Some(table_len) = rd32(stream, 28) else {
-            return;
-        };
-        (HEADER_LEN + table_len as usize).saturating_sub(4)
-    } else {
-        HEADER_LEN + ENTRY * level_count
-    };
-    if stream.len() < table_end + 4 || table_end < HEADER_LEN {
-        return;
-    }
-    let crc = crc32(&stream[HEADER_LEN..table_end]);
-    stream[table_end..table_end + 4].copy_from_slice(&crc.to_le_bytes());
     let ranges: Vec<(u64, u64)> = if compact_table {
         compact_ranges(
             &stream[HEADER_LEN..table_end],
@@ -81,6 +70,32 @@ pub fn fix_checksums(stream: &mut [u8]) {
         let crc = crc32(&level[..crc_at]);
         level[crc_at..crc_at + 4].copy_from_slice(&crc.to_le_bytes());
     }
+}
+
+/// Rewrites the header's checksum and the level table's (SPEC §3.3, §4.2),
+/// wherever the header's flags and `table_len` put the table (fixed or
+/// compact, §4.3), and answers where the table's CRC lies; `None`, with
+/// the table's CRC untouched, where the stream is too short for it.
+pub fn fix_head_checksums(stream: &mut [u8]) -> Option<usize> {
+    use splitstream_decoder_core::crc32;
+    if stream.len() < HEADER_LEN {
+        return None;
+    }
+    let crc = crc32(&stream[..HEADER_LEN - 4]);
+    stream[HEADER_LEN - 4..HEADER_LEN].copy_from_slice(&crc.to_le_bytes());
+    let level_count = u16::from_le_bytes([stream[14], stream[15]]) as usize;
+    let table_end = if stream[10] & 8 != 0 {
+        let table_len = u32::from_le_bytes(stream[28..32].try_into().ok()?);
+        (HEADER_LEN + table_len as usize).saturating_sub(4)
+    } else {
+        HEADER_LEN + ENTRY * level_count
+    };
+    if stream.len() < table_end + 4 || table_end < HEADER_LEN {
+        return None;
+    }
+    let crc = crc32(&stream[HEADER_LEN..table_end]);
+    stream[table_end..table_end + 4].copy_from_slice(&crc.to_le_bytes());
+    Some(table_end)
 }
 
 /// Each level's offset and length from a compact table's entries (SPEC

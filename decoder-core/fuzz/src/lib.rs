@@ -71,4 +71,4 @@ pub fn needed(stream: &[u8]) -> Option<usize> {
 }
 
 mod fix_checksums;
-pub use fix_checksums::fix_checksums;
+pub use fix_checksums::{fix_checksums, fix_head_checksums};
