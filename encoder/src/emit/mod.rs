@@ -24,7 +24,7 @@ use crate::mesh::Mesh;
 use crate::quantize::{GridError, Lattice, Quantization, QuantizedMesh, Units, quantize_with};
 use crate::simplify::{Backend, Checked, GpuError, SimplifyOptions, simplify_on};
 use crate::spatial_order::spatially_ordered;
-pub use levels::plan_levels;
+pub use levels::{LevelPlan, plan_levels};
 pub use replay::{ReplayError, ReplayOptions, positions_first_allowed, replay};
 use std::borrow::Cow;
 pub use transcode::{TranscodeError, TranscodeOptions, Transcoded, transcode};
