@@ -143,9 +143,64 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let header = parser
         .read_header(&mut reader)
         .map_err(|e| ply_error(file, &e, true))?;
-    let payload = parser
-        .read_payload(&mut reader, &header)
-        .map_err(|e| ply_error(file, &e, header.encoding == Encoding::Ascii))?;
+    let vertex_count = check_header(file, &header)?;
+    let mut mesh = Mesh {
+        positions: Vec::with_capacity(vertex_count.min(PREALLOCATED)),
+        triangles: Vec::new(),
+    };
+    let mut faces = Faces {
+        vertex_count,
+        read: 0,
+        scratch: Vec::new(),
+    };
+    // Each element goes into the mesh as it is read: holding them all
+    // first, as `read_payload` does, kept a `Vec` alive per face (about 100
+    // bytes a face) and walked them all again.
+    for (name, def) in &header.elements {
+        if name == "face" {
+            mesh.triangles.reserve(def.count.min(PREALLOCATED));
+        }
+        let mut keep = |e: Element| match name.as_str() {
+            "vertex" => {
+                mesh.positions.push(e.xyz);
+                Ok(())
+            }
+            "face" => faces.push(&mut mesh.triangles, &e, file),
+            _ => Ok(()),
+        };
+        match header.encoding {
+            Encoding::Ascii => {
+                let elements = parser
+                    .read_payload_for_element(&mut reader, def, &header)
+                    .map_err(|e| ply_error(file, &e, true))?;
+                elements.into_iter().try_for_each(keep)?;
+            }
+            encoding => {
+                let big = encoding == Encoding::BinaryBigEndian;
+                for i in 0..def.count {
+                    let inner = reader.get_mut();
+                    let e = if big {
+                        parser.read_big_endian_element(inner, def)
+                    } else {
+                        parser.read_little_endian_element(inner, def)
+                    };
+                    let e = e.map_err(|e| binary_error(file, name, i, def.count, &e))?;
+                    keep(e)?;
+                }
+            }
+        }
+    }
+    Ok(mesh)
+}
+
+/// Capacity reserved from a header's element count at most: a header may
+/// claim more elements than its file holds.
+const PREALLOCATED: usize = 1 << 20;
+
+/// Checks that the header declares what a mesh needs (`vertex` x, y, z
+/// scalars; a `face` index list) before any payload is read, and answers
+/// the vertex count.
+fn check_header(file: &str, header: &ply_rs_bw::ply::Header) -> Result<usize, InputError> {
     let vertex_def = header
         .elements
         .get("vertex")
@@ -181,27 +236,48 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
             "PLY face element has no 'vertex_indices' or 'vertex_index' list",
         ));
     }
+    check_vertex_count(file, vertex_def.count as u64)?;
+    Ok(vertex_def.count)
+}
 
-    let empty = Vec::new();
-    let vertices = payload.get("vertex").unwrap_or(&empty);
-    let faces = payload.get("face").unwrap_or(&empty);
-    check_vertex_count(file, vertices.len() as u64)?;
-    let positions: Vec<[f64; 3]> = vertices.iter().map(|v| v.xyz).collect();
-    let mut triangles = Vec::with_capacity(faces.len());
-    let mut scratch = Vec::new();
-    for (i, face) in faces.iter().enumerate() {
+/// The faces read so far, triangulated as they come.
+struct Faces {
+    /// The header's vertex count: faces may come before the vertices.
+    vertex_count: usize,
+    read: usize,
+    scratch: Vec<u32>,
+}
+
+impl Faces {
+    fn push(
+        &mut self,
+        triangles: &mut Vec<[u32; 3]>,
+        face: &Element,
+        file: &str,
+    ) -> Result<(), InputError> {
         push_polygon(
-            &mut triangles,
+            triangles,
             face.indices(),
-            positions.len(),
-            &mut scratch,
+            self.vertex_count,
+            &mut self.scratch,
         )
-        .map_err(|m| InputError::element(file, format!("face {i}"), m))?;
+        .map_err(|m| InputError::element(file, format!("face {}", self.read), m))?;
+        self.read += 1;
+        Ok(())
     }
-    Ok(Mesh {
-        positions,
-        triangles,
-    })
+}
+
+/// A binary element that could not be read, in one line: which element,
+/// which of how many, and why (most often the file ends early).
+fn binary_error(file: &str, name: &str, i: usize, count: usize, e: &ParseError) -> InputError {
+    let why = match e.kind() {
+        std::io::ErrorKind::UnexpectedEof => "the file ends".to_owned(),
+        _ => ply_error(file, e, false).to_string(),
+    };
+    InputError::malformed(
+        file,
+        format!("invalid PLY: cannot read {name} {i} of {count}: {why}"),
+    )
 }
 
 /// Turns a `ply-rs-bw` error into one readable line: the line number only
