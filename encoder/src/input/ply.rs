@@ -391,6 +391,28 @@ element face 2\nproperty list uchar uint {index_name}\nend_header\n"
         }
     }
 
+    /// PLY lets elements come in any order: faces before their vertices
+    /// are checked against the header's vertex count.
+    #[test]
+    fn faces_before_vertices() {
+        let mut out = b"ply\nformat binary_little_endian 1.0\nelement face 2\n\
+property list uchar int vertex_indices\nelement vertex 5\nproperty float x\n\
+property float y\nproperty float z\nend_header\n"
+            .to_vec();
+        for face in [&[0i32, 1, 2, 3][..], &[1, 4, 2]] {
+            out.push(face.len() as u8);
+            out.extend(face.iter().flat_map(|i| i.to_le_bytes()));
+        }
+        for p in expected().positions {
+            out.extend(p.iter().flat_map(|&c| (c as f32).to_le_bytes()));
+        }
+        let f = TempFile::new("faces-first.ply", &out);
+        assert_eq!(
+            read_mesh(&f.0, &ReadOptions::default()).unwrap(),
+            expected()
+        );
+    }
+
     #[test]
     fn truncated_binary_fails_cleanly() {
         let data = binary(false, "vertex_indices");
@@ -399,6 +421,9 @@ element face 2\nproperty list uchar uint {index_name}\nend_header\n"
             let err = read_mesh(&f.0, &ReadOptions::default()).unwrap_err();
             let msg = err.to_string();
             assert!(msg.contains("trunc.ply") && !msg.contains('\n'), "{msg}");
+            if cut > 200 {
+                assert!(msg.contains("of 2: the file ends"), "{msg}");
+            }
         }
     }
 
