@@ -13,27 +13,31 @@
 //! every other statement (`vt`, `vn`, `o`, `g`, `usemtl`, `l`, …) is
 //! skipped. Coordinates stay f64.
 
+use std::borrow::Cow;
 use std::path::Path;
 
 use crate::Mesh;
 
-use super::{InputError, check_vertex_count};
+use super::{InputError, ascii_lines, check_vertex_count, text_of};
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let bytes = std::fs::read(path).map_err(|e| InputError::io(file, e))?;
-    let text = String::from_utf8_lossy(&bytes);
-    parse(&text, file)
+    parse(&text_of(&bytes), file)
 }
 
 /// The statements of `text`, each with the line it starts on (1-based),
-/// continuation lines (`\` at a line's end) joined.
-fn statements(text: &str) -> impl Iterator<Item = (usize, String)> + '_ {
-    let mut lines = text.lines().enumerate();
+/// continuation lines (`\` at a line's end) joined. A statement of one
+/// line, nearly all of them, is borrowed from `text`, not copied.
+fn statements(text: &str) -> impl Iterator<Item = (usize, Cow<'_, str>)> + '_ {
+    let mut lines = ascii_lines(text).enumerate();
     std::iter::from_fn(move || {
         let (i, first) = lines.next()?;
+        if !first.trim_ascii_end().ends_with('\\') {
+            return Some((i + 1, Cow::Borrowed(first)));
+        }
         let mut statement = first.to_string();
-        while statement.trim_end().ends_with('\\') {
-            let cut = statement.trim_end().len() - 1;
+        while statement.trim_ascii_end().ends_with('\\') {
+            let cut = statement.trim_ascii_end().len() - 1;
             statement.truncate(cut);
             match lines.next() {
                 Some((_, more)) => {
@@ -43,7 +47,7 @@ fn statements(text: &str) -> impl Iterator<Item = (usize, String)> + '_ {
                 None => break,
             }
         }
-        Some((i + 1, statement))
+        Some((i + 1, Cow::Owned(statement)))
     })
 }
 
@@ -54,7 +58,8 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
     let mut corners: Vec<(i64, usize)> = Vec::new();
     let mut polygon: Vec<(i64, usize)> = Vec::new();
     for (line, statement) in statements(text) {
-        let mut words = statement.split_whitespace();
+        // OBJ is ASCII: its separators are ASCII blanks.
+        let mut words = statement.split_ascii_whitespace();
         match words.next() {
             Some("v") => {
                 let mut xyz = [0.0f64; 3];
@@ -73,7 +78,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
             Some("f") => {
                 polygon.clear();
                 for word in words {
-                    let v = word.split('/').next().unwrap_or("");
+                    let v = word.split_once('/').map_or(word, |(v, _)| v);
                     let index: i64 = v.parse().map_err(|_| {
                         InputError::line(file, line, format!("'{word}' is not a vertex index"))
                     })?;

@@ -8,19 +8,18 @@ use std::path::Path;
 
 use crate::Mesh;
 
-use super::{InputError, check_vertex_count, push_polygon};
+use super::{InputError, ascii_lines, check_vertex_count, push_polygon, text_of};
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let bytes = std::fs::read(path).map_err(|e| InputError::io(file, e))?;
-    let text = String::from_utf8_lossy(&bytes);
-    parse(&text, file)
+    parse(&text_of(&bytes), file)
 }
 
 /// Non-empty lines with comments stripped, with their 1-based numbers.
 fn content_lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
-    text.lines()
+    ascii_lines(text)
         .enumerate()
-        .map(|(i, l)| (i + 1, l.split('#').next().unwrap_or("").trim()))
+        .map(|(i, l)| (i + 1, l.split('#').next().unwrap_or("").trim_ascii()))
         .filter(|(_, l)| !l.is_empty())
 }
 
@@ -41,7 +40,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
     let (line_no, header) = lines
         .next()
         .ok_or_else(|| InputError::malformed(file, "empty file (expected an 'OFF' header)"))?;
-    let mut tokens = header.split_whitespace();
+    let mut tokens = header.split_ascii_whitespace();
     let keyword = tokens.next().unwrap_or("");
     let known = [
         "OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF",
@@ -72,7 +71,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
             .next()
             .ok_or_else(|| InputError::line(file, line_no, "missing vertex and face counts"))?;
         counts_line = n;
-        rest = l.split_whitespace().collect();
+        rest = l.split_ascii_whitespace().collect();
     }
     let mut counts = rest.into_iter();
     let nv = parse_count(file, counts_line, counts.next(), "vertex count")?;
@@ -94,7 +93,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
         last_line = n;
         let mut p = [0.0; 3];
         let mut found = 0;
-        for (k, token) in l.split_whitespace().take(3).enumerate() {
+        for (k, token) in l.split_ascii_whitespace().take(3).enumerate() {
             p[k] = token.parse::<f64>().map_err(|_| {
                 InputError::line(file, n, format!("vertex {i}: invalid coordinate '{token}'"))
             })?;
@@ -121,7 +120,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
             )
         })?;
         last_line = n;
-        let mut tokens = l.split_whitespace();
+        let mut tokens = l.split_ascii_whitespace();
         let count = parse_count(file, n, tokens.next(), "face vertex count")?;
         // The line holds at most one index per two bytes: a count beyond
         // that fails below, without reserving memory for it first.
