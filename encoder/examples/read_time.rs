@@ -2,7 +2,7 @@
 //! `cargo run --release -p splitstream-encoder --example read_time -- FILE... [--runs N]`.
 //! Prints each file's median and fastest read of N (default 5), and a
 //! digest of what was read, so that two readers can be compared on the
-//! same files (encoder/BENCHMARKS.md, "Reading PLY, OBJ and OFF files faster").
+//! same files (encoder/BENCHMARKS.md, "Reading PLY, OBJ, OFF and glTF files faster").
 use splitstream_encoder::input::{ReadOptions, read_mesh};
 
 fn main() {

@@ -77,7 +77,7 @@ pub(super) fn parse(bytes: &[u8], base: Option<&Path>, file: &str) -> Result<Mes
         bin,
         buffers: vec![None; root.buffers.len()],
         mesh: Mesh::default(),
-        weld: HashMap::new(),
+        weld: HashMap::default(),
         non_triangle_primitives: 0,
     };
     for (mesh, world) in reader.instances()? {
@@ -224,7 +224,9 @@ struct Reader<'a> {
     buffers: Vec<Option<Vec<u8>>>,
     mesh: Mesh,
     /// World position (bit patterns, -0 folded into 0) → vertex id.
-    weld: HashMap<[u64; 3], u32>,
+    /// Welded ids by position bits (foldhash: a file is not a hash-flooding
+    /// threat worth SipHash's cost, several times foldhash's on 24-byte keys).
+    weld: HashMap<[u64; 3], u32, foldhash::fast::RandomState>,
     non_triangle_primitives: usize,
 }
 
@@ -359,6 +361,7 @@ impl<'a> Reader<'a> {
         for &c in triangles.iter().flatten() {
             ids[c as usize] = 0;
         }
+        self.weld.reserve(local.len());
         for (id, &p) in ids.iter_mut().zip(local) {
             if *id == UNUSED {
                 continue;
