@@ -31,7 +31,7 @@ struct Input {
     units: Units,
 }
 
-const INPUTS: [Input; 5] = [
+const INPUTS: [Input; 6] = [
     Input {
         name: "armadillo",
         file: "armadillo.off",
@@ -55,6 +55,13 @@ const INPUTS: [Input; 5] = [
     Input {
         name: "jacksboro DEM",
         file: "jacksboro_fault_dem.npz",
+        units: Units::Geographic,
+    },
+    // matplotlib's second sample raster: 91 x 120 samples, land and sea
+    // floor, its longitudes and latitudes in the file.
+    Input {
+        name: "topobathy DEM",
+        file: "topobathy.npz",
         units: Units::Geographic,
     },
 ];
