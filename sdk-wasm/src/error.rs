@@ -3,6 +3,7 @@
 use std::fmt;
 
 use splitstream_decoder_core::Error;
+#[cfg(feature = "grid")]
 use splitstream_sdk_native::grid_tile::GridTileError;
 use wasm_bindgen::JsValue;
 
@@ -33,6 +34,7 @@ impl From<Error> for SdkError {
     }
 }
 
+#[cfg(feature = "grid")]
 impl From<GridTileError> for SdkError {
     fn from(e: GridTileError) -> Self {
         SdkError {

@@ -1,6 +1,6 @@
 //! Browser SDK for splitstream streams: wasm-bindgen bindings of
 //! splitstream-sdk-native's progressive decoder ([`StreamDecoder`]) and
-//! grid-tile simplifier ([`GridSimplifier`]). `wasm-bindgen` writes the
+//! grid-tile simplifier (`GridSimplifier`, feature `grid`, on by default). `wasm-bindgen` writes the
 //! JavaScript glue and the TypeScript `.d.ts`; usage is in README.md.
 //!
 //! Errors reach JavaScript as exceptions: `Error` objects named
@@ -15,10 +15,12 @@
 
 mod decoder;
 mod error;
+#[cfg(feature = "grid")]
 mod grid;
 
 pub use decoder::StreamDecoder;
 pub use error::SdkError;
+#[cfg(feature = "grid")]
 pub use grid::{GridSimplifier, TileStats};
 
 #[cfg(test)]

@@ -5,7 +5,9 @@ use std::path::PathBuf;
 
 use serde_json::Value;
 
-use crate::{GridSimplifier, SdkError, StreamDecoder};
+#[cfg(feature = "grid")]
+use crate::GridSimplifier;
+use crate::{SdkError, StreamDecoder};
 
 /// The newest vector set: `conformance/vectors/<version>/`.
 fn vector_dir() -> PathBuf {
@@ -220,6 +222,7 @@ fn head_length_needs_the_header() {
     assert_eq!(e.class, "truncated");
 }
 
+#[cfg(feature = "grid")]
 #[test]
 fn grid_simplifier_wraps_the_tile_simplifier() {
     let (rows, cols) = (33, 17);
