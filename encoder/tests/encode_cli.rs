@@ -127,6 +127,19 @@ fn bad_streams_and_arguments_get_one_line_naming_the_file() {
     }
     let described = succeeded(&splitstream(&["info", c]));
     assert!(described.contains("truncated: levels "), "{described}");
+    // Cut inside level 0: no field table (it had no vertex to count bits
+    // per, and printed NaN).
+    let head_len = splitstream_decoder_core::Header::parse(&bytes)
+        .unwrap()
+        .head_len();
+    let early = input.with_file_name("cut-in-level-0.sps");
+    std::fs::write(&early, &bytes[..head_len + 10]).unwrap();
+    let described = succeeded(&splitstream(&["info", early.to_str().unwrap()]));
+    assert!(described.contains("no level is whole"), "{described}");
+    assert!(
+        !described.contains("NaN") && !described.contains("bits/vertex\n"),
+        "{described}"
+    );
     let garbage = temp("garbage.sps", "not a stream at all");
     let err = one_line_error(&splitstream(&["info", garbage.to_str().unwrap()]));
     assert!(err.contains("garbage.sps: not a splitstream file"), "{err}");

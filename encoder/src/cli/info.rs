@@ -213,9 +213,13 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
     let last = table.get(table.len() - 1);
     let declared_bytes = last.offset + last.length as u64;
     let truncated = (in_file < table.len()).then(|| {
+        let counted = match in_file {
+            0 => "no level is whole, so no field is counted".to_owned(),
+            1 => "the fields count level 0 only".to_owned(),
+            n => format!("the fields count levels 0..={} only", n - 1),
+        };
         format!(
-            "truncated: levels {in_file}..={} are not in the file (it has {} of {declared_bytes} bytes); \
-             the fields count levels before {in_file} only",
+            "truncated: levels {in_file}..={} are not in the file (it has {} of {declared_bytes} bytes); {counted}",
             table.len() - 1,
             stream.len(),
         )
@@ -453,6 +457,10 @@ pub fn run(input: &Path, options: InfoOptions) -> CliResult {
         .iter()
         .map(|r| format!(" {:>10}", format!("as {}", r.codec)))
         .collect();
+    if in_file == 0 {
+        // No vertex to count bits per: the table would say NaN.
+        return Ok(());
+    }
     println!(
         "  field            bytes  raw bytes/values  chunks  codecs          bits/vertex{recoded_header}"
     );
