@@ -6,7 +6,7 @@
 //! `vertex_index` list are kept. Polygons are fan-triangulated.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 use ply_rs_bw::parser::{ParseError, Parser, Reader};
@@ -144,6 +144,9 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
         .read_header(&mut reader)
         .map_err(|e| ply_error(file, &e, true))?;
     let vertex_count = check_header(file, &header)?;
+    // ASCII payload lines are numbered on from the header's last line
+    // (`line()` is the number of the line the reader is at).
+    let (mut line, mut text) = (reader.line().saturating_sub(1), String::with_capacity(128));
     let mut mesh = Mesh {
         positions: Vec::with_capacity(vertex_count.min(PREALLOCATED)),
         triangles: Vec::new(),
@@ -155,7 +158,8 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     };
     // Each element goes into the mesh as it is read: holding them all
     // first, as `read_payload` does, kept a `Vec` alive per face (about 100
-    // bytes a face) and walked them all again.
+    // bytes a face) and walked them all again. The crate parses each
+    // element (`read_ascii_element`, `read_*_endian_element`).
     for (name, def) in &header.elements {
         if name == "face" {
             mesh.triangles.reserve(def.count.min(PREALLOCATED));
@@ -170,10 +174,22 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
         };
         match header.encoding {
             Encoding::Ascii => {
-                let elements = parser
-                    .read_payload_for_element(&mut reader, def, &header)
-                    .map_err(|e| ply_error(file, &e, true))?;
-                elements.into_iter().try_for_each(keep)?;
+                // One element a line, read into one reused `String`.
+                for i in 0..def.count {
+                    line += 1;
+                    text.clear();
+                    let read = reader.get_mut().read_line(&mut text).map_err(|e| {
+                        InputError::line(file, line, format!("cannot read {name} {i}: {e}"))
+                    })?;
+                    if read == 0 {
+                        let why = format!("the file ends: cannot read {name} {i} of {}", def.count);
+                        return Err(InputError::line(file, line, why));
+                    }
+                    let e = parser
+                        .read_ascii_element(&text, def)
+                        .map_err(|e| InputError::line(file, line, ply_message(&e)))?;
+                    keep(e)?;
+                }
             }
             encoding => {
                 let big = encoding == Encoding::BinaryBigEndian;
@@ -284,12 +300,22 @@ fn binary_error(file: &str, name: &str, i: usize, count: usize, e: &ParseError) 
 /// where lines mean something (header, ascii payload), and the offending
 /// text plus the innermost cause instead of the nested restatements.
 fn ply_error(file: &str, e: &ParseError, text: bool) -> InputError {
+    let message = ply_message(e);
+    match e.line() {
+        Some(line) if text && line > 0 => InputError::line(file, line, message),
+        _ => InputError::malformed(file, format!("invalid PLY: {message}")),
+    }
+}
+
+/// The readable part of a `ply-rs-bw` error: the offending text and the
+/// innermost cause.
+fn ply_message(e: &ParseError) -> String {
     let message = e.to_string();
     let message = match message.strip_prefix("Line ") {
         Some(rest) => rest.split_once(": ").map_or(message.as_str(), |(_, m)| m),
         None => message.as_str(),
     };
-    let message = match (
+    match (
         message.split_once("String: '"),
         message.rsplit_once("Error: "),
     ) {
@@ -298,10 +324,6 @@ fn ply_error(file: &str, e: &ParseError, text: bool) -> InputError {
             format!("cannot parse '{quoted}': {cause}")
         }
         _ => message.to_owned(),
-    };
-    match e.line() {
-        Some(line) if text && line > 0 => InputError::line(file, line, message),
-        _ => InputError::malformed(file, format!("invalid PLY: {message}")),
     }
 }
 
