@@ -476,6 +476,17 @@ property float y\nproperty float z\nend_header\n"
         let msg = read_mesh(&f.0, &ReadOptions::default())
             .unwrap_err()
             .to_string();
-        assert!(msg.contains("line") && !msg.contains('\n'), "{msg}");
+        assert!(msg.contains("line 14: ") && !msg.contains('\n'), "{msg}");
+
+        // An ASCII payload one line short: the line it ran out at.
+        let short = ASCII.strip_suffix("3 1 4 2\n").unwrap();
+        let f = TempFile::new("short.ply", short.as_bytes());
+        let msg = read_mesh(&f.0, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.ends_with("short.ply: line 18: the file ends: cannot read face 1 of 2"),
+            "{msg}"
+        );
     }
 }
