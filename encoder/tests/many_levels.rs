@@ -6,7 +6,7 @@
 
 use splitstream_decoder_core::limits::MAX_COMPACT_LEVELS;
 use splitstream_decoder_core::owned::decode_all;
-use splitstream_decoder_core::writer::{StreamParams, assemble_stream};
+use splitstream_decoder_core::writer::assemble_stream;
 use splitstream_decoder_core::{Framing, Header, LevelTable};
 use splitstream_encoder::emit::{EncodeOptions, LevelPlan, ReplayOptions, quantize_for, replay};
 use splitstream_encoder::input::fractal_terrain;
@@ -19,19 +19,11 @@ fn written(
     plan: &LevelPlan,
     framing: Framing,
 ) -> Vec<u8> {
-    let options = EncodeOptions::default();
-    let params = StreamParams {
-        position_mode: options.position_mode,
-        bits: mesh.bits,
-        origin: mesh.origin,
-        scale: mesh.scale,
-        codec: options.codec,
-        chunk_limit: options.chunk_limit,
-        rans_chunk_limit: options.rans_chunk_limit,
-        schedule: options.schedule,
-        adaptive_tables: options.adaptive_tables,
+    let options = EncodeOptions {
         framing,
+        ..EncodeOptions::default()
     };
+    let params = options.stream_params(mesh);
     let replayed = replay(mesh, s, plan, &params, ReplayOptions::default()).expect("replay");
     assemble_stream(&params, &replayed.levels, replayed.framed)
 }

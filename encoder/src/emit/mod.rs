@@ -269,6 +269,23 @@ fn timed_check(mesh: &Mesh) -> Result<(MeshStats, f64), EncodeError> {
 pub const MAX_LEVELS: usize = 64;
 
 impl EncodeOptions {
+    /// What the stream writer is told for `mesh` under these options: its
+    /// quantization and the options' coding and framing.
+    pub fn stream_params(&self, mesh: &QuantizedMesh) -> StreamParams {
+        StreamParams {
+            position_mode: self.position_mode,
+            bits: mesh.bits,
+            origin: mesh.origin,
+            scale: mesh.scale,
+            codec: self.codec,
+            chunk_limit: self.chunk_limit,
+            rans_chunk_limit: self.rans_chunk_limit,
+            schedule: self.schedule,
+            adaptive_tables: self.adaptive_tables,
+            framing: self.framing,
+        }
+    }
+
     /// Refuses what the types allow but the format or the encoder does not,
     /// with one message naming the `splitstream encode` option: [`encode`]
     /// and [`encode_quantized`] call it first (a library caller gets the
@@ -447,18 +464,7 @@ fn encode_checked(
     let simplify_seconds = started.elapsed().as_secs_f64();
     let started = std::time::Instant::now();
     let plan = plan_levels(&simplification, options.levels, base);
-    let params = StreamParams {
-        position_mode: options.position_mode,
-        bits: mesh.bits,
-        origin: mesh.origin,
-        scale: mesh.scale,
-        codec: options.codec,
-        chunk_limit: options.chunk_limit,
-        rans_chunk_limit: options.rans_chunk_limit,
-        schedule: options.schedule,
-        adaptive_tables: options.adaptive_tables,
-        framing: options.framing,
-    };
+    let params = options.stream_params(mesh);
     let replayed = replay(
         mesh,
         &simplification,
