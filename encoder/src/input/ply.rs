@@ -191,6 +191,11 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
                     keep(e)?;
                 }
             }
+            // A binary element without properties has no bytes: its count,
+            // up to 2^64 − 1, would be a loop over nothing (every element
+            // with a property reads a byte at least, so the file's end
+            // bounds the others).
+            _ if def.properties.is_empty() => {}
             encoding => {
                 let big = encoding == Encoding::BinaryBigEndian;
                 for i in 0..def.count {
@@ -433,6 +438,25 @@ property float y\nproperty float z\nend_header\n"
             read_mesh(&f.0, &ReadOptions::default()).unwrap(),
             expected()
         );
+    }
+
+    /// Found by reading the code (2026-12-08): a binary element declared
+    /// with no properties and a count of 4 billion kept the reader looping
+    /// over nothing for minutes (the reader before it too).
+    #[test]
+    fn a_huge_element_without_properties_is_skipped_at_once() {
+        let mut bytes = b"ply\nformat binary_little_endian 1.0\nelement junk 4000000000\n\
+element vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+            .to_vec();
+        for p in [[0f32, 0., 0.], [1., 0., 0.], [0., 1., 0.]] {
+            bytes.extend(p.iter().flat_map(|c| c.to_le_bytes()));
+        }
+        bytes.push(3);
+        bytes.extend([0i32, 1, 2].iter().flat_map(|i| i.to_le_bytes()));
+        let f = TempFile::new("junk.ply", &bytes);
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        assert_eq!((m.positions.len(), m.triangles), (3, vec![[0, 1, 2]]));
     }
 
     #[test]
