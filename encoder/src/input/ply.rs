@@ -293,7 +293,7 @@ impl Faces {
 fn binary_error(file: &str, name: &str, i: usize, count: usize, e: &ParseError) -> InputError {
     let why = match e.kind() {
         std::io::ErrorKind::UnexpectedEof => "the file ends".to_owned(),
-        _ => ply_error(file, e, false).to_string(),
+        _ => ply_message(e),
     };
     InputError::malformed(
         file,
