@@ -13,7 +13,7 @@ use super::{InputError, check_vertex_count};
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
     let bytes = std::fs::read(path).map_err(|e| InputError::io(file, e))?;
-    let text = String::from_utf8_lossy(&bytes);
+    let text = super::text_of(&bytes);
     parse(&text, file)
 }
 

@@ -45,6 +45,23 @@ use super::{InputError, check_vertex_count};
 /// one gets an error saying so instead of a wrong mesh.
 const COMPRESSED_GEOMETRY: &[&str] = &["KHR_draco_mesh_compression", "EXT_meshopt_compression"];
 
+/// Whether a required extension leaves the triangles and their positions
+/// as the core specification reads them: quantized positions (which this
+/// reader decodes), and extensions of materials, textures, lights and
+/// metadata.
+fn geometry_neutral(name: &str) -> bool {
+    name == "KHR_mesh_quantization"
+        || [
+            "KHR_materials_",
+            "KHR_texture_",
+            "EXT_texture_",
+            "KHR_lights_",
+            "KHR_xmp",
+        ]
+        .iter()
+        .any(|prefix| name.starts_with(prefix))
+}
+
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let bytes = std::fs::read(path).map_err(|e| InputError::io(file, e))?;
     parse(&bytes, path.parent(), file)
@@ -54,9 +71,19 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
 /// looked up relative to `base` (none: external buffers are an error).
 pub(super) fn parse(bytes: &[u8], base: Option<&Path>, file: &str) -> Result<Mesh, InputError> {
     let (json_bytes, bin) = split_container(bytes, file)?;
-    let root = json::Root::from_slice(json_bytes)
-        .map_err(|e| InputError::malformed(file, format!("invalid glTF JSON: {e}")))?;
+    // The version first, from the JSON as it is: a glTF 1.0 document failed
+    // the 2.0 schema with a message about a map where a list was expected.
     let raw: Value = json::deserialize::from_slice(json_bytes)
+        .map_err(|e| InputError::malformed(file, format!("invalid glTF JSON: {e}")))?;
+    if let Some(version) = raw.pointer("/asset/version").and_then(Value::as_str)
+        && !version.starts_with("2.")
+    {
+        return Err(InputError::unsupported(
+            file,
+            format!("glTF version {version} (2.x is read)"),
+        ));
+    }
+    let root = json::Root::from_slice(json_bytes)
         .map_err(|e| InputError::malformed(file, format!("invalid glTF JSON: {e}")))?;
     if !root.asset.version.starts_with("2.") {
         return Err(InputError::unsupported(
@@ -67,6 +94,15 @@ pub(super) fn parse(bytes: &[u8], base: Option<&Path>, file: &str) -> Result<Mes
     for name in &root.extensions_required {
         if COMPRESSED_GEOMETRY.contains(&name.as_str()) {
             return Err(compressed(file, name));
+        }
+        // A loader must refuse a file that requires an extension it does not
+        // know (glTF 2.0, 3.12): one such as EXT_mesh_gpu_instancing changes
+        // what the geometry is, and was read as if absent.
+        if !geometry_neutral(name) {
+            return Err(InputError::unsupported(
+                file,
+                format!("the file requires the extension {name}, which this reader does not apply"),
+            ));
         }
     }
     let mut reader = Reader {
@@ -1023,6 +1059,16 @@ mod tests {
             (
                 square_indexed(json!({"asset": {"version": "1.0"}})),
                 "unsupported: glTF version 1.0",
+            ),
+            (
+                // A 1.0 document's own layout (meshes as a map) is named
+                // by its version, not by the 2.0 schema's complaint.
+                json!({"asset": {"version": "1.0"}, "meshes": {}}),
+                "unsupported: glTF version 1.0",
+            ),
+            (
+                square_indexed(json!({"extensionsRequired": ["EXT_mesh_gpu_instancing"]})),
+                "unsupported: the file requires the extension EXT_mesh_gpu_instancing",
             ),
             (
                 square_indexed(

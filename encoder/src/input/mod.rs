@@ -18,6 +18,8 @@ mod npz_axes;
 mod obj;
 mod off;
 mod ply;
+mod ply_ascii;
+mod polygon;
 mod read_grid;
 mod repair;
 mod shapes;
@@ -31,6 +33,7 @@ use crate::Mesh;
 pub use check::{MeshError, MeshStats, check_mesh};
 pub use error::{GRID_EXTENSIONS, InputError, SUPPORTED_EXTENSIONS};
 pub use grid::{Grid, grid_to_mesh};
+pub(crate) use polygon::Polygons;
 pub use read_grid::read_grid;
 pub use repair::{RepairReport, repair_mesh};
 pub use shapes::icosphere;
@@ -144,11 +147,17 @@ fn apply_spacing(mut grid: Grid, options: &ReadOptions) -> Grid {
 /// conversion walks them), converted lossily where they are not (a Latin-1
 /// comment, say). The text formats (OBJ, OFF) are ASCII in what we read.
 pub(crate) fn text_of(bytes: &[u8]) -> std::borrow::Cow<'_, str> {
+    // A UTF-8 byte order mark (Windows editors write one) is not text: kept,
+    // it glued itself to the first word, and an OBJ lost its first vertex.
+    let bytes = bytes.strip_prefix(UTF8_BOM).unwrap_or(bytes);
     match std::str::from_utf8(bytes) {
         Ok(text) => std::borrow::Cow::Borrowed(text),
         Err(_) => String::from_utf8_lossy(bytes),
     }
 }
+
+/// The UTF-8 byte order mark, which a text file may begin with.
+pub(crate) const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
 
 /// `text.lines()` (`\n` ends a line, a `\r` before it is dropped) by a
 /// plain byte scan: the general searcher `lines` uses took about a fifth
@@ -168,18 +177,20 @@ pub(crate) fn ascii_lines(text: &str) -> impl Iterator<Item = &str> + '_ {
     })
 }
 
-/// Appends the fan triangulation (v0, vi, vi+1) of one polygon, which keeps
-/// its winding; shared by the PLY and OFF readers. `indices` are as read
-/// (possibly negative); returns a message naming the bad index.
+/// Appends one polygon as triangles (its fan, which keeps its winding;
+/// `polygons.untangle` later cuts a concave one again), shared by the PLY
+/// and OFF readers. `indices` are as read (possibly negative); returns a
+/// message naming the bad index.
 pub(crate) fn push_polygon<I>(
     triangles: &mut Vec<[u32; 3]>,
     indices: I,
     vertex_count: usize,
-    scratch: &mut Vec<u32>,
+    polygons: &mut Polygons,
 ) -> Result<(), String>
 where
     I: IntoIterator<Item = i64>,
 {
+    let scratch = &mut polygons.corners;
     scratch.clear();
     for i in indices {
         if i < 0 || i as u64 >= vertex_count as u64 {
@@ -195,10 +206,35 @@ where
             scratch.len()
         ));
     }
-    for k in 1..scratch.len() - 1 {
-        triangles.push([scratch[0], scratch[k], scratch[k + 1]]);
-    }
+    merge_repeated_corners(scratch, |&v| v);
+    polygons.fan_into(triangles);
     Ok(())
+}
+
+/// Merges a polygon's corners that repeat the one before them, the last
+/// and the first included (`4 a b c c`: a triangle some exporters write as
+/// a quad, whose fan had a degenerate triangle), unless fewer than three
+/// corners would remain: a polygon that degenerate is left for the input
+/// check to name.
+pub(crate) fn merge_repeated_corners<T, K: PartialEq>(corners: &mut Vec<T>, key: impl Fn(&T) -> K) {
+    let distinct = |c: &[T]| {
+        let n = c.len();
+        (0..n)
+            .filter(|&i| key(&c[i]) != key(&c[(i + n - 1) % n]))
+            .count()
+    };
+    if corners.len() < 3 || distinct(corners) == corners.len() || distinct(corners) < 3 {
+        return;
+    }
+    let n = corners.len();
+    let keep: Vec<bool> = (0..n)
+        .map(|i| key(&corners[i]) != key(&corners[(i + n - 1) % n]))
+        .collect();
+    let mut i = 0;
+    corners.retain(|_| {
+        i += 1;
+        keep[i - 1]
+    });
 }
 
 /// Fails with [`InputError::TooLarge`] when `count` vertices cannot be
@@ -355,9 +391,16 @@ mod tests {
     #[test]
     fn fan_triangulation() {
         let mut tris = Vec::new();
-        let mut scratch = Vec::new();
+        let mut scratch = Polygons::default();
         push_polygon(&mut tris, [0, 1, 2, 3, 4], 5, &mut scratch).unwrap();
         assert_eq!(tris, vec![[0, 1, 2], [0, 2, 3], [0, 3, 4]]);
+        // A corner repeated at once is merged (`4 a b c c`, a triangle as
+        // a quad), unless too few corners would be left.
+        push_polygon(&mut tris, [0, 1, 2, 2], 5, &mut scratch).unwrap();
+        push_polygon(&mut tris, [3, 3, 1, 2, 3], 5, &mut scratch).unwrap();
+        push_polygon(&mut tris, [4, 4, 1, 4], 5, &mut scratch).unwrap();
+        assert_eq!(tris[3..], [[0, 1, 2], [1, 2, 3], [4, 4, 1], [4, 1, 4]]);
+        tris.truncate(3);
         assert!(
             push_polygon(&mut tris, [0, 5, 1], 5, &mut scratch)
                 .unwrap_err()

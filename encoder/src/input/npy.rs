@@ -161,7 +161,20 @@ fn read_values<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<Vec<f
             format!("{name} has a structured dtype"),
         ));
     };
-    let err = |e: std::io::Error| InputError::malformed(file, format!("cannot read {name}: {e}"));
+    let shape = npy.shape().to_vec();
+    let bytes = shape
+        .iter()
+        .product::<u64>()
+        .saturating_mul(ts.size_field());
+    let err = |e: std::io::Error| {
+        let why = match e.kind() {
+            std::io::ErrorKind::UnexpectedEof => {
+                format!("the file ends before its shape {shape:?} of {bytes} bytes")
+            }
+            _ => e.to_string(),
+        };
+        InputError::malformed(file, format!("cannot read {name}: {why}"))
+    };
     fn widen<T: Copy + Into<f64>>(v: Vec<T>) -> Vec<f64> {
         v.into_iter().map(Into::into).collect()
     }
@@ -193,6 +206,15 @@ fn read_values<R: Read>(npy: NpyFile<R>, file: &str, name: &str) -> Result<Vec<f
             ));
         }
     })
+}
+
+/// Names (or parts of names) of arrays that hold heights, which wins
+/// where an archive has several two-dimensional arrays.
+const HEIGHT_NAMES: &[&str] = &["elev", "height", "dem", "topo", "bathy", "alt", "depth"];
+
+/// Integer or floating-point values (not booleans, strings or records).
+fn is_numeric(dtype: &DType) -> bool {
+    matches!(dtype, DType::Plain(ts) if matches!(ts.type_char(), TypeChar::Float | TypeChar::Int | TypeChar::Uint))
 }
 
 pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<Grid, InputError> {
@@ -240,12 +262,36 @@ pub(super) fn read_npz(path: &Path, file: &str, wanted: Option<&str>) -> Result<
                     .chain(&Y_NAMES)
                     .any(|c| n.eq_ignore_ascii_case(c))
             };
+            // Numeric two-dimensional arrays only (a boolean mask beside
+            // the heights was taken and refused); where there are several,
+            // one named as heights are, or else the user says which: the
+            // first of them, taken silently, was once a slope raster.
+            let mut candidates = Vec::new();
             for n in names.iter().filter(|n| !coordinate(n)) {
                 let npy = archive.by_name(n).map_err(bad)?;
-                if npy.is_some_and(|a| a.shape().len() == 2) {
-                    found = Some(n.clone());
-                    break;
+                if npy.is_some_and(|a| a.shape().len() == 2 && is_numeric(&a.dtype())) {
+                    candidates.push(n.clone());
                 }
+            }
+            let height_like = |n: &str| {
+                let n = n.to_ascii_lowercase();
+                n == "z" || HEIGHT_NAMES.iter().any(|h| n.contains(h))
+            };
+            match candidates.as_slice() {
+                [one] => found = Some(one.clone()),
+                [] => {}
+                several => match several.iter().find(|n| height_like(n)) {
+                    Some(n) => found = Some(n.clone()),
+                    None => {
+                        return Err(InputError::malformed(
+                            file,
+                            format!(
+                                "several two-dimensional arrays ({}): say which holds the heights with --npz-array",
+                                several.join(", ")
+                            ),
+                        ));
+                    }
+                },
             }
             found.ok_or_else(|| {
                 InputError::malformed(
@@ -617,6 +663,49 @@ mod tests {
 
     fn scalar(v: f64) -> Vec<u8> {
         npy_bytes("<f8", false, "()", &v.to_le_bytes())
+    }
+
+    /// Found by an audit (2026-12-08): a boolean mask before the heights
+    /// was taken and refused, and a slope raster before them was encoded
+    /// as if it held heights.
+    /// A payload shorter than its shape says (an audit, 2026-12-08) is
+    /// named as such, not as "failed to fill whole buffer".
+    #[test]
+    fn a_short_payload_names_the_shape() {
+        let bytes = npy_bytes("<f8", false, "(300, 400)", &[0; 100]);
+        let f = TempFile::new("short.npy", &bytes);
+        let msg = read_npy(&f.0, "short.npy").unwrap_err().to_string();
+        assert!(
+            msg.contains("the file ends before its shape [300, 400] of 960000 bytes"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn npz_takes_the_heights_among_several_arrays_or_asks() {
+        let grid = |v: f64| npy_bytes("<f8", false, "(2, 2)", &le(&[v; 4], f64::to_le_bytes));
+        let mask = npy_bytes("|b1", false, "(2, 2)", &[1, 0, 1, 1]);
+        for (entries, file) in [
+            (vec![("mask", mask), ("elevation", grid(7.0))], "mask.npz"),
+            (
+                vec![("slope", grid(1.0)), ("elevation", grid(7.0))],
+                "slope.npz",
+            ),
+        ] {
+            let f = TempFile::new(file, &npz(&entries));
+            let g = read_npz(&f.0, file, None).unwrap();
+            assert_eq!(g.elevations, vec![7.0; 4], "{file}");
+        }
+        let f = TempFile::new("two.npz", &npz(&[("a", grid(1.0)), ("b", grid(2.0))]));
+        let msg = read_npz(&f.0, "two.npz", None).unwrap_err().to_string();
+        assert!(
+            msg.contains("several two-dimensional arrays (a, b): say which holds the heights with --npz-array"),
+            "{msg}"
+        );
+        assert_eq!(
+            read_npz(&f.0, "two.npz", Some("b")).unwrap().elevations,
+            vec![2.0; 4]
+        );
     }
 
     #[test]

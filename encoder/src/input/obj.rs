@@ -9,7 +9,9 @@
 //! numbering, hence this reader. It takes what the OBJ format says of
 //! these two statements: 1-based indices, negative ones relative to the
 //! vertices read so far, `v/vt/vn` forms (only `v` is kept), polygons
-//! fanned into triangles from their first vertex, `\` line continuations;
+//! fanned into triangles from their first vertex (a concave one cut by ear
+//! clipping instead, `polygon.rs`), `#` comments anywhere on a line, `\`
+//! line continuations;
 //! every other statement (`vt`, `vn`, `o`, `g`, `usemtl`, `l`, …) is
 //! skipped. Coordinates stay f64.
 
@@ -57,9 +59,12 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
     // vertex defined further down, so they are resolved at the end.
     let mut corners: Vec<(i64, usize)> = Vec::new();
     let mut polygon: Vec<(i64, usize)> = Vec::new();
+    let mut polygons = super::Polygons::default();
     for (line, statement) in statements(text) {
-        // OBJ is ASCII: its separators are ASCII blanks.
-        let mut words = statement.split_ascii_whitespace();
+        // OBJ is ASCII: its separators are ASCII blanks; `#` starts a
+        // comment anywhere on a line (`f 1 2 3 # a quad` was refused).
+        let body = statement.split('#').next().unwrap_or_default();
+        let mut words = body.split_ascii_whitespace();
         match words.next() {
             Some("v") => {
                 let mut xyz = [0.0f64; 3];
@@ -106,6 +111,10 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
                         format!("face with {} vertices", polygon.len()),
                     ));
                 }
+                // A corner repeated at once (`f 1 2 3 3`, a triangle
+                // written as a quad) is one corner.
+                super::merge_repeated_corners(&mut polygon, |c| c.0);
+                polygons.note(corners.len() / 3, polygon.len());
                 for i in 1..polygon.len() - 1 {
                     corners.extend([polygon[0], polygon[i], polygon[i + 1]]);
                 }
@@ -129,6 +138,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
         .chunks_exact(3)
         .map(|t| Ok([resolve(t[0])?, resolve(t[1])?, resolve(t[2])?]))
         .collect::<Result<_, InputError>>()?;
+    polygons.untangle(&mut mesh);
     Ok(mesh)
 }
 
@@ -155,6 +165,37 @@ vt 0 0\nvn 0 0 1\no first\ng a\nusemtl red\nf 1/1/1 2/1/1 3/1/1 4/1/1\ng b\nf -4
         )
         .unwrap();
         assert_eq!(m.positions[0], [12345678.123456, -0.1, 1e-9]);
+    }
+
+    /// Found by an audit of real-world files (2026-12-08): a UTF-8 byte
+    /// order mark hid the first `v` (every index then named the next
+    /// vertex), a comment after a face's indices was refused, and a
+    /// triangle written as a quad with its last corner repeated had a
+    /// degenerate fan triangle.
+    #[test]
+    fn byte_order_mark_comments_and_repeated_corners() {
+        let text = "\u{feff}v 0 0 0\nv 1 0 0\nv 1 1 0 # a comment\nv 0 1 0\nv 9 9 9\n\
+                    f 1 2 3 # a triangle\nf 1 3 4 4\n";
+        let f = TempFile::new("bom.obj", text.as_bytes());
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        assert_eq!(m.positions[0], [0.0, 0.0, 0.0]);
+        assert_eq!(m.positions.len(), 5);
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+    }
+
+    /// The audit's L-shaped hexagon (2026-12-08): its fan from the first
+    /// corner turned a triangle over; it is cut into upright triangles.
+    #[test]
+    fn a_concave_face_is_cut_without_a_fold() {
+        let text = "v 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\nf 1 2 3 4 5 6\n";
+        let f = TempFile::new("ell.obj", text.as_bytes());
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        assert_eq!(m.triangles.len(), 4);
+        for t in &m.triangles {
+            let [a, b, c] = t.map(|v| m.positions[v as usize]);
+            let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            assert!(area > 0.0, "{t:?} in {:?}", m.triangles);
+        }
     }
 
     #[test]

@@ -2,13 +2,15 @@
 //! value. Accepts the `OFF`/`COFF`/`NOFF`/`CNOFF`/`STOFF` header keywords
 //! (extra per-vertex and per-face values such as colours are ignored), `#`
 //! comments anywhere, blank lines, the counts on the header line or the next
-//! line, and polygons (fan-triangulated). Every error names its line.
+//! line (or glued to the keyword, `OFF8 6 0`), and polygons (fanned, a
+//! concave one cut by ear clipping: `polygon.rs`). Lines after the
+//! declared faces are ignored. Every error names its line.
 
 use std::path::Path;
 
 use crate::Mesh;
 
-use super::{InputError, ascii_lines, check_vertex_count, push_polygon, text_of};
+use super::{InputError, Polygons, ascii_lines, check_vertex_count, push_polygon, text_of};
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let bytes = std::fs::read(path).map_err(|e| InputError::io(file, e))?;
@@ -41,7 +43,15 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
         .next()
         .ok_or_else(|| InputError::malformed(file, "empty file (expected an 'OFF' header)"))?;
     let mut tokens = header.split_ascii_whitespace();
-    let keyword = tokens.next().unwrap_or("");
+    let mut keyword = tokens.next().unwrap_or("");
+    // `OFF8 6 0`: the counts run into the keyword (many ModelNet files).
+    let mut glued = None;
+    if let Some(at) = keyword.find(|c: char| c.is_ascii_digit())
+        && keyword[..at].ends_with("OFF")
+    {
+        glued = Some(&keyword[at..]);
+        keyword = &keyword[..at];
+    }
     let known = [
         "OFF", "COFF", "NOFF", "CNOFF", "STOFF", "STCOFF", "STNOFF", "STCNOFF",
     ];
@@ -58,7 +68,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
             format!("expected an 'OFF' header, found '{keyword}'"),
         ));
     }
-    let mut rest: Vec<&str> = tokens.collect();
+    let mut rest: Vec<&str> = glued.into_iter().chain(tokens).collect();
     if rest
         .first()
         .is_some_and(|t| t.eq_ignore_ascii_case("BINARY"))
@@ -110,7 +120,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
     }
 
     let mut triangles = Vec::with_capacity(nf.min(text.len() / 8));
-    let mut scratch = Vec::new();
+    let mut polygons = Polygons::default();
     for i in 0..nf {
         let (n, l) = lines.next().ok_or_else(|| {
             InputError::line(
@@ -141,13 +151,17 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
             })?;
             indices.push(index);
         }
-        push_polygon(&mut triangles, indices, nv, &mut scratch)
+        push_polygon(&mut triangles, indices, nv, &mut polygons)
             .map_err(|m| InputError::line(file, n, format!("face {i}: {m}")))?;
     }
-    Ok(Mesh {
+    // Lines after the declared faces are ignored, as CGAL's reader ignores
+    // them: its own sample prim.off declares 7 of the 8 faces it holds.
+    let mut mesh = Mesh {
         positions,
         triangles,
-    })
+    };
+    polygons.untangle(&mut mesh);
+    Ok(mesh)
 }
 
 #[cfg(test)]
@@ -155,6 +169,24 @@ mod tests {
     use super::super::test_util::TempFile;
     use super::super::{ReadOptions, read_mesh};
     use super::*;
+
+    /// Found by an audit of real-world files (2026-12-08): `OFF8 6 0`
+    /// (ModelNet) was refused and a UTF-8 byte order mark made the keyword
+    /// unknown. Faces beyond the header's count stay ignored, as CGAL reads
+    /// them (its prim.off declares 7 of its 8 faces).
+    #[test]
+    fn glued_counts_a_byte_order_mark_and_surplus_faces() {
+        let body = "0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+        for head in ["OFF4 4 0\n", "\u{feff}OFF\n4 4 0\n"] {
+            let text = format!("{head}{body}");
+            let f = TempFile::new("head.off", text.as_bytes());
+            let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+            assert_eq!((m.positions.len(), m.triangles.len()), (4, 4), "{head:?}");
+        }
+        let f = TempFile::new("surplus.off", format!("OFF\n4 3 0\n{body}").as_bytes());
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        assert_eq!(m.triangles.len(), 3);
+    }
 
     #[test]
     fn reads_comments_counts_on_header_and_polygons() {

@@ -16,7 +16,8 @@ use ply_rs_bw::ply::{
 
 use crate::Mesh;
 
-use super::{InputError, check_vertex_count, push_polygon};
+use super::ply_ascii::AsciiPayload;
+use super::{InputError, Polygons, check_vertex_count, push_polygon};
 
 /// Whatever a PLY element carries that we care about.
 #[derive(Default)]
@@ -139,14 +140,24 @@ impl PropertyAccess for Element {
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let f = File::open(path).map_err(|e| InputError::io(file, e))?;
     let parser = Parser::<Element>::new();
-    let mut reader = Reader::new(BufReader::new(f));
+    let mut buffered = BufReader::new(f);
+    // A UTF-8 byte order mark before `ply` is skipped, as the text readers
+    // skip it (`text_of`).
+    if buffered
+        .fill_buf()
+        .map_err(|e| InputError::io(file, e))?
+        .starts_with(super::UTF8_BOM)
+    {
+        buffered.consume(super::UTF8_BOM.len());
+    }
+    let mut reader = Reader::new(buffered);
     let header = parser
         .read_header(&mut reader)
         .map_err(|e| ply_error(file, &e, true))?;
     let vertex_count = check_header(file, &header)?;
     // ASCII payload lines are numbered on from the header's last line
     // (`line()` is the number of the line the reader is at).
-    let (mut line, mut text) = (reader.line().saturating_sub(1), String::with_capacity(128));
+    let line = reader.line().saturating_sub(1);
     let mut mesh = Mesh {
         positions: Vec::with_capacity(vertex_count.min(PREALLOCATED)),
         triangles: Vec::new(),
@@ -154,63 +165,63 @@ pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let mut faces = Faces {
         vertex_count,
         read: 0,
-        scratch: Vec::new(),
+        polygons: Polygons::default(),
     };
     // Each element goes into the mesh as it is read: holding them all
     // first, as `read_payload` does, kept a `Vec` alive per face (about 100
-    // bytes a face) and walked them all again. The crate parses each
-    // element (`read_ascii_element`, `read_*_endian_element`).
-    for (name, def) in &header.elements {
-        if name == "face" {
-            mesh.triangles.reserve(def.count.min(PREALLOCATED));
+    // bytes a face) and walked them all again. Binary elements are parsed
+    // by the crate (`read_*_endian_element`), ASCII ones by `ply_ascii`.
+    let mut keep = |name: &str, e: Element, mesh: &mut Mesh| match name {
+        "vertex" => {
+            mesh.positions.push(e.xyz);
+            Ok(())
         }
-        let mut keep = |e: Element| match name.as_str() {
-            "vertex" => {
-                mesh.positions.push(e.xyz);
-                Ok(())
+        "face" => faces.push(&mut mesh.triangles, &e, file),
+        _ => Ok(()),
+    };
+    if header.encoding == Encoding::Ascii {
+        let mut payload = AsciiPayload::new(reader.get_mut(), file, line);
+        for (name, def) in &header.elements {
+            if name == "face" {
+                mesh.triangles.reserve(def.count.min(PREALLOCATED));
             }
-            "face" => faces.push(&mut mesh.triangles, &e, file),
-            _ => Ok(()),
-        };
-        match header.encoding {
-            Encoding::Ascii => {
-                // One element a line, read into one reused `String`.
-                for i in 0..def.count {
-                    line += 1;
-                    text.clear();
-                    let read = reader.get_mut().read_line(&mut text).map_err(|e| {
-                        InputError::line(file, line, format!("cannot read {name} {i}: {e}"))
-                    })?;
-                    if read == 0 {
-                        let why = format!("the file ends: cannot read {name} {i} of {}", def.count);
-                        return Err(InputError::line(file, line, why));
-                    }
-                    let e = parser
-                        .read_ascii_element(&text, def)
-                        .map_err(|e| InputError::line(file, line, ply_message(&e)))?;
-                    keep(e)?;
-                }
+            for i in 0..def.count {
+                let e = payload.element(def, i, is_index_list)?;
+                let e = Element {
+                    xyz: e.xyz,
+                    indices_other: e.indices,
+                    ..Element::default()
+                };
+                keep(name, e, &mut mesh)?;
             }
+            payload.finish(def)?;
+        }
+    } else {
+        let big = header.encoding == Encoding::BinaryBigEndian;
+        for (name, def) in &header.elements {
             // A binary element without properties has no bytes: its count,
             // up to 2^64 − 1, would be a loop over nothing (every element
             // with a property reads a byte at least, so the file's end
             // bounds the others).
-            _ if def.properties.is_empty() => {}
-            encoding => {
-                let big = encoding == Encoding::BinaryBigEndian;
-                for i in 0..def.count {
-                    let inner = reader.get_mut();
-                    let e = if big {
-                        parser.read_big_endian_element(inner, def)
-                    } else {
-                        parser.read_little_endian_element(inner, def)
-                    };
-                    let e = e.map_err(|e| binary_error(file, name, i, def.count, &e))?;
-                    keep(e)?;
-                }
+            if def.properties.is_empty() {
+                continue;
+            }
+            if name == "face" {
+                mesh.triangles.reserve(def.count.min(PREALLOCATED));
+            }
+            for i in 0..def.count {
+                let inner = reader.get_mut();
+                let e = if big {
+                    parser.read_big_endian_element(inner, def)
+                } else {
+                    parser.read_little_endian_element(inner, def)
+                };
+                let e = e.map_err(|e| binary_error(file, name, i, def.count, &e))?;
+                keep(name, e, &mut mesh)?;
             }
         }
     }
+    faces.polygons.untangle(&mut mesh);
     Ok(mesh)
 }
 
@@ -266,7 +277,7 @@ struct Faces {
     /// The header's vertex count: faces may come before the vertices.
     vertex_count: usize,
     read: usize,
-    scratch: Vec<u32>,
+    polygons: Polygons,
 }
 
 impl Faces {
@@ -280,7 +291,7 @@ impl Faces {
             triangles,
             face.indices(),
             self.vertex_count,
-            &mut self.scratch,
+            &mut self.polygons,
         )
         .map_err(|m| InputError::element(file, format!("face {}", self.read), m))?;
         self.read += 1;
@@ -326,9 +337,34 @@ fn ply_message(e: &ParseError) -> String {
     ) {
         (Some((_, rest)), Some((_, cause))) => {
             let quoted = rest.split_once('\'').map_or(rest, |(q, _)| q).trim();
-            format!("cannot parse '{quoted}': {cause}")
+            // The header grammar's own error is a dump of the tokens it
+            // expected: say instead what the line should have been.
+            if cause.starts_with("ParseError") {
+                format!("cannot parse '{quoted}': {}", header_line_hint(quoted))
+            } else {
+                format!("cannot parse '{quoted}': {cause}")
+            }
         }
         _ => message.to_owned(),
+    }
+}
+
+/// What a header line that the grammar refused should look like, by its
+/// first word.
+fn header_line_hint(line: &str) -> &'static str {
+    let first = line.split_ascii_whitespace().next().unwrap_or("");
+    match first {
+        "property" => {
+            "not a property ('property TYPE NAME' or 'property list COUNT_TYPE TYPE NAME', TYPE one of char, uchar, short, ushort, int, uint, float, double, or int8 ... float64)"
+        }
+        "format" => {
+            "not a format line ('format ascii 1.0', 'format binary_little_endian 1.0' or 'format binary_big_endian 1.0')"
+        }
+        "element" => "not an element ('element NAME COUNT')",
+        _ if first.parse::<f64>().is_ok() => "a value inside the header: is 'end_header' missing?",
+        _ => {
+            "not a PLY header line (the file starts with 'ply', then 'format', 'comment', 'obj_info', 'element' and 'property' lines, and 'end_header')"
+        }
     }
 }
 
@@ -403,6 +439,114 @@ element face 2\nproperty list uchar uint {index_name}\nend_header\n"
         let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
         assert_eq!(m, expected());
         check_mesh(&m).unwrap();
+    }
+
+    /// Numbers and layouts the crate's ASCII grammar refused (an audit of
+    /// real-world files, 2026-12-08) read as C readers read them: `.5`,
+    /// `1.`, `-0.`, a `uchar` written `255.0`, NaN normals, blank lines,
+    /// an element continued on the next line, CRLF.
+    #[test]
+    fn ascii_numbers_and_layouts_that_writers_produce() {
+        let text = "ply\r\nformat ascii 1.0\r\nelement vertex 5\r\nproperty float x\r\nproperty float y\r\n\
+property float z\r\nproperty float nx\r\nproperty uchar red\r\nelement face 2\r\n\
+property list uchar int vertex_indices\r\nend_header\r\n\
+.0 -0. 0 nan 255.0\r\n1. 0 0 inf 0\r\n\r\n1 1 0\r\n -nan 0\r\n0 1.0e0 0 0 0\r\n2 .5 0 0 0\r\n4 0 1 2 3\r\n3 1 4 2\r\n\r\n";
+        let f = TempFile::new("writers.ply", text.as_bytes());
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        assert_eq!(m, expected());
+    }
+
+    /// Header lines the grammar refuses are named with what they should
+    /// have been, not with a dump of the grammar's expected tokens (an
+    /// audit, 2026-12-08).
+    #[test]
+    fn header_errors_say_what_the_line_should_be() {
+        for (text, message) in [
+            (
+                "PLY\nformat ascii 1.0\n",
+                "line 1: cannot parse 'PLY': not a PLY header line",
+            ),
+            (
+                "ply\nformat ascii 1.0\nelement vertex 1\nproperty half x\n",
+                "line 4: cannot parse 'property half x': not a property ('property TYPE NAME'",
+            ),
+            (
+                "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n0 0 0\n",
+                "line 5: cannot parse '0 0 0': a value inside the header: is 'end_header' missing?",
+            ),
+        ] {
+            let f = TempFile::new("bad-header.ply", text.as_bytes());
+            let err = read_mesh(&f.0, &ReadOptions::default())
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(message), "{text:?}: {err}");
+            assert!(!err.contains("ParseError"), "{err}");
+        }
+    }
+
+    /// Every ASCII value error names its line, element and property, in
+    /// one line (the crate's errors dumped their grammar).
+    #[test]
+    fn ascii_value_errors_name_line_element_and_property() {
+        let head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+property float z\nproperty uchar red\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+        for (body, message) in [
+            (
+                "0 0 0 0\n1 0 0 0\n0 1 zero 0\n3 0 1 2\n",
+                "line 13: vertex 2, property 'z': 'zero' is not a number",
+            ),
+            (
+                "0 0 0 256\n1 0 0 0\n0 1 0 0\n3 0 1 2\n",
+                "line 11: vertex 0, property 'red': 256 is outside the type's range 0..=255",
+            ),
+            (
+                "0 0 0 0 7\n1 0 0 0\n0 1 0 0\n3 0 1 2\n",
+                "line 11: more values than the vertex's 4 properties",
+            ),
+            (
+                "0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1 2.5\n",
+                "line 14: face 0, list 'vertex_indices': '2.5' is not an integer",
+            ),
+            (
+                "0 0 0 0\n1 0 0 0\n0 1 0 0\n-1 0 1 2\n",
+                "line 14: face 0, list 'vertex_indices': '-1' is not a count",
+            ),
+            (
+                "0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1\n",
+                "line 15: the file ends inside face 0",
+            ),
+            (
+                "0 0 0 0\n1 0 0 0\n",
+                "line 13: the file ends: cannot read vertex 2 of 3",
+            ),
+        ] {
+            let f = TempFile::new("bad-value.ply", format!("{head}{body}").as_bytes());
+            let err = read_mesh(&f.0, &ReadOptions::default())
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains(message), "{body:?}: {err}");
+            assert_eq!(err.lines().count(), 1, "{err}");
+        }
+    }
+
+    /// A UTF-8 byte order mark before `ply` (found by an audit,
+    /// 2026-12-08) is skipped, in ASCII and binary files alike.
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let mut bytes = super::super::UTF8_BOM.to_vec();
+        bytes.extend_from_slice(ASCII.as_bytes());
+        let f = TempFile::new("bom.ply", &bytes);
+        assert_eq!(
+            read_mesh(&f.0, &ReadOptions::default()).unwrap(),
+            expected()
+        );
+        let mut bytes = super::super::UTF8_BOM.to_vec();
+        bytes.extend_from_slice(&binary(false, "vertex_indices"));
+        let f = TempFile::new("bom-bin.ply", &bytes);
+        assert_eq!(
+            read_mesh(&f.0, &ReadOptions::default()).unwrap(),
+            expected()
+        );
     }
 
     #[test]

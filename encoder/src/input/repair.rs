@@ -107,11 +107,6 @@ impl fmt::Display for RepairReport {
 pub fn repair_mesh(mesh: &Mesh) -> (Mesh, RepairReport) {
     let mut report = RepairReport::default();
     let nv = mesh.positions.len();
-    report.non_finite_vertices = mesh
-        .positions
-        .iter()
-        .filter(|p| !p.iter().all(|c| c.is_finite()))
-        .count();
 
     let mut tris = Vec::with_capacity(mesh.triangles.len());
     for &t @ [a, b, c] in &mesh.triangles {
@@ -144,6 +139,13 @@ pub fn repair_mesh(mesh: &Mesh) -> (Mesh, RepairReport) {
         report.vertex_copies_added,
     ) = split_nonmanifold_vertices(&mut out);
     report.unreferenced_vertices_removed = remove_unreferenced(&mut out);
+    // Counted on what is left: an unused vertex with a NaN coordinate is
+    // removed above, and was reported "not repairable" beside a success.
+    report.non_finite_vertices = out
+        .positions
+        .iter()
+        .filter(|p| !p.iter().all(|c| c.is_finite()))
+        .count();
     (out, report)
 }
 
@@ -418,6 +420,23 @@ mod tests {
             nodata: None,
             coordinates: None,
         })
+    }
+
+    /// Found by an audit (2026-12-08): an unused vertex with a NaN
+    /// coordinate was reported "not repairable" though it was removed and
+    /// the mesh encoded.
+    #[test]
+    fn a_removed_non_finite_vertex_is_not_reported_unrepairable() {
+        let mut mesh = grid_mesh(3, 3);
+        mesh.positions.push([f64::NAN, 0.0, 0.0]);
+        let (fixed, report) = repair_mesh(&mesh);
+        assert_eq!(report.unreferenced_vertices_removed, 1);
+        assert_eq!(report.non_finite_vertices, 0, "{report}");
+        check_mesh(&fixed).unwrap();
+        let mut mesh = grid_mesh(3, 3);
+        mesh.positions[4][2] = f64::INFINITY;
+        let (_, report) = repair_mesh(&mesh);
+        assert_eq!(report.non_finite_vertices, 1, "{report}");
     }
 
     #[test]
