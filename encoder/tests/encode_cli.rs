@@ -856,3 +856,59 @@ fn tables_adaptive_and_static_decode_alike_and_info_counts_them() {
     );
     assert_eq!((da.positions, da.triangles), (df.positions, df.triangles));
 }
+
+/// Found by an audit of the command line (2026-12-08): `encode mine.ply -o
+/// mine.ply` replaced the mesh with the stream (exit 0), a missing output
+/// folder failed only after the whole encoding, a one-value `--rans-chunk`
+/// took armadillo's encoding to 2.2 GB, `bench --terrain-side 100000000`
+/// aborted on a failed allocation, and `--z-scale nan` was blamed on the
+/// file's first vertex. Each is now one line before any work, and the
+/// input is untouched.
+#[test]
+fn outputs_and_options_that_would_lose_data_or_run_away_are_refused_first() {
+    let input = raster();
+    let s = input.to_str().unwrap();
+    let before = std::fs::read(&input).unwrap();
+    let mesh_out = input.with_extension("ply");
+    let out = input.with_file_name("refused.sps");
+    let o = out.to_str().unwrap();
+    std::fs::write(&mesh_out, b"not a stream").unwrap();
+    let cases: Vec<(Vec<&str>, String)> = vec![
+        (
+            vec!["encode", s, "-o", s],
+            format!("{s}: a stream would be written under a mesh or grid file's extension (.asc)"),
+        ),
+        (
+            vec!["encode", s, "-o", mesh_out.to_str().unwrap()],
+            "name it .sps".to_string(),
+        ),
+        (
+            vec!["encode", s, "-o", "/nonexistent-folder/x.sps"],
+            "the folder /nonexistent-folder does not exist".to_string(),
+        ),
+        (
+            vec!["encode", s, "-o", o, "--rans-chunk", "16"],
+            "--rans-chunk 16 is below 256 values".to_string(),
+        ),
+        (
+            vec!["encode", s, "-o", o, "--z-scale", "nan"],
+            "--z-scale NaN must be finite and non-zero".to_string(),
+        ),
+        (
+            vec!["bench", "--terrain-side", "100000000"],
+            "--terrain-side 100000000 is outside 2..=4096".to_string(),
+        ),
+        (
+            vec!["demo", "-o", "demo.glb"],
+            "demo.glb: a stream would be written under a mesh or grid file's extension (.glb)"
+                .to_string(),
+        ),
+    ];
+    for (args, expected) in cases {
+        let err = one_line_error(&splitstream(&args));
+        assert!(err.contains(&expected), "{args:?}: {err}");
+    }
+    assert_eq!(std::fs::read(&input).unwrap(), before);
+    assert_eq!(std::fs::read(&mesh_out).unwrap(), b"not a stream");
+    assert!(!out.exists(), "a refused encoding wrote {}", out.display());
+}

@@ -103,6 +103,28 @@ pub struct Settings {
 pub fn run(settings: &Settings) -> CliResult {
     let data: &Path = &settings.data;
     let admit = settings.admit;
+    // Every argument is checked before the report's first line (the
+    // terrain's side as `demo --side` checks it: an unchecked side aborted
+    // on a failed allocation or overflowed the grid's size).
+    if !(admit > 0.0 && admit <= 1.0) {
+        return Err(format!("--admit {admit} is outside (0, 1]"));
+    }
+    if !settings.skip_throughput && !(2..=4096).contains(&settings.terrain_side) {
+        return Err(format!(
+            "--terrain-side {} is outside 2..=4096",
+            settings.terrain_side
+        ));
+    }
+    let reads_inputs = settings
+        .only
+        .as_ref()
+        .is_none_or(|only| INPUTS.iter().any(|i| i.name.contains(only.as_str())));
+    if reads_inputs && !data.is_dir() {
+        return Err(format!(
+            "--data {}: no such folder (run encoder/data/fetch.sh, or name the folder of the real inputs)",
+            data.display()
+        ));
+    }
     let backend: Backend = settings.backend.into();
     let simplify_options = |target: usize, max_error: Option<f64>| SimplifyOptions {
         target_vertices: target,

@@ -9,7 +9,7 @@ use splitstream_decoder_core::{
 use super::{
     CliResult, Codec, DeficitsArg, FlagsArg, PlaneArg, RecordsArg, ScheduleArg, TiesArg, WingsArg,
 };
-use splitstream_encoder::emit::{TranscodeOptions, check_coding, lanes_for};
+use splitstream_encoder::emit::{MIN_RANS_CHUNK, TranscodeOptions, check_coding, lanes_for};
 
 /// `--tables`: how rANS chunks code their contexts (SPEC §5.5.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -52,8 +52,8 @@ pub struct CodingArgs {
     /// Longest rANS chunk in values. Each chunk has its own tables: the
     /// encoder cuts a substream where tables fitted to its parts cost less
     /// than one table for the whole (at 4,096-value steps; a limit of
-    /// 4,096 or less cuts every chunk that long). No effect on the
-    /// decoder's memory (format 3.4).
+    /// 4,096 or less cuts every chunk that long; at least 256). No effect
+    /// on the decoder's memory (format 3.4).
     #[arg(long, default_value_t = splitstream_decoder_core::writer::DEFAULT_RANS_CHUNK_LIMIT)]
     pub rans_chunk: u32,
     /// How rANS chunks code each context: `adaptive` lets a context whose
@@ -122,6 +122,12 @@ impl CodingArgs {
     /// read, by the library's own rules.
     pub fn check(&self) -> CliResult {
         // Any mesh size gives a valid lane count: check with the smallest.
+        if self.rans_chunk < MIN_RANS_CHUNK {
+            return Err(format!(
+                "--rans-chunk {} is below {MIN_RANS_CHUNK} values (smaller chunks only add tables)",
+                self.rans_chunk
+            ));
+        }
         check_coding(self.chunk_codec(0), self.chunk_size, self.rans_chunk)
     }
 

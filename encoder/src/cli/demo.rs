@@ -8,6 +8,7 @@ use splitstream_encoder::emit::{EncodeOptions, encode, lanes_for};
 use splitstream_encoder::input::fractal_terrain;
 
 use super::CliResult;
+use super::output::check_stream_output;
 
 pub fn run(
     side: usize,
@@ -17,6 +18,9 @@ pub fn run(
 ) -> CliResult {
     if !(2..=4096).contains(&side) {
         return Err(format!("--side {side} is outside 2..=4096"));
+    }
+    if let Some(path) = output {
+        check_stream_output(path, None)?;
     }
     let started = Instant::now();
     let mesh = fractal_terrain(side, 2012);

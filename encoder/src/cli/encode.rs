@@ -11,6 +11,7 @@ use splitstream_encoder::input::{ReadOptions, read_mesh, repair_mesh};
 use splitstream_encoder::quantize::{Quantization, Units};
 
 use super::coding::CodingArgs;
+use super::output::check_stream_output;
 use super::{BackendArg, CliResult, LatticeArg, Position, QuantizationArg};
 
 /// `splitstream encode`'s arguments.
@@ -20,7 +21,7 @@ pub struct Args {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Quantization bits per axis (1..=31).
-    #[arg(long, default_value_t = 14)]
+    #[arg(long, default_value_t = 14, value_parser = clap::value_parser!(u8).range(1..=31))]
     pub bits: u8,
     /// Levels of detail, base mesh included.
     #[arg(long, default_value_t = 5)]
@@ -112,7 +113,17 @@ pub fn run(a: Args) -> CliResult {
     // The lane count of a mesh whose size is not known yet; set again
     // below, once it is.
     .with_coding(a.coding.options(usize::MAX));
+    a.coding.check()?;
     options.check().map_err(|e| e.to_string())?;
+    check_stream_output(&a.output, Some(&a.input))?;
+    // As `grid` checks it: a NaN scale was reported as the file's first
+    // vertex having a non-finite coordinate.
+    if !(a.z_scale.is_finite() && a.z_scale != 0.0) {
+        return Err(format!(
+            "--z-scale {} must be finite and non-zero",
+            a.z_scale
+        ));
+    }
     if options.levels == 1 && options.base_vertices.is_some() {
         eprintln!(
             "note: --base-vertices has no effect with --levels 1: the one level holds the whole mesh"
@@ -162,6 +173,9 @@ pub fn run(a: Args) -> CliResult {
         let hint = if degrees_unconverted && options.quantization == Quantization::Uniform {
             "with --quantization uniform, x and y in degrees fall on a few steps of the height's \
              scale and every triangle degenerates: pass --geographic, or use --quantization per-axis"
+        } else if options.max_error.is_some_and(|e| e <= 0.0) {
+            // `--max-error 0` admits only collapses without any error.
+            "--max-error 0 admits only collapses that cost no error"
         } else {
             "the quantized mesh may be degenerate: try more --bits"
         };

@@ -20,6 +20,44 @@ pub fn mesh_extension(path: &Path) -> Result<String, String> {
     }
 }
 
+/// Refuses, before any work, a stream output that would overwrite a mesh:
+/// a name with an input format's extension (`encode mine.ply -o mine.ply`
+/// replaced the mesh with the stream, and `-o x.ply` wrote a stream no mesh
+/// reader opens), or the input file itself (`input`: `encode`'s; a
+/// transcode may rewrite its own stream). A folder that does not exist is
+/// also named now, not after the encoding.
+pub fn check_stream_output(path: &Path, input: Option<&Path>) -> Result<(), String> {
+    let name = path.display();
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    if splitstream_encoder::input::SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
+        return Err(format!(
+            "{name}: a stream would be written under a mesh or grid file's extension (.{ext}); name it .sps"
+        ));
+    }
+    if let Some(input) = input {
+        let same = match (std::fs::canonicalize(path), std::fs::canonicalize(input)) {
+            (Ok(a), Ok(b)) => a == b,
+            _ => false,
+        };
+        if same {
+            return Err(format!("{name} is the input file: choose another output"));
+        }
+    }
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(dir) = parent
+        && !dir.is_dir()
+    {
+        return Err(format!(
+            "{name}: the folder {} does not exist",
+            dir.display()
+        ));
+    }
+    Ok(())
+}
+
 /// Writes `positions` and `triangles` to `path`, format chosen by extension.
 pub fn write_mesh(
     path: &Path,

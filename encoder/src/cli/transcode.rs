@@ -9,6 +9,7 @@ use splitstream_encoder::emit::transcode;
 
 use super::CliResult;
 use super::coding::CodingArgs;
+use super::output::check_stream_output;
 
 /// `splitstream transcode`'s arguments.
 #[derive(clap::Args)]
@@ -22,6 +23,7 @@ pub struct Args {
 
 pub fn run(a: Args) -> CliResult {
     a.coding.check()?;
+    check_stream_output(&a.output, None)?;
     let stream = std::fs::read(&a.input).map_err(|e| format!("{}: {e}", a.input.display()))?;
     // The lane count by the mesh's size (a stream that does not parse fails
     // in `transcode` with its own error).

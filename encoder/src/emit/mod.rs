@@ -365,6 +365,16 @@ pub fn lanes_for(vertices: usize) -> u8 {
     }
 }
 
+/// The fewest values the command line lets an rANS chunk be limited to.
+/// Each chunk has tables of its own, and the writer keeps every chunk's
+/// costed tables until the level is framed: a limit of 1 took armadillo's
+/// encoding to 2.2 GB and 7.8 s for a stream no smaller than at 16 (204
+/// MB). Below the cut search's 4,096-value steps a limit only cuts every
+/// chunk that long, and the decoder's memory does not depend on it
+/// (format 3.4). The library takes any limit from 1 on: tiny chunks are
+/// how tests and conformance vectors reach chunk boundaries.
+pub const MIN_RANS_CHUNK: u32 = 256;
+
 /// The coding options' own rules, shared by [`EncodeOptions::check`] and
 /// [`transcode()`]: chunks of at least one byte or value, and 1 to 32 rANS
 /// lanes (SPEC §5.5.3; the writer would put any other count in a header
