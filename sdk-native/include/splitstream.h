@@ -25,15 +25,23 @@ typedef enum {
   SS_STATUS_MALFORMED = 3,
   SS_STATUS_CHECKSUM_MISMATCH = 4,
   SS_STATUS_TRUNCATED = 5,
+  // A count beyond the capacity the header declares; a memory budget
+  // (`ss_decoder_open_within`) too small for the base level; a level
+  // beyond those that fit the decoder's memory
+  // (`ss_decoder_levels_that_fit`), refused without failing the decoder.
   SS_STATUS_CAPACITY_EXCEEDED = 6,
   SS_STATUS_COUNT_MISMATCH = 7,
   SS_STATUS_RING_OFFSET_OUT_OF_RANGE = 8,
   SS_STATUS_VALENCE_OVERFLOW = 9,
   SS_STATUS_NON_MANIFOLD = 11,
   SS_STATUS_POSITION_OUT_OF_RANGE = 12,
-  // Levels fed out of order, a decoder used after an error, …
+  // Levels fed out of order or while another is open (refused, the
+  // decoder unchanged); any decoding call after a failure.
   SS_STATUS_API_MISUSE = 13,
-  // A null pointer, a too-short buffer, a level index out of range.
+  // A null pointer, a level's bytes of another length than its
+  // level-table entry's, an output buffer too short, a level index out of
+  // range, a value that is not a number the call takes. Refused before
+  // anything is decoded: the decoder is unchanged.
   SS_STATUS_INVALID_ARGUMENT = 14,
   // The grid-tile simplifier refused its input (see the message).
   SS_STATUS_GRID_TILE = 15,
@@ -161,20 +169,24 @@ uint16_t ss_decoder_level_count(const SsDecoder *decoder);
 // `decoder` is null or a live handle; `out` is writable.
 SsStatus ss_decoder_level_info(const SsDecoder *decoder, uint16_t level, SsLevelInfo *out);
 
-// The coarsest level whose geometric error (decoder-core SPEC §4.1,
-// model units) is at most `max_error`, the last level when none is, into
-// `*out`: decode levels 0 ..= it.
+// The coarsest level this decoder can decode (below
+// `ss_decoder_levels_that_fit`) whose geometric error (decoder-core SPEC
+// §4.1, model units) is at most `max_error`, the finest that fits when
+// none is, into `*out`: decode levels 0 ..= it. `max_error` is a number
+// of at least 0 (+infinity gives level 0); NaN or a negative bound is
+// `SS_STATUS_INVALID_ARGUMENT`.
 //
 // # Safety
 // `decoder` is null or a live handle; `out` is null or writable.
 SsStatus ss_decoder_level_within_error(const SsDecoder *decoder, float max_error, uint16_t *out);
 
-// The coarsest level whose geometric error covers at most `max_pixels`
-// pixels on screen, for a perspective camera with a viewport
-// `viewport_height` pixels high and a vertical field of view of `fov_y`
-// radians, at `distance` model units from the object, into `*out`.
-// Parameters that describe no camera are `SS_STATUS_INVALID_ARGUMENT`,
-// with the reason in `ss_last_error_message`.
+// The coarsest level this decoder can decode (below
+// `ss_decoder_levels_that_fit`) whose geometric error covers at most
+// `max_pixels` pixels on screen, the finest that fits when none does, for
+// a perspective camera with a viewport `viewport_height` pixels high and
+// a vertical field of view of `fov_y` radians, at `distance` model units
+// from the object, into `*out`. Parameters that describe no camera are
+// `SS_STATUS_INVALID_ARGUMENT`, with the reason in `ss_last_error_message`.
 //
 // # Safety
 // `decoder` is null or a live handle; `out` is null or writable.
@@ -191,16 +203,29 @@ SsStatus ss_decoder_level_for_screen_error(const SsDecoder *decoder,
 // `decoder` is null or a live handle.
 uint64_t ss_decoder_workspace_bytes(const SsDecoder *decoder);
 
-// The level to feed next, or -1 when every level is decoded, a level is
-// being decoded round by round, the decoder failed, or it is null.
+// The level to feed next, or -1 when every level that fits is decoded, a
+// level is being decoded round by round, the decoder failed, or it is
+// null.
 //
 // # Safety
 // `decoder` is null or a live handle.
 int32_t ss_decoder_next_level(const SsDecoder *decoder);
 
 // Decodes level `level` whole from its bytes `bytes[0 .. len]` (exactly
-// the level's range). After a failure the decoder answers only
-// `SS_STATUS_API_MISUSE`: open a new one.
+// the level's range, `SsLevelInfo::length` bytes).
+//
+// Refused before anything is decoded, the decoder unchanged (the call may
+// be repeated with the right arguments): `SS_STATUS_INVALID_ARGUMENT` for
+// a null pointer, a level beyond the stream, or `len` other than the
+// level's length (a short range response: fetch the level again);
+// `SS_STATUS_CAPACITY_EXCEEDED` for a level beyond
+// `ss_decoder_levels_that_fit`; `SS_STATUS_API_MISUSE` for a level out of
+// order or given while a level begun with `ss_decoder_begin_level` is
+// open. Any other status is a failure of the level's bytes: the decoder
+// is then spent, and `ss_decoder_decode_level`,
+// `ss_decoder_decode_level_two_threads`, `ss_decoder_begin_level`,
+// `ss_decoder_next_round` and `ss_decoder_positions_f64` answer only
+// `SS_STATUS_API_MISUSE` (`ss_decoder_next_level` -1): open a new one.
 //
 // # Safety
 // `decoder` is a live handle; `bytes` points to `len` readable bytes.
@@ -224,7 +249,8 @@ SsStatus ss_decoder_decode_level_two_threads(SsDecoder *decoder,
 
 // Starts level `level` from its bytes (copied) for round-by-round
 // decoding with `ss_decoder_next_round`; level 0's seed mesh is decoded
-// here.
+// here. Refusals and failures as `ss_decoder_decode_level`'s; a level
+// given while this one is open is refused with `SS_STATUS_API_MISUSE`.
 //
 // # Safety
 // `decoder` is a live handle; `bytes` points to `len` readable bytes.
@@ -234,8 +260,11 @@ SsStatus ss_decoder_begin_level(SsDecoder *decoder,
                                 size_t len);
 
 // Decodes the next round of the level begun with `ss_decoder_begin_level`.
-// `*decoded` is true when a round was decoded, false when the level is
-// complete (and verified) or none is open.
+// With `SS_STATUS_OK`, `*decoded` is true when a round was decoded, false
+// when the level is complete (and verified) or none is open. A round that
+// fails spends the decoder; from then on this call answers
+// `SS_STATUS_API_MISUSE` (never `SS_STATUS_OK` with false), as after any
+// failure (`ss_decoder_decode_level`).
 //
 // # Safety
 // `decoder` is a live handle; `decoded` is writable.
@@ -254,7 +283,9 @@ uint32_t ss_decoder_vertex_count(const SsDecoder *decoder);
 uint32_t ss_decoder_triangle_count(const SsDecoder *decoder);
 
 // Quantized positions, `x, y, z` per vertex (`3 * vertex_count` values),
-// valid until the decoder next changes; null for a null handle.
+// valid until the decoder next changes; null for a null handle. These
+// getters (counts, positions, triangles, state hash) answer after a
+// failure too, but the mesh they then show means nothing.
 //
 // # Safety
 // `decoder` is null or a live handle.
@@ -269,7 +300,9 @@ const uint32_t *ss_decoder_triangles(const SsDecoder *decoder);
 
 // Writes the real (dequantized) positions, `x, y, z` per vertex, into
 // `out[0 .. 3 * vertex_count]`; `out_len` is the buffer's length in
-// doubles.
+// doubles. `SS_STATUS_INVALID_ARGUMENT` for a null `out` (unless the mesh
+// is empty) or a buffer too short; `SS_STATUS_API_MISUSE` after a failure
+// (the mesh then means nothing).
 //
 // # Safety
 // `decoder` is a live handle; `out` points to `out_len` writable doubles.

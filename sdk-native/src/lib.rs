@@ -23,7 +23,7 @@ pub mod grid_tile;
 pub mod threaded;
 pub mod view;
 
-pub use ffi::Session;
+pub use ffi::{Refusal, Session};
 pub use view::{ScreenView, ViewError};
 
 // The README's Rust examples run as doctests, so they follow the API (one

@@ -69,6 +69,9 @@ pub enum ViewError {
     Distance(f32),
     /// Not a finite error above 0 pixels.
     Pixels(f32),
+    /// A model-space error bound that is NaN or below 0
+    /// (`Session::checked_level_within_error`).
+    MaxError(f32),
 }
 
 impl fmt::Display for ViewError {
@@ -90,6 +93,10 @@ impl fmt::Display for ViewError {
             ViewError::Pixels(v) => write!(
                 f,
                 "screen-space error {v} is not a finite number of pixels above 0"
+            ),
+            ViewError::MaxError(v) => write!(
+                f,
+                "error bound {v} is not a number of model units of at least 0"
             ),
         }
     }

@@ -267,7 +267,7 @@ fn a_live_decoder_checks_its_other_arguments() {
         );
         invalid(
             ss_decoder_positions_f64(d, ptr::null_mut(), n),
-            "output buffer shorter than 3 * vertex_count",
+            "null output pointer",
         );
         assert_eq!(
             ss_decoder_positions_f64(d, out.as_mut_ptr(), n),
@@ -393,10 +393,17 @@ fn every_invalid_vector_gets_the_status_of_its_class() {
                 };
                 let mut info = SsLevelInfo::default();
                 assert_eq!(ss_decoder_level_info(d, k, &mut info), SsStatus::Ok);
-                // A range past the stream's end: the bytes there are.
+                // A range past the stream's end: the bytes there are, which
+                // the decoder refuses, unchanged; the stream is truncated.
                 let start = (info.offset as usize).min(bytes.len());
                 let end = (start + info.length as usize).min(bytes.len());
                 status = ss_decoder_decode_level(d, k, bytes[start..end].as_ptr(), end - start);
+                if end - start < info.length as usize {
+                    assert_eq!(status, SsStatus::InvalidArgument, "{name}");
+                    assert!(last_error().1.contains("bytes; "), "{name}");
+                    assert_eq!(ss_decoder_next_level(d), i32::from(k), "{name}");
+                    status = SsStatus::Truncated;
+                }
             }
             ss_decoder_free(d);
             status

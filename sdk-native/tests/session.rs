@@ -225,3 +225,134 @@ fn a_budget_opens_the_levels_that_fit_and_decodes_them_exactly() {
         assert_eq!(err.class(), "capacity-exceeded");
     }
 }
+
+/// The Rust face of the C ABI's refusals: calls that cannot be right are
+/// refused before anything is decoded (`check_level` names why) and leave
+/// the session as it was; a failure spends it, and `next_round` then says
+/// so instead of `Ok(None)`.
+#[test]
+fn refusals_leave_the_session_as_it_was_and_failures_spend_it() {
+    use splitstream_decoder_core::Error;
+    use splitstream_sdk_native::{Refusal, ViewError};
+    let (name, stream, expected) = valid_vectors(usize::MAX)
+        .into_iter()
+        .find(|(_, b, _)| Session::open(b).unwrap().level_count() >= 3)
+        .expect("a vector with three levels");
+    let final_hash = expected.last().unwrap().clone();
+    let full = Session::open(&stream).unwrap();
+    let count = full.level_count();
+
+    // Wrong lengths, levels beyond the stream, out of order: refused, and
+    // the right bytes then decode, on one thread, two, or round by round.
+    let mut s = Session::open(&stream).unwrap();
+    for k in 0..count {
+        let right = level(&s, &stream, k);
+        let mut long = right.to_vec();
+        long.push(0);
+        for wrong in [&long[..], &right[..right.len() - 1], &stream[..], &[]] {
+            assert_eq!(
+                s.check_level(k, wrong.len()),
+                Err(Refusal::WrongLength {
+                    level: k,
+                    expected: right.len() as u32,
+                    given: wrong.len()
+                })
+            );
+            assert_eq!(s.decode_level(k, wrong), Err(Error::Truncated), "{name}");
+            assert_eq!(s.decode_level_two_threads(k, wrong), Err(Error::Truncated));
+            assert_eq!(s.begin_level(k, wrong), Err(Error::Truncated));
+            assert_eq!(s.failure(), None);
+            assert_eq!(s.next_level(), Some(k), "{name}: unchanged");
+        }
+        let e = s.decode_level(count, right).unwrap_err();
+        assert_eq!(
+            e,
+            Error::NoSuchLevel {
+                level: count,
+                count
+            }
+        );
+        if k > 0 {
+            assert_eq!(
+                s.begin_level(k - 1, level(&s, &stream, k - 1))
+                    .unwrap_err()
+                    .class(),
+                "api-misuse"
+            );
+        }
+        match k % 3 {
+            0 => s.decode_level(k, right).unwrap(),
+            1 => s.decode_level_two_threads(k, right).unwrap(),
+            _ => {
+                s.begin_level(k, right).unwrap();
+                let again = s.check_level(k, right.len()).unwrap_err();
+                assert_eq!(again, Refusal::LevelOpen { open: k, got: k });
+                assert!(again.to_string().contains("is already open"), "{again}");
+                while s.next_round().unwrap().is_some() {}
+            }
+        }
+    }
+    assert_eq!(format!("{:016x}", s.state_hash()), final_hash, "{name}");
+    let done = s.check_level(0, 0).unwrap_err();
+    assert!(done.to_string().contains("already decoded"), "{done}");
+
+    // A level beyond the memory: capacity-exceeded, nothing changed.
+    let budget = full.workspace_bytes() - 1;
+    let mut s = Session::open_within(&stream, budget).unwrap();
+    let fit = s.levels_that_fit();
+    assert_eq!(fit, count - 1);
+    assert_eq!(s.level_within_error(0.0), fit - 1);
+    assert_eq!(s.level_within_error(f32::NAN), fit - 1);
+    // NaN and negative bounds: the picker that says so refuses them.
+    assert!(matches!(
+        s.checked_level_within_error(f32::NAN),
+        Err(ViewError::MaxError(v)) if v.is_nan()
+    ));
+    assert_eq!(
+        s.checked_level_within_error(-1.0),
+        Err(ViewError::MaxError(-1.0))
+    );
+    assert_eq!(s.checked_level_within_error(f32::INFINITY), Ok(0));
+    let view = splitstream_sdk_native::ScreenView::perspective(1080.0, 1.0).unwrap();
+    assert_eq!(s.level_for_screen_error(&view, 0.0, 1.0), Ok(fit - 1));
+    let last = level(&s, &stream, fit);
+    let e = s.decode_level(fit, last).unwrap_err();
+    assert!(matches!(e, Error::WorkspaceTooSmall { .. }), "{e}");
+    assert_eq!(e.class(), "capacity-exceeded");
+    let r = s.check_level(fit, last.len()).unwrap_err();
+    assert_eq!(r.class(), "capacity-exceeded");
+    assert!(
+        r.to_string().contains(&format!(
+            "level {fit} does not fit the memory this decoder was opened with (levels 0..={} fit)",
+            fit - 1
+        )),
+        "{r}"
+    );
+    assert_eq!(s.next_level(), Some(0));
+
+    // A failure spends the session: every decoding call, next_round
+    // included, answers Poisoned.
+    let mut bad = level(&s, &stream, 0).to_vec();
+    let at = bad.len() - 1;
+    bad[at] ^= 0x5A;
+    let failed = s
+        .begin_level(0, &bad)
+        .and_then(|()| {
+            while s.next_round()?.is_some() {}
+            Ok(())
+        })
+        .unwrap_err();
+    assert_eq!(s.failure(), Some(failed));
+    for _ in 0..2 {
+        assert_eq!(s.next_round(), Err(Error::Poisoned));
+    }
+    assert_eq!(s.next_level(), None);
+    let l0 = level(&s, &stream, 0);
+    assert_eq!(s.decode_level(0, l0), Err(Error::Poisoned));
+    assert_eq!(s.decode_level_two_threads(0, l0), Err(Error::Poisoned));
+    assert_eq!(s.begin_level(0, l0), Err(Error::Poisoned));
+    assert_eq!(
+        s.check_level(0, l0.len()),
+        Err(Refusal::Failed { error: failed })
+    );
+}

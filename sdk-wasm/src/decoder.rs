@@ -129,10 +129,14 @@ impl StreamDecoder {
     }
 
     /// The coarsest level whose geometric error (model units) is at most
-    /// `maxError`, the last level when none is: decode levels 0 to it.
+    /// `maxError`, the last level that fits when none is: decode levels 0
+    /// to it. Throws `invalid-argument` for a NaN or negative `maxError`
+    /// (as `levelForScreenError` does for its parameters).
     #[wasm_bindgen(js_name = levelWithinError)]
-    pub fn level_within_error(&self, max_error: f32) -> u16 {
-        self.session.level_within_error(max_error)
+    pub fn level_within_error(&self, max_error: f32) -> Result<u16, SdkError> {
+        self.session
+            .checked_level_within_error(max_error)
+            .map_err(|e| SdkError::argument(e.to_string()))
     }
 
     /// The coarsest level whose geometric error covers at most `maxPixels`

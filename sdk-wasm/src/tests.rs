@@ -155,9 +155,16 @@ fn the_level_for_a_screen_error_follows_the_distance() {
     // Close up, the level within error 0; very far, the base level.
     assert_eq!(
         d.level_for_screen_error(1080.0, fov, 0.0, 2.0),
-        Ok(d.level_within_error(0.0))
+        Ok(d.level_within_error(0.0).unwrap())
     );
-    assert!(d.level_within_error(0.0) <= last);
+    assert!(d.level_within_error(0.0).unwrap() <= last);
+    // A bound that is no bound is refused, as the camera's parameters are.
+    for bad in [f32::NAN, -1.0] {
+        assert_eq!(
+            d.level_within_error(bad).unwrap_err().class,
+            "invalid-argument"
+        );
+    }
     assert_eq!(d.level_for_screen_error(1080.0, fov, 1e30, 2.0), Ok(0));
     let err = d
         .level_for_screen_error(1080.0, 4.0, 10.0, 2.0)

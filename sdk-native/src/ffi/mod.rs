@@ -12,7 +12,7 @@
 
 mod session;
 
-pub use session::Session;
+pub use session::{Refusal, Session};
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod c;

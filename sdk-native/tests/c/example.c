@@ -82,11 +82,23 @@ static int decode(const char *path) {
     while ((k = ss_decoder_next_level(d)) >= 0) {
         SsLevelInfo info;
         if (ss_decoder_level_info(d, (uint16_t)k, &info) != SS_STATUS_OK) goto failed;
-        if (info.offset + info.length > len) {
-            /* The bytes are not there: hand over what there is. */
-            info.length = info.offset < len ? (uint32_t)(len - info.offset) : 0;
-        }
         const unsigned char *bytes = stream + (info.offset < len ? info.offset : len);
+        if (info.offset + info.length > len) {
+            /* The bytes are not all there (a cut file, a short range
+               response): the decoder refuses what there is without failing,
+               so a client may fetch the level again; here the stream is
+               truncated. */
+            size_t have = info.offset < len ? (size_t)(len - info.offset) : 0;
+            if (ss_decoder_decode_level(d, (uint16_t)k, bytes, have) != SS_STATUS_INVALID_ARGUMENT
+                || ss_decoder_next_level(d) != k) {
+                fprintf(stderr, "a short level was not refused, or failed the decoder\n");
+                return 3;
+            }
+            printf("error truncated: %s\n", ss_last_error_message());
+            ss_decoder_free(d);
+            free(stream);
+            return 0;
+        }
         if (k % 3 == 0) {
             if (ss_decoder_decode_level(d, (uint16_t)k, bytes, info.length) != SS_STATUS_OK)
                 goto failed;

@@ -105,6 +105,7 @@ assert.ok(valid >= 5, 'too few valid vectors');
   assert.equal(d.levelForScreenError(1080, fov, 0, 2), d.levelWithinError(0));
   assert.equal(d.levelForScreenError(1080, fov, 1e30, 2), 0);
   assert.throws(() => d.levelForScreenError(1080, 4, 10, 2), (err) => err.class === 'invalid-argument');
+  assert.throws(() => d.levelWithinError(NaN), (err) => err.class === 'invalid-argument');
   // A memory budget: all levels with room for all, none with one byte.
   assert.equal(d.levelsThatFit, d.levelCount);
   const all = StreamDecoder.withinBudget(stream, d.workspaceBytes + 8);

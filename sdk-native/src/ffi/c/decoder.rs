@@ -2,8 +2,8 @@
 
 use std::ptr;
 
-use super::error::{SsStatus, fail_argument, fail_decoder, guard};
-use crate::ffi::Session;
+use super::error::{SsStatus, fail_argument, fail_decoder, fail_refusal, guard};
+use crate::ffi::{Refusal, Session};
 use crate::view::ScreenView;
 
 /// A progressive decoder (opaque). Create with `ss_decoder_open`, release
@@ -232,9 +232,12 @@ pub unsafe extern "C" fn ss_decoder_level_info(
     SsStatus::Ok
 }
 
-/// The coarsest level whose geometric error (decoder-core SPEC §4.1,
-/// model units) is at most `max_error`, the last level when none is, into
-/// `*out`: decode levels 0 ..= it.
+/// The coarsest level this decoder can decode (below
+/// `ss_decoder_levels_that_fit`) whose geometric error (decoder-core SPEC
+/// §4.1, model units) is at most `max_error`, the finest that fits when
+/// none is, into `*out`: decode levels 0 ..= it. `max_error` is a number
+/// of at least 0 (+infinity gives level 0); NaN or a negative bound is
+/// `SS_STATUS_INVALID_ARGUMENT`.
 ///
 /// # Safety
 /// `decoder` is null or a live handle; `out` is null or writable.
@@ -249,17 +252,23 @@ pub unsafe extern "C" fn ss_decoder_level_within_error(
         Ok(s) => s,
         Err(status) => return status,
     };
-    // SAFETY: checked non-null; writable per the contract.
-    unsafe { out.write(s.level_within_error(max_error)) };
-    SsStatus::Ok
+    match s.checked_level_within_error(max_error) {
+        Ok(k) => {
+            // SAFETY: checked non-null; writable per the contract.
+            unsafe { out.write(k) };
+            SsStatus::Ok
+        }
+        Err(e) => fail_argument(&e.to_string()),
+    }
 }
 
-/// The coarsest level whose geometric error covers at most `max_pixels`
-/// pixels on screen, for a perspective camera with a viewport
-/// `viewport_height` pixels high and a vertical field of view of `fov_y`
-/// radians, at `distance` model units from the object, into `*out`.
-/// Parameters that describe no camera are `SS_STATUS_INVALID_ARGUMENT`,
-/// with the reason in `ss_last_error_message`.
+/// The coarsest level this decoder can decode (below
+/// `ss_decoder_levels_that_fit`) whose geometric error covers at most
+/// `max_pixels` pixels on screen, the finest that fits when none does, for
+/// a perspective camera with a viewport `viewport_height` pixels high and
+/// a vertical field of view of `fov_y` radians, at `distance` model units
+/// from the object, into `*out`. Parameters that describe no camera are
+/// `SS_STATUS_INVALID_ARGUMENT`, with the reason in `ss_last_error_message`.
 ///
 /// # Safety
 /// `decoder` is null or a live handle; `out` is null or writable.
@@ -299,8 +308,9 @@ pub unsafe extern "C" fn ss_decoder_workspace_bytes(decoder: *const SsDecoder) -
     unsafe { session(decoder) }.map_or(0, Session::workspace_bytes)
 }
 
-/// The level to feed next, or -1 when every level is decoded, a level is
-/// being decoded round by round, the decoder failed, or it is null.
+/// The level to feed next, or -1 when every level that fits is decoded, a
+/// level is being decoded round by round, the decoder failed, or it is
+/// null.
 ///
 /// # Safety
 /// `decoder` is null or a live handle.
@@ -313,8 +323,20 @@ pub unsafe extern "C" fn ss_decoder_next_level(decoder: *const SsDecoder) -> i32
 }
 
 /// Decodes level `level` whole from its bytes `bytes[0 .. len]` (exactly
-/// the level's range). After a failure the decoder answers only
-/// `SS_STATUS_API_MISUSE`: open a new one.
+/// the level's range, `SsLevelInfo::length` bytes).
+///
+/// Refused before anything is decoded, the decoder unchanged (the call may
+/// be repeated with the right arguments): `SS_STATUS_INVALID_ARGUMENT` for
+/// a null pointer, a level beyond the stream, or `len` other than the
+/// level's length (a short range response: fetch the level again);
+/// `SS_STATUS_CAPACITY_EXCEEDED` for a level beyond
+/// `ss_decoder_levels_that_fit`; `SS_STATUS_API_MISUSE` for a level out of
+/// order or given while a level begun with `ss_decoder_begin_level` is
+/// open. Any other status is a failure of the level's bytes: the decoder
+/// is then spent, and `ss_decoder_decode_level`,
+/// `ss_decoder_decode_level_two_threads`, `ss_decoder_begin_level`,
+/// `ss_decoder_next_round` and `ss_decoder_positions_f64` answer only
+/// `SS_STATUS_API_MISUSE` (`ss_decoder_next_level` -1): open a new one.
 ///
 /// # Safety
 /// `decoder` is a live handle; `bytes` points to `len` readable bytes.
@@ -326,7 +348,7 @@ pub unsafe extern "C" fn ss_decoder_decode_level(
     len: usize,
 ) -> SsStatus {
     // SAFETY: the caller's contract is this function's.
-    unsafe { with_level_bytes(decoder, bytes, len, |s, b| s.decode_level(level, b)) }
+    unsafe { with_level_bytes(decoder, level, bytes, len, Session::decode_level) }
 }
 
 /// `ss_decoder_decode_level` on two cores: the rounds on the calling
@@ -346,15 +368,20 @@ pub unsafe extern "C" fn ss_decoder_decode_level_two_threads(
 ) -> SsStatus {
     // SAFETY: the caller's contract is this function's.
     unsafe {
-        with_level_bytes(decoder, bytes, len, |s, b| {
-            s.decode_level_two_threads(level, b)
-        })
+        with_level_bytes(
+            decoder,
+            level,
+            bytes,
+            len,
+            Session::decode_level_two_threads,
+        )
     }
 }
 
 /// Starts level `level` from its bytes (copied) for round-by-round
 /// decoding with `ss_decoder_next_round`; level 0's seed mesh is decoded
-/// here.
+/// here. Refusals and failures as `ss_decoder_decode_level`'s; a level
+/// given while this one is open is refused with `SS_STATUS_API_MISUSE`.
 ///
 /// # Safety
 /// `decoder` is a live handle; `bytes` points to `len` readable bytes.
@@ -366,19 +393,22 @@ pub unsafe extern "C" fn ss_decoder_begin_level(
     len: usize,
 ) -> SsStatus {
     // SAFETY: the caller's contract is this function's.
-    unsafe { with_level_bytes(decoder, bytes, len, |s, b| s.begin_level(level, b)) }
+    unsafe { with_level_bytes(decoder, level, bytes, len, Session::begin_level) }
 }
 
-/// Runs `f` on the session behind `decoder` and the level bytes
-/// `bytes[0 .. len]`, turning bad arguments and decoder errors into statuses.
+/// Runs `f` on the session behind `decoder`, level `level` and its bytes
+/// `bytes[0 .. len]`, turning bad arguments, refusals (checked first, with
+/// their own messages: `Session::check_level`) and decoder errors into
+/// statuses.
 ///
 /// # Safety
 /// `decoder` is a live handle; `bytes` points to `len` readable bytes.
 unsafe fn with_level_bytes(
     decoder: *mut SsDecoder,
+    level: u16,
     bytes: *const u8,
     len: usize,
-    f: impl FnOnce(&mut Session, &[u8]) -> Result<(), splitstream_decoder_core::Error>,
+    f: impl FnOnce(&mut Session, u16, &[u8]) -> Result<(), splitstream_decoder_core::Error>,
 ) -> SsStatus {
     guard(|| {
         // SAFETY: per the contract.
@@ -386,7 +416,10 @@ unsafe fn with_level_bytes(
             (Ok(s), Ok(b)) => (s, b),
             (Err(e), _) | (_, Err(e)) => return e,
         };
-        match f(s, b) {
+        if let Err(r) = s.check_level(level, b.len()) {
+            return fail_refusal(r);
+        }
+        match f(s, level, b) {
             Ok(()) => SsStatus::Ok,
             Err(e) => fail_decoder(e),
         }
@@ -394,8 +427,11 @@ unsafe fn with_level_bytes(
 }
 
 /// Decodes the next round of the level begun with `ss_decoder_begin_level`.
-/// `*decoded` is true when a round was decoded, false when the level is
-/// complete (and verified) or none is open.
+/// With `SS_STATUS_OK`, `*decoded` is true when a round was decoded, false
+/// when the level is complete (and verified) or none is open. A round that
+/// fails spends the decoder; from then on this call answers
+/// `SS_STATUS_API_MISUSE` (never `SS_STATUS_OK` with false), as after any
+/// failure (`ss_decoder_decode_level`).
 ///
 /// # Safety
 /// `decoder` is a live handle; `decoded` is writable.
@@ -413,6 +449,9 @@ pub unsafe extern "C" fn ss_decoder_next_round(
             Ok(s) => s,
             Err(e) => return e,
         };
+        if let Some(error) = s.failure() {
+            return fail_refusal(Refusal::Failed { error });
+        }
         match s.next_round() {
             Ok(r) => {
                 // SAFETY: checked non-null; writable per the contract.
@@ -445,7 +484,9 @@ pub unsafe extern "C" fn ss_decoder_triangle_count(decoder: *const SsDecoder) ->
 }
 
 /// Quantized positions, `x, y, z` per vertex (`3 * vertex_count` values),
-/// valid until the decoder next changes; null for a null handle.
+/// valid until the decoder next changes; null for a null handle. These
+/// getters (counts, positions, triangles, state hash) answer after a
+/// failure too, but the mesh they then show means nothing.
 ///
 /// # Safety
 /// `decoder` is null or a live handle.
@@ -468,7 +509,9 @@ pub unsafe extern "C" fn ss_decoder_triangles(decoder: *const SsDecoder) -> *con
 
 /// Writes the real (dequantized) positions, `x, y, z` per vertex, into
 /// `out[0 .. 3 * vertex_count]`; `out_len` is the buffer's length in
-/// doubles.
+/// doubles. `SS_STATUS_INVALID_ARGUMENT` for a null `out` (unless the mesh
+/// is empty) or a buffer too short; `SS_STATUS_API_MISUSE` after a failure
+/// (the mesh then means nothing).
 ///
 /// # Safety
 /// `decoder` is a live handle; `out` points to `out_len` writable doubles.
@@ -482,9 +525,17 @@ pub unsafe extern "C" fn ss_decoder_positions_f64(
     let Some(s) = (unsafe { session(decoder) }) else {
         return fail_argument("null decoder");
     };
+    if let Some(error) = s.failure() {
+        return fail_refusal(Refusal::Failed { error });
+    }
     let n = 3 * s.positions().len();
-    if out_len < n || (out.is_null() && n > 0) {
-        return fail_argument("output buffer shorter than 3 * vertex_count");
+    if out.is_null() && n > 0 {
+        return fail_argument("null output pointer");
+    }
+    if out_len < n {
+        return fail_argument(&format!(
+            "output buffer shorter than 3 * vertex_count: {n} doubles needed, {out_len} given"
+        ));
     }
     if n == 0 {
         return SsStatus::Ok;

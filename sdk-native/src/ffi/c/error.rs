@@ -6,6 +6,7 @@ use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use splitstream_decoder_core::Error;
 
+use crate::ffi::Refusal;
 use crate::grid_tile::GridTileError;
 
 /// Result of a C ABI call. The decoder's codes are its conformance error
@@ -19,6 +20,10 @@ pub enum SsStatus {
     Malformed = 3,
     ChecksumMismatch = 4,
     Truncated = 5,
+    /// A count beyond the capacity the header declares; a memory budget
+    /// (`ss_decoder_open_within`) too small for the base level; a level
+    /// beyond those that fit the decoder's memory
+    /// (`ss_decoder_levels_that_fit`), refused without failing the decoder.
     CapacityExceeded = 6,
     CountMismatch = 7,
     RingOffsetOutOfRange = 8,
@@ -26,9 +31,13 @@ pub enum SsStatus {
     // 10 is unused: format 1.0's dependent-splits, gone in 2.0.
     NonManifold = 11,
     PositionOutOfRange = 12,
-    /// Levels fed out of order, a decoder used after an error, …
+    /// Levels fed out of order or while another is open (refused, the
+    /// decoder unchanged); any decoding call after a failure.
     ApiMisuse = 13,
-    /// A null pointer, a too-short buffer, a level index out of range.
+    /// A null pointer, a level's bytes of another length than its
+    /// level-table entry's, an output buffer too short, a level index out of
+    /// range, a value that is not a number the call takes. Refused before
+    /// anything is decoded: the decoder is unchanged.
     InvalidArgument = 14,
     /// The grid-tile simplifier refused its input (see the message).
     GridTile = 15,
@@ -81,6 +90,17 @@ pub(crate) fn fail_decoder(e: Error) -> SsStatus {
 pub(crate) fn fail_grid(e: GridTileError) -> SsStatus {
     set_last("grid-tile", e.to_string());
     SsStatus::GridTile
+}
+
+/// Records a call the session refused (it is unchanged) and gives its
+/// status: `api-misuse`, `capacity-exceeded` or `invalid-argument`.
+pub(crate) fn fail_refusal(r: Refusal) -> SsStatus {
+    set_last(r.class(), r.to_string());
+    match r.class() {
+        "capacity-exceeded" => SsStatus::CapacityExceeded,
+        "invalid-argument" => SsStatus::InvalidArgument,
+        _ => SsStatus::ApiMisuse,
+    }
 }
 
 pub(crate) fn fail_argument(what: &str) -> SsStatus {
