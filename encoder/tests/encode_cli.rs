@@ -912,3 +912,26 @@ fn outputs_and_options_that_would_lose_data_or_run_away_are_refused_first() {
     assert_eq!(std::fs::read(&mesh_out).unwrap(), b"not a stream");
     assert!(!out.exists(), "a refused encoding wrote {}", out.display());
 }
+
+/// Two files glued together verified as one, silently (an audit,
+/// 2026-12-08): the bytes after the last level (SPEC §4.2) are now said.
+#[test]
+fn verify_says_bytes_after_the_last_level() {
+    let input = raster();
+    let out = input.with_file_name("glued.sps");
+    let o = out.to_str().unwrap();
+    succeeded(&splitstream(&["encode", input.to_str().unwrap(), "-o", o]));
+    let clean = succeeded(&splitstream(&["verify", o]));
+    assert!(!clean.contains("note:"), "{clean}");
+    let mut bytes = std::fs::read(&out).unwrap();
+    let end = bytes.len();
+    bytes.extend_from_slice(b"14 extra bytes");
+    std::fs::write(&out, &bytes).unwrap();
+    let glued = succeeded(&splitstream(&["verify", o]));
+    assert!(
+        glued.contains(&format!(
+            "note: 14 bytes after the last level's end (byte {end}) are not part of the stream"
+        )),
+        "{glued}"
+    );
+}

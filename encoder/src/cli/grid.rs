@@ -165,7 +165,7 @@ pub fn run(args: Args) -> CliResult {
         .map_err(|e| format!("{}: {e}", args.input.display()))?;
     let elapsed = start.elapsed();
     println!(
-        "grid {} x {} samples, spacing {:.3} x {:.3}, H {}, T {:.4}",
+        "grid {} rows x {} columns, spacing {:.3} (x) x {:.3} (y), H {}, T {:.4}",
         grid.rows, grid.cols, grid.spacing[0], grid.spacing[1], args.height, stats.threshold
     );
     println!(

@@ -23,6 +23,17 @@ pub fn run(input: &Path) -> CliResult {
         started.elapsed().as_secs_f64() * 1e3
     );
     println!("state hash {:016x}", verified.hash);
+    // SPEC §4.2: bytes after the last level are not part of the stream.
+    // Said, so that two files glued together do not pass for one.
+    if let Some(extra) = (stream.len() as u64)
+        .checked_sub(verified.end)
+        .filter(|&n| n > 0)
+    {
+        println!(
+            "note: {extra} bytes after the last level's end (byte {}) are not part of the stream and were not read",
+            verified.end
+        );
+    }
     Ok(())
 }
 
@@ -34,6 +45,8 @@ struct Verified {
     triangles: u32,
     /// The state hash after the last round (SPEC §8).
     hash: u64,
+    /// Where the last level ends (SPEC §4.2).
+    end: u64,
 }
 
 /// Decodes every level of `stream`, a large level's records on a second
@@ -51,7 +64,11 @@ fn verify(stream: &[u8]) -> Result<Verified, Error> {
             rounds += round.is_some() as usize;
         })?;
     }
+    let end = decoder
+        .level_range(decoder.levels_done().saturating_sub(1))
+        .end;
     Ok(Verified {
+        end,
         levels: decoder.levels_done(),
         rounds,
         vertices: decoder.state().vertex_count(),

@@ -1,7 +1,7 @@
 //! ESRI ASCII grid (`.asc`) reader, by hand.
 //!
 //! Header: `ncols`, `nrows`, `xllcorner`|`xllcenter`, `yllcorner`|`yllcenter`,
-//! `cellsize` or `dx` + `dy`, optional `NODATA_value`; keys are
+//! `cellsize` or `dx` + `dy`, optional `NODATA_value` (or `nodata`); keys are
 //! case-insensitive and in any order. Then `nrows * ncols` values, rows north
 //! to south, laid out over lines in any way. Samples sit at cell centres, so
 //! a `*corner` origin is shifted by half a cell.
@@ -13,6 +13,7 @@ use super::{InputError, check_vertex_count};
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Grid, InputError> {
     let bytes = std::fs::read(path).map_err(|e| InputError::io(file, e))?;
+    super::refuse_utf16(&bytes, file)?;
     let text = super::text_of(&bytes);
     parse(&text, file)
 }
@@ -66,7 +67,9 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Grid, InputError> {
             "cellsize" => h.cellsize = Some(num()?),
             "dx" | "xdim" => h.dx = Some(num()?),
             "dy" | "ydim" => h.dy = Some(num()?),
-            "nodata_value" => h.nodata = Some(num()?),
+            // `nodata` is how some writers (and GDAL's driver, reading)
+            // spell it.
+            "nodata_value" | "nodata" => h.nodata = Some(num()?),
             "byteorder" => {}
             _ => {
                 return Err(InputError::line(
@@ -154,6 +157,16 @@ mod tests {
         // South row first.
         assert_eq!(g.elevations, vec![4.0, 5.0, -9999.0, 1.0, 2.0, 3.0]);
         assert_eq!(g.nodata, Some(-9999.0));
+    }
+
+    /// `nodata` for `NODATA_value` (an audit, 2026-12-08), and a byte
+    /// order mark before the header.
+    #[test]
+    fn nodata_spelled_short_and_a_byte_order_mark() {
+        let text = format!("\u{feff}{}", SAMPLE.replace("NODATA_value", "nodata"));
+        let f = TempFile::new("short.asc", text.as_bytes());
+        let m = read_mesh(&f.0, &ReadOptions::default()).unwrap();
+        assert_eq!((m.positions.len(), m.triangles.len()), (5, 3));
     }
 
     #[test]

@@ -156,6 +156,19 @@ pub(crate) fn text_of(bytes: &[u8]) -> std::borrow::Cow<'_, str> {
     }
 }
 
+/// Refuses a text file saved as UTF-16 (its byte order mark first): read
+/// as bytes it held no statement, and the check said only that the mesh
+/// was empty.
+pub(crate) fn refuse_utf16(bytes: &[u8], file: &str) -> Result<(), InputError> {
+    if bytes.starts_with(b"\xFF\xFE") || bytes.starts_with(b"\xFE\xFF") {
+        return Err(InputError::unsupported(
+            file,
+            "a UTF-16 text file (save it as UTF-8 or ASCII)",
+        ));
+    }
+    Ok(())
+}
+
 /// The UTF-8 byte order mark, which a text file may begin with.
 pub(crate) const UTF8_BOM: &[u8] = b"\xEF\xBB\xBF";
 

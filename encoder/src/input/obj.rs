@@ -24,6 +24,7 @@ use super::{InputError, ascii_lines, check_vertex_count, text_of};
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let bytes = std::fs::read(path).map_err(|e| InputError::io(file, e))?;
+    super::refuse_utf16(&bytes, file)?;
     parse(&text_of(&bytes), file)
 }
 
@@ -60,6 +61,7 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
     let mut corners: Vec<(i64, usize)> = Vec::new();
     let mut polygon: Vec<(i64, usize)> = Vec::new();
     let mut polygons = super::Polygons::default();
+    let mut skipped = 0usize;
     for (line, statement) in statements(text) {
         // OBJ is ASCII: its separators are ASCII blanks; `#` starts a
         // comment anywhere on a line (`f 1 2 3 # a quad` was refused).
@@ -119,8 +121,15 @@ pub(super) fn parse(text: &str, file: &str) -> Result<Mesh, InputError> {
                     corners.extend([polygon[0], polygon[i], polygon[i + 1]]);
                 }
             }
+            Some("l" | "p") => skipped += 1,
             _ => {}
         }
+    }
+    if corners.is_empty() && skipped > 0 {
+        return Err(InputError::malformed(
+            file,
+            format!("no faces ('f'): {skipped} line or point statements ('l', 'p') skipped"),
+        ));
     }
     let n = mesh.positions.len() as i64;
     let resolve = |(index, line): (i64, usize)| {
@@ -196,6 +205,29 @@ vt 0 0\nvn 0 0 1\no first\ng a\nusemtl red\nf 1/1/1 2/1/1 3/1/1 4/1/1\ng b\nf -4
             let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
             assert!(area > 0.0, "{t:?} in {:?}", m.triangles);
         }
+    }
+
+    /// Files with nothing to read said only that the mesh was empty (an
+    /// audit, 2026-12-08).
+    #[test]
+    fn lines_only_and_utf16_files_say_why_nothing_was_read() {
+        let f = TempFile::new("lines.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2 3\np 1\n");
+        let err = read_mesh(&f.0, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("no faces ('f'): 2 line or point statements"),
+            "{err}"
+        );
+        let utf16: Vec<u8> = "\u{feff}v 0 0 0\n"
+            .encode_utf16()
+            .flat_map(u16::to_le_bytes)
+            .collect();
+        let f = TempFile::new("utf16.obj", &utf16);
+        let err = read_mesh(&f.0, &ReadOptions::default())
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("a UTF-16 text file"), "{err}");
     }
 
     #[test]

@@ -14,6 +14,7 @@ use super::{InputError, Polygons, ascii_lines, check_vertex_count, push_polygon,
 
 pub(super) fn read(path: &Path, file: &str) -> Result<Mesh, InputError> {
     let bytes = std::fs::read(path).map_err(|e| InputError::io(file, e))?;
+    super::refuse_utf16(&bytes, file)?;
     parse(&text_of(&bytes), file)
 }
 
