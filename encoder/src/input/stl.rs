@@ -71,14 +71,12 @@ pub(super) fn parse(bytes: &[u8], file: &str) -> Result<Mesh, InputError> {
         Some(0) => format!(
             "binary STL header declares 0 facets, but {} bytes of facet data \
              follow it; {not_ascii}",
-            grouped(len - HEADER as u64)
+            len - HEADER as u64
         ),
         Some(count) => format!(
-            "binary STL header declares {} facets ({} bytes), the file has {} \
-             bytes; {not_ascii}",
-            grouped(count),
-            grouped(binary_size(count)),
-            grouped(len)
+            "binary STL header declares {count} facets ({} bytes), the file has \
+             {len} bytes; {not_ascii}",
+            binary_size(count),
         ),
     };
     Err(InputError::malformed(file, message))
@@ -111,19 +109,6 @@ fn begins_with_solid(bytes: &[u8]) -> bool {
         }
         None => false,
     }
-}
-
-/// `n` with thousands separators: 1,084.
-fn grouped(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
-    for (i, d) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(d);
-    }
-    out
 }
 
 /// The facets after the header, `count` of them (the caller checked the
@@ -508,7 +493,7 @@ mod tests {
         let mut huge = binary(b"", &TETRA);
         huge[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
         assert!(error(&huge).starts_with(
-            "bad.stl: binary STL header declares 4,294,967,295 facets (214,748,364,834 bytes), \
+            "bad.stl: binary STL header declares 4294967295 facets (214748364834 bytes), \
              the file has 284 bytes"
         ));
     }
@@ -683,7 +668,7 @@ mod tests {
         truncated[80..84].copy_from_slice(&20u32.to_le_bytes());
         assert_eq!(truncated.len(), 684);
         assert!(error(&truncated).starts_with(
-            "bad.stl: binary STL header declares 20 facets (1,084 bytes), the file has 684 bytes"
+            "bad.stl: binary STL header declares 20 facets (1084 bytes), the file has 684 bytes"
         ));
         // The same with a header that begins like ascii.
         let mut solid_header = binary(b"solid part", &TETRA);
@@ -801,20 +786,6 @@ mod tests {
                     let _ = parse(&damaged, "x.stl");
                 }
             }
-        }
-    }
-
-    #[test]
-    fn thousands_separators() {
-        let cases = [
-            (0, "0"),
-            (684, "684"),
-            (1084, "1,084"),
-            (123456, "123,456"),
-            (1234567, "1,234,567"),
-        ];
-        for (n, s) in cases {
-            assert_eq!(grouped(n), s);
         }
     }
 }
