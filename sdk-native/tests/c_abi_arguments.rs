@@ -6,24 +6,14 @@
 //! through a static library that coverage tools do not see, so the checks
 //! are held here, where `cargo llvm-cov` measures them.)
 
+mod c_abi_common;
 mod vectors;
 
-use std::ffi::CStr;
 use std::ptr;
 
+use c_abi_common::{last_error, level_bytes, open, stream};
 use splitstream_sdk_native::ffi::c::*;
 use vectors::newest_vectors;
-
-/// The last error on this thread, as (class, message).
-fn last_error() -> (String, String) {
-    let text = |p: *const std::ffi::c_char| {
-        assert!(!p.is_null(), "the last error's strings are never null");
-        // SAFETY: ss_last_error_* return NUL-terminated strings valid until
-        // the next failing call on this thread.
-        unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned()
-    };
-    (text(ss_last_error_class()), text(ss_last_error_message()))
-}
 
 /// `status` is `SS_STATUS_INVALID_ARGUMENT` and the message names `what`.
 fn invalid(status: SsStatus, what: &str) {
@@ -31,33 +21,6 @@ fn invalid(status: SsStatus, what: &str) {
     let (class, message) = last_error();
     assert_eq!(class, "invalid-argument");
     assert!(message.contains(what), "{message:?} does not say {what:?}");
-}
-
-/// A small valid stream of several levels from the conformance vectors.
-fn stream() -> Vec<u8> {
-    std::fs::read(newest_vectors().join("valid/bunny-npm.sps")).expect("bunny-npm vector")
-}
-
-/// A decoder over the whole of `stream`.
-fn open(stream: &[u8]) -> *mut SsDecoder {
-    let mut d = ptr::null_mut();
-    // SAFETY: a live slice and a writable out pointer.
-    let status = unsafe { ss_decoder_open(stream.as_ptr(), stream.len(), &mut d) };
-    assert_eq!(status, SsStatus::Ok);
-    assert!(!d.is_null());
-    d
-}
-
-/// The bytes of level `k` (offset and length from its table entry).
-fn level_bytes(d: *const SsDecoder, stream: &[u8], k: u16) -> Vec<u8> {
-    let mut info = SsLevelInfo::default();
-    // SAFETY: a live handle and a writable struct.
-    assert_eq!(
-        unsafe { ss_decoder_level_info(d, k, &mut info) },
-        SsStatus::Ok
-    );
-    let start = info.offset as usize;
-    stream[start..start + info.length as usize].to_vec()
 }
 
 #[test]

@@ -7,21 +7,13 @@
 //! `SS_STATUS_INVALID_ARGUMENT`, refused before anything is decoded, and
 //! the right bytes then decode to the same state as a clean decode.
 
+mod c_abi_common;
 mod vectors;
 
-use std::ffi::CStr;
 use std::ptr;
 
+use c_abi_common::{last_error, level_bytes, open, open_within, stream};
 use splitstream_sdk_native::ffi::c::*;
-use vectors::newest_vectors;
-
-/// The last error on this thread, as (class, message).
-fn last_error() -> (String, String) {
-    // SAFETY: ss_last_error_* return NUL-terminated strings valid until
-    // the next failing call on this thread.
-    let text = |p| unsafe { CStr::from_ptr(p) }.to_string_lossy().into_owned();
-    (text(ss_last_error_class()), text(ss_last_error_message()))
-}
 
 /// `status` is `want`, the last error of `class`, its message saying `what`.
 #[track_caller]
@@ -30,38 +22,6 @@ fn refused(status: SsStatus, want: SsStatus, class: &str, what: &str) {
     let (got_class, message) = last_error();
     assert_eq!(got_class, class, "{message}");
     assert!(message.contains(what), "{message:?} does not say {what:?}");
-}
-
-/// A small valid stream of several levels from the conformance vectors.
-fn stream() -> Vec<u8> {
-    std::fs::read(newest_vectors().join("valid/bunny-npm.sps")).expect("bunny-npm vector")
-}
-
-/// A decoder over the whole of `stream` with at most `budget` bytes of
-/// working memory.
-fn open_within(stream: &[u8], budget: u64) -> *mut SsDecoder {
-    let mut d = ptr::null_mut();
-    // SAFETY: a live slice and a writable out pointer.
-    let status = unsafe { ss_decoder_open_within(stream.as_ptr(), stream.len(), budget, &mut d) };
-    assert_eq!(status, SsStatus::Ok, "{:?}", last_error());
-    assert!(!d.is_null());
-    d
-}
-
-fn open(stream: &[u8]) -> *mut SsDecoder {
-    open_within(stream, u64::MAX)
-}
-
-/// The bytes of level `k` (offset and length from its table entry).
-fn level_bytes(d: *const SsDecoder, stream: &[u8], k: u16) -> Vec<u8> {
-    let mut info = SsLevelInfo::default();
-    // SAFETY: a live handle and a writable struct.
-    assert_eq!(
-        unsafe { ss_decoder_level_info(d, k, &mut info) },
-        SsStatus::Ok
-    );
-    let start = info.offset as usize;
-    stream[start..start + info.length as usize].to_vec()
 }
 
 /// Level `k`'s bytes with one byte in its last chunk flipped (the chunk's
